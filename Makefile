@@ -1,0 +1,47 @@
+# One command to set up, one to start the lab, one to test. All are idempotent.
+#   make setup   create .venv/ from environment.txt and install course_lib into it
+#   make lab     set up, then start JupyterLab on the course (prints the URL; no browser needed)
+#   make test    set up, then run the whole test suite (unit tests, notebooks, browser tests)
+
+PYTHON ?= python3
+VENV   := .venv
+PY     := $(VENV)/bin/python
+UV     := $(VENV)/bin/uv
+UV_VERSION := 0.13.8
+LAB_PORT ?= 8888
+PYTEST_ARGS ?=
+
+.PHONY: setup lab test browser-deps clean
+
+setup: $(VENV)/.setup-done
+
+$(VENV)/.setup-done: environment.txt pyproject.toml course_lib/wheelfix.py
+	@$(PYTHON) -c 'import sys; v = sys.version_info[:2]; ok = (3, 10) <= v <= (3, 13); \
+	print("Using Python %d.%d from %s" % (v + (sys.executable,))) if ok else \
+	sys.exit("Python %d.%d found, but the ROS 2 Jazzy wheels exist for CPython 3.10-3.13 only. " \
+	"Run: make setup PYTHON=python3.12 (or any 3.10-3.13 interpreter)" % v)'
+	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
+	@test -x $(UV) || $(PY) -m pip install --quiet --disable-pip-version-check uv==$(UV_VERSION)
+	$(UV) pip install --quiet --python $(PY) -r environment.txt -e .
+	$(PY) -m course_lib repair-wheels
+	@touch $@
+
+lab: setup
+	$(VENV)/bin/jupyter lab --no-browser --ip=127.0.0.1 --port=$(LAB_PORT) \
+	  --ServerApp.root_dir="$(CURDIR)" --LabApp.default_url=/lab/tree/notebooks
+
+# Browser tests need Debian's chromium. Install it when we may (root with apt); otherwise the
+# browser tests skip and say why.
+browser-deps:
+	@if command -v chromium >/dev/null 2>&1; then :; \
+	elif [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then \
+	  echo "Installing Debian's chromium for the browser tests"; \
+	  (apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium >/dev/null) \
+	    || echo "Could not install chromium: browser tests will be skipped"; \
+	else echo "chromium is not installed and this user cannot apt-get it: browser tests will be skipped"; fi
+
+test: setup browser-deps
+	$(PY) -m pytest $(PYTEST_ARGS)
+
+clean:
+	rm -rf $(VENV) .pytest_cache artifacts

@@ -1,0 +1,36 @@
+"""Command line of course_lib: ``python -m course_lib COMMAND``.
+
+Commands:
+    doctor            check the ROS 2 environment and run a live pub/sub round trip
+    build WS [ARGS]   run the real ``colcon build`` in workspace WS with the right environment
+    repair-wheels     make the pip-installed ROS 2 CMake files usable in this environment
+"""
+
+from __future__ import annotations
+
+import sys
+
+USAGE = __doc__.split("Commands:")[1]
+
+
+def main(argv: list[str] | None = None) -> int:
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if not argv or argv[0] in ("-h", "--help", "help"):
+        print("usage: python -m course_lib COMMAND\n\ncommands:" + USAGE)
+        return 0 if argv else 2
+    command, rest = argv[0], argv[1:]
+    if command == "doctor":
+        from course_lib import doctor
+        return doctor.main(rest)
+    if command == "build":
+        from course_lib import workspace
+        return workspace.main_build(rest)
+    if command == "repair-wheels":
+        from course_lib import wheelfix
+        return wheelfix.main(rest)
+    print(f"unknown command {command!r}; commands:{USAGE}", file=sys.stderr)
+    return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

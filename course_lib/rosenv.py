@@ -1,0 +1,216 @@
+"""Where ROS 2 comes from, and the environment every ROS process of the course runs in.
+
+The course runs on three kinds of ROS 2 Jazzy install, and this module is the one place that
+tells them apart:
+
+- ``pip``: the ros-jazzy-* wheels from PyPI inside the project's virtual environment;
+- ``system``: the Debian packages under ``/opt/ros/jazzy`` (Ubuntu 24.04), sourced in the shell;
+- ``conda``: RoboStack in a conda/mamba environment, activated in the shell.
+
+Traffic isolation is also written once here: every process the course starts gets a
+``ROS_DOMAIN_ID`` of its own and ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import errno
+import fcntl
+import importlib.metadata
+import importlib.util
+import os
+import sys
+import tempfile
+from pathlib import Path
+
+DISTRO = "jazzy"
+SYSTEM_PREFIX = Path("/opt/ros") / DISTRO
+
+#: Domain ids handed out to test runs and graders. Fast DDS maps a domain to UDP ports
+#: 7400 + 250 * id, so ids above 232 do not fit; 0 stays free for the student's own session.
+RESERVABLE_DOMAIN_IDS = range(1, 102)
+
+
+@dataclasses.dataclass(frozen=True)
+class RosInstall:
+    """What provides rclpy in this interpreter.
+
+    Attributes:
+        kind: "pip", "system", "conda" or "missing".
+        rclpy_path: the directory rclpy is imported from (None when missing).
+        prefixes: ament prefixes that hold the ament index (share/ament_index).
+        distro: the ROS distribution name from ROS_DISTRO or the install layout.
+    """
+
+    kind: str
+    rclpy_path: Path | None
+    prefixes: tuple[Path, ...]
+    distro: str | None
+
+    def describe(self) -> str:
+        if self.kind == "missing":
+            return "rclpy is not importable"
+        names = {"pip": "pip wheels (ros-jazzy-* from PyPI)", "system": "system install",
+                 "conda": "conda environment (RoboStack)"}
+        return f"{names[self.kind]} at {self.rclpy_path}"
+
+
+def _has_ament_index(prefix: Path) -> bool:
+    return (prefix / "share" / "ament_index" / "resource_index").is_dir()
+
+
+def _env_prefixes() -> list[Path]:
+    return [Path(p) for p in os.environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep) if p]
+
+
+def detect_install() -> RosInstall:
+    """Find out where rclpy comes from without importing it (importing it can be slow)."""
+    spec = importlib.util.find_spec("rclpy")
+    if spec is None or not spec.submodule_search_locations:
+        return RosInstall("missing", None, tuple(_env_prefixes()), os.environ.get("ROS_DISTRO"))
+    rclpy_path = Path(next(iter(spec.submodule_search_locations))).resolve()
+    prefixes = _env_prefixes()
+    conda_prefix = os.environ.get("CONDA_PREFIX")
+    if _is_relative_to(rclpy_path, SYSTEM_PREFIX.resolve() if SYSTEM_PREFIX.exists() else SYSTEM_PREFIX):
+        kind = "system"
+    elif conda_prefix and _is_relative_to(rclpy_path, Path(conda_prefix).resolve()):
+        kind = "conda"
+        prefixes.append(Path(conda_prefix))
+    elif _pip_wheels_installed():
+        kind = "pip"
+        prefixes.insert(0, Path(sys.prefix))
+    else:
+        # Some other prefix (a source build, a colcon overlay): treat it like a sourced install.
+        kind = "system"
+    distro = os.environ.get("ROS_DISTRO") or (DISTRO if kind == "pip" else None)
+    return RosInstall(kind, rclpy_path, tuple(_unique(p for p in prefixes if _has_ament_index(p))), distro)
+
+
+def _pip_wheels_installed() -> bool:
+    try:
+        importlib.metadata.version("ros-jazzy-rclpy")
+    except importlib.metadata.PackageNotFoundError:
+        return False
+    return True
+
+
+def _is_relative_to(path: Path, parent: Path) -> bool:
+    try:
+        path.relative_to(parent)
+    except ValueError:
+        return False
+    return True
+
+
+def _unique(items):
+    seen = []
+    for item in items:
+        if item not in seen:
+            seen.append(item)
+    return seen
+
+
+def ros_environment(domain_id: int | None = None, base: dict[str, str] | None = None,
+                    install: RosInstall | None = None) -> dict[str, str]:
+    """The environment for a ROS child process (a node, colcon, a kernel).
+
+    Args:
+        domain_id: ROS_DOMAIN_ID for the child; None keeps the caller's (or 0).
+        base: the environment to start from; defaults to os.environ.
+        install: the detected install; detected when None.
+
+    Returns:
+        A new dict: discovery limited to this machine, the ament index of the install
+        reachable through AMENT_PREFIX_PATH, this interpreter's bin/ first on PATH, and
+        unbuffered Python output so that logs arrive while the node runs.
+    """
+    env = dict(os.environ if base is None else base)
+    install = install or detect_install()
+    if domain_id is not None:
+        check_domain_id(domain_id)
+        env["ROS_DOMAIN_ID"] = str(domain_id)
+    env.setdefault("ROS_DOMAIN_ID", "0")
+    env["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+    env.pop("ROS_LOCALHOST_ONLY", None)  # deprecated in Jazzy; warns when set
+    prefixes = _unique([str(p) for p in install.prefixes]
+                       + [p for p in env.get("AMENT_PREFIX_PATH", "").split(os.pathsep) if p])
+    if prefixes:
+        env["AMENT_PREFIX_PATH"] = os.pathsep.join(prefixes)
+    bindir = str(Path(sys.executable).parent)
+    path = env.get("PATH", "").split(os.pathsep)
+    env["PATH"] = os.pathsep.join([bindir] + [p for p in path if p and p != bindir])
+    env["PYTHONUNBUFFERED"] = "1"
+    return env
+
+
+def check_domain_id(domain_id: int) -> int:
+    """Raise ValueError with the valid range unless domain_id works with Fast DDS on Linux."""
+    if not isinstance(domain_id, int) or not 0 <= domain_id <= 232:
+        raise ValueError(f"ROS_DOMAIN_ID {domain_id!r} is out of range: use an integer from 0 to 232 "
+                         "(0-101 is the safe range on Linux)")
+    return domain_id
+
+
+class DomainReservation:
+    """A ROS_DOMAIN_ID held for this process through a lock file, so parallel runs never share one.
+
+    Use as a context manager or call release(). The lock is an flock, so it is released by
+    the kernel when the holder dies, even on SIGKILL.
+    """
+
+    def __init__(self, domain_id: int, handle):
+        self.domain_id = domain_id
+        self._handle = handle
+
+    def release(self) -> None:
+        if self._handle is not None:
+            self._handle.close()
+            self._handle = None
+
+    def __enter__(self) -> "DomainReservation":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.release()
+
+    def __repr__(self) -> str:
+        return f"DomainReservation({self.domain_id})"
+
+
+def _lock_dir() -> Path:
+    path = Path(tempfile.gettempdir()) / f"course_lib-domains-{os.getuid()}"
+    path.mkdir(mode=0o700, exist_ok=True)
+    return path
+
+
+def reserve_domain_id(candidates=RESERVABLE_DOMAIN_IDS) -> DomainReservation:
+    """Reserve a domain id no other process on this machine holds through this function.
+
+    Raises:
+        RuntimeError: every candidate is taken (stop other test or grading runs).
+    """
+    lock_dir = _lock_dir()
+    start = os.getpid() % len(candidates)  # spread parallel callers over the range
+    ordered = list(candidates)[start:] + list(candidates)[:start]
+    for domain_id in ordered:
+        handle = open(lock_dir / f"{domain_id}.lock", "a+")
+        try:
+            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError as error:
+            handle.close()
+            if error.errno in (errno.EAGAIN, errno.EACCES):
+                continue
+            raise
+        return DomainReservation(domain_id, handle)
+    raise RuntimeError(f"All ROS domain ids {candidates.start}-{candidates.stop - 1} are reserved by "
+                       f"other processes (locks in {lock_dir}); wait for other test or grading runs to end")
+
+
+def under_test() -> bool:
+    """True under the test suite or CI notebook runs: bound loops that would run forever live."""
+    return os.environ.get("COURSE_LIB_UNDER_TEST", "") not in ("", "0")
+
+
+def under_grading() -> bool:
+    """True while the autograder runs a submission (a separate flag from under_test on purpose)."""
+    return os.environ.get("COURSE_LIB_GRADING", "") not in ("", "0")
