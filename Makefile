@@ -10,6 +10,17 @@ UV     := $(VENV)/bin/uv
 UV_VERSION := 0.13.8
 LAB_PORT ?= 8888
 PYTEST_ARGS ?=
+# Where ROS 2 comes from: pip (the ros-jazzy-* wheels, default), system (/opt/ros/jazzy, sourced
+# first) or conda (an activated RoboStack environment). With system/conda the virtual environment
+# sees the installed rclpy and only the non-ROS packages of environment.txt are installed.
+ROS ?= pip
+ifeq ($(ROS),pip)
+VENV_FLAGS :=
+REQUIREMENTS := environment.txt
+else
+VENV_FLAGS := --system-site-packages
+REQUIREMENTS := $(VENV)/requirements-without-ros.txt
+endif
 
 .PHONY: setup lab test browser-deps clean
 
@@ -20,9 +31,12 @@ $(VENV)/.setup-done: environment.txt pyproject.toml course_lib/wheelfix.py
 	print("Using Python %d.%d from %s" % (v + (sys.executable,))) if ok else \
 	sys.exit("Python %d.%d found, but the ROS 2 Jazzy wheels exist for CPython 3.10-3.13 only. " \
 	"Run: make setup PYTHON=python3.12 (or any 3.10-3.13 interpreter)" % v)'
-	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
+	@if [ "$(ROS)" != pip ] && [ -z "$$ROS_DISTRO" ]; then echo "ROS=$(ROS) needs a sourced ROS 2 Jazzy: \
+	run 'source /opt/ros/jazzy/setup.bash' (system) or 'conda activate <robostack env>' (conda) first"; exit 1; fi
+	@test -x $(PY) || $(PYTHON) -m venv $(VENV_FLAGS) $(VENV)
 	@test -x $(UV) || $(PY) -m pip install --quiet --disable-pip-version-check uv==$(UV_VERSION)
-	$(UV) pip install --quiet --python $(PY) -r environment.txt -e .
+	@if [ "$(ROS)" != pip ]; then grep -v -E '^(ros-jazzy-|colcon-)' environment.txt > $(REQUIREMENTS); fi
+	$(UV) pip install --quiet --python $(PY) -r $(REQUIREMENTS) -e .
 	$(PY) -m course_lib repair-wheels
 	@touch $@
 

@@ -11,8 +11,12 @@ import importlib
 
 __version__ = "0.1.0"
 
-_MODULES = ("camera", "doctor", "graph", "images", "processes", "rosenv", "scenes", "session",
-            "wheelfix", "workspace")
+from course_lib import rosenv as _rosenv
+
+_rosenv.prepare_current_process()
+
+_MODULES = ("camera", "doctor", "graph", "images", "interfaces", "processes", "rosenv", "scenes",
+            "selfcheck", "session", "wheelfix", "workspace")
 
 
 def __getattr__(name):

@@ -143,6 +143,23 @@ def ros_environment(domain_id: int | None = None, base: dict[str, str] | None = 
     return env
 
 
+def prepare_current_process() -> None:
+    """Give this interpreter what sourcing a ROS setup file would: the ament index and the
+    course's discovery range (kept when the user set one). Called when course_lib is imported.
+
+    Only the pip install needs this: the wheels register their packages in sys.prefix's ament
+    index, but nothing puts sys.prefix on AMENT_PREFIX_PATH, so ament_index_python (and every
+    tool built on it) finds nothing.
+    """
+    install = detect_install()
+    paths = [p for p in os.environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep) if p]
+    missing = [str(p) for p in install.prefixes if str(p) not in paths]
+    if missing:
+        os.environ["AMENT_PREFIX_PATH"] = os.pathsep.join(paths + missing)
+    if "ROS_LOCALHOST_ONLY" not in os.environ:
+        os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
+
+
 def check_domain_id(domain_id: int) -> int:
     """Raise ValueError with the valid range unless domain_id works with Fast DDS on Linux."""
     if not isinstance(domain_id, int) or not 0 <= domain_id <= 232:
