@@ -1,0 +1,260 @@
+"""Tests for course_lib.session: a background ROS session that survives re-run notebook cells."""
+
+import subprocess
+import sys
+import threading
+
+import pytest
+import rclpy
+from rclpy.node import Node
+from rclpy.signals import SignalHandlerOptions
+
+from course_lib import graph, rosenv, session
+
+
+class Counter(Node):
+    """Counts the ticks of a fast timer and remembers which thread ran them."""
+
+    def __init__(self, name="counter", period=0.02):
+        super().__init__(name)
+        self.ticks = 0
+        self.threads = set()
+        self.create_timer(period, self.tick)
+
+    def tick(self):
+        self.ticks += 1
+        self.threads.add(threading.current_thread().name)
+
+
+class Failing(Node):
+    """A node whose timer callback always raises, like a student's buggy callback."""
+
+    def __init__(self):
+        super().__init__("failing")
+        self.create_timer(0.02, self.tick)
+
+    def tick(self):
+        raise ValueError("boom from a callback")
+
+
+@pytest.fixture(autouse=True)
+def no_session_left():
+    """Every test starts without a session and leaves none behind."""
+    session.stop()
+    session.clear_errors()
+    yield
+    session.stop()
+    session.clear_errors()
+
+
+@pytest.fixture
+def quick_graph(monkeypatch):
+    """graph queries without the discovery wait: these tests only look at in-process nodes."""
+    monkeypatch.setattr(graph, "SETTLE_SECONDS", 0.0)
+
+
+def test_start_twice_is_idempotent(domain_id):
+    """A second start() keeps the running executor thread and the same ROS context."""
+    session.start(domain_id=domain_id)
+    first = (session._state.thread, session._state.context)
+    session.start()
+    session.start(domain_id=domain_id)
+    assert session.is_running()
+    assert (session._state.thread, session._state.context) == first
+    assert rclpy.utilities.get_default_context().get_domain_id() == domain_id
+
+
+def test_start_on_another_domain_names_the_fix(domain_id):
+    """Asking a running session for another domain fails and says to stop first."""
+    session.start(domain_id=domain_id)
+    other = domain_id + 1 if domain_id < 101 else domain_id - 1
+    with pytest.raises(ValueError, match="session.stop"):
+        session.start(domain_id=other)
+
+
+def test_readding_a_node_replaces_the_old_one(domain_id, quick_graph):
+    """Re-running a cell that adds a node leaves one node of that name, the new one."""
+    session.start(domain_id=domain_id)
+    old = session.add_node(Counter())
+    assert session.wait_for(lambda: old.ticks >= 2, timeout=10)
+    new = session.add_node(Counter())
+    assert session.nodes() == [new]
+    with pytest.raises(Exception):  # the old node was destroyed
+        old.get_fully_qualified_name()
+    assert session.wait_for(lambda: graph.node_list().count("/counter") == 1, timeout=5), \
+        graph.node_list()
+    ticks_of_old = old.ticks
+    assert session.wait_for(lambda: new.ticks >= 3, timeout=10)
+    assert old.ticks == ticks_of_old
+
+
+def test_adding_the_same_node_twice_keeps_it(domain_id):
+    """add_node() of a node the session already spins returns it and changes nothing."""
+    session.start(domain_id=domain_id)
+    node = session.add_node(Counter())
+    assert session.add_node(node) is node
+    assert session.nodes() == [node]
+
+
+def test_stop_then_start_again_works(domain_id):
+    """After stop(), start() brings up a fresh session, and stale nodes are refused by name."""
+    session.start(domain_id=domain_id)
+    old = session.add_node(Counter())
+    session.stop()
+    assert not session.is_running()
+    assert session.nodes() == []
+    assert not rclpy.ok()
+    session.start(domain_id=domain_id)
+    assert session.is_running()
+    new = session.add_node(Counter())
+    assert session.wait_for(lambda: new.ticks >= 3, timeout=10)
+    with pytest.raises(ValueError, match="create it again"):
+        session.add_node(old)
+
+
+def test_stop_without_start_does_nothing():
+    """stop() is safe to call when nothing runs (a notebook's last cell, re-run)."""
+    session.stop()
+    assert not session.is_running()
+
+
+def test_spin_for_keeps_callbacks_running_in_the_background(domain_id):
+    """While a cell waits in spin_for(), timer callbacks run, in the session's thread."""
+    session.start(domain_id=domain_id)
+    node = session.add_node(Counter())
+    before = node.ticks
+    waited = session.spin_for(1.0)
+    assert waited >= 1.0
+    assert node.ticks > before
+    assert node.threads == {"course_lib.session"}
+
+
+def test_wait_for_returns_false_when_time_runs_out(domain_id):
+    """wait_for() is bounded: a predicate that never holds gives False, not a hang."""
+    session.start(domain_id=domain_id)
+    assert session.wait_for(lambda: False, timeout=0.2) is False
+
+
+def test_an_interrupted_wait_leaves_the_session_spinning(domain_id):
+    """KeyboardInterrupt (the kernel's interrupt button) ends the wait, not the session."""
+    session.start(domain_id=domain_id)
+    node = session.add_node(Counter())
+    calls = []
+
+    def interrupted():
+        calls.append(1)
+        if len(calls) == 3:
+            raise KeyboardInterrupt
+        return False
+
+    with pytest.raises(KeyboardInterrupt):
+        session.wait_for(interrupted, timeout=10)
+    assert session.is_running()
+    ticks = node.ticks
+    assert session.wait_for(lambda: node.ticks > ticks + 2, timeout=10)
+
+
+def test_a_failing_callback_is_reported_once_and_spinning_goes_on(domain_id, capsys):
+    """A callback's exception is printed once, kept in errors(), and other nodes keep running."""
+    session.start(domain_id=domain_id)
+    session.add_node(Failing())
+    counter = session.add_node(Counter())
+    assert session.wait_for(lambda: len(session.errors()) >= 3 and counter.ticks >= 3,
+                            timeout=10)
+    assert session.is_running()
+    assert all(isinstance(error, ValueError) for error in session.errors())
+    assert capsys.readouterr().err.count("ValueError: boom from a callback") == 1
+
+
+def test_remove_node_by_plain_name(domain_id):
+    """remove_node('name') destroys that node and keeps the others."""
+    session.start(domain_id=domain_id)
+    first = session.add_node(Counter("first"))
+    second = session.add_node(Counter("second"))
+    session.remove_node("first")
+    assert session.nodes() == [second]
+    with pytest.raises(Exception):
+        first.get_fully_qualified_name()
+    session.remove_node(second)
+    assert session.nodes() == []
+
+
+def test_remove_node_of_an_unknown_name_lists_the_known_ones(domain_id):
+    """A wrong name in remove_node() gets an error that lists the names to use."""
+    session.start(domain_id=domain_id)
+    session.add_node(Counter("present"))
+    with pytest.raises(ValueError, match="/present"):
+        session.remove_node("absent")
+
+
+def test_add_node_refuses_what_is_not_a_node(domain_id):
+    """Passing the class instead of an instance (a common slip) gets a TypeError."""
+    session.start(domain_id=domain_id)
+    with pytest.raises(TypeError, match="MyNode"):
+        session.add_node(Counter)
+
+
+def test_add_node_starts_the_session_when_rclpy_was_initialised_by_hand(domain_id):
+    """A notebook that called rclpy.init() itself can still hand its nodes to the session."""
+    rclpy.init(domain_id=domain_id, signal_handler_options=SignalHandlerOptions.NO)
+    try:
+        node = session.add_node(Counter())
+        assert session.is_running()
+        assert session.wait_for(lambda: node.ticks >= 2, timeout=10)
+    finally:
+        session.stop()
+        rclpy.try_shutdown()
+
+
+def test_tool_node_is_hidden_lazy_and_single(domain_id):
+    """The tool node is made on first use, once, and is not among the student's nodes."""
+    session.start(domain_id=domain_id)
+    assert session._state.tool is None
+    tool = session.tool_node()
+    assert session.tool_node() is tool
+    assert tool.get_name() == session.TOOL_NODE_NAME
+    assert tool.get_name().startswith("_")
+    assert session.nodes() == []
+
+
+def test_time_limit_caps_only_under_test_or_grading(monkeypatch):
+    """Live notebooks keep their durations; test and grading runs get separate, finite caps."""
+    monkeypatch.delenv("COURSE_LIB_UNDER_TEST", raising=False)
+    monkeypatch.delenv("COURSE_LIB_GRADING", raising=False)
+    assert session.time_limit(None) is None
+    assert session.time_limit(60.0) == 60.0
+    monkeypatch.setenv("COURSE_LIB_UNDER_TEST", "1")
+    assert session.time_limit(None) == session.TEST_TIME_LIMIT
+    assert session.time_limit(0.5) == 0.5
+    monkeypatch.setenv("COURSE_LIB_UNDER_TEST", "0")
+    monkeypatch.setenv("COURSE_LIB_GRADING", "1")
+    assert session.time_limit(None) == session.GRADING_TIME_LIMIT
+    assert session.time_limit(60.0) == session.GRADING_TIME_LIMIT
+
+
+def test_unbounded_spin_for_ends_under_test(domain_id):
+    """spin_for() with no duration, which runs until interrupted live, returns under test."""
+    assert rosenv.under_test()
+    session.start(domain_id=domain_id)
+    assert session.spin_for() <= session.TEST_TIME_LIMIT + 1.0
+
+
+KERNEL_EXIT = """
+import atexit
+# Registered before the session's handler, so it runs after it (atexit is last-in, first-out).
+atexit.register(lambda: print("running at exit:", session.is_running(), flush=True))
+from course_lib import session
+from rclpy.node import Node
+session.start()
+session.add_node(Node("exiting"))
+print("started:", session.is_running(), flush=True)
+"""
+
+
+def test_the_session_stops_itself_when_the_interpreter_exits(domain_id):
+    """A kernel that exits with a running session shuts ROS down cleanly (exit code 0)."""
+    result = subprocess.run([sys.executable, "-c", KERNEL_EXIT], capture_output=True, text=True,
+                            env=rosenv.ros_environment(domain_id=domain_id), timeout=60)
+    assert result.returncode == 0, result.stderr
+    assert "started: True" in result.stdout
+    assert "running at exit: False" in result.stdout
