@@ -1,0 +1,358 @@
+"""Tests for course_lib.processes: real node processes over real DDS, and no orphans ever.
+
+Orphans are found by a unique marker in the command line (psutil), so a test only sees the
+processes it started itself.
+"""
+
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+import uuid
+
+import psutil
+import pytest
+
+from course_lib import processes
+from course_lib.processes import Limits, NodeProcess, python_node
+
+TALKER = '''
+import rclpy
+from rclpy.executors import ExternalShutdownException
+from rclpy.node import Node
+from std_msgs.msg import String
+
+
+class Talker(Node):
+    def __init__(self):
+        super().__init__("talker")
+        self.publisher = self.create_publisher(String, "chatter", 10)
+        self.timer = self.create_timer(0.2, self.tick)
+        self.count = 0
+
+    def tick(self):
+        self.count += 1
+        self.publisher.publish(String(data=f"hello {self.count}"))
+        self.get_logger().info(f"Publishing hello {self.count}")
+
+
+def main(args=None):
+    rclpy.init(args=args)
+    node = Talker()
+    try:
+        rclpy.spin(node)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        node.destroy_node()
+        rclpy.try_shutdown()
+        print("talker shut down cleanly", flush=True)
+'''
+
+
+def marker() -> str:
+    """A token that appears only in the command lines of one test's processes."""
+    return f"course-lib-test-{uuid.uuid4().hex}"
+
+
+def processes_with(token: str) -> list[psutil.Process]:
+    found = []
+    for process in psutil.process_iter(["cmdline", "status"]):
+        try:
+            if process.info["status"] != psutil.STATUS_ZOMBIE and any(
+                    token in part for part in process.info["cmdline"] or ()):
+                found.append(process)
+        except (psutil.NoSuchProcess, psutil.AccessDenied):
+            pass
+    return found
+
+
+def wait_until(condition, timeout: float = 10.0) -> bool:
+    """Poll `condition` until it holds or `timeout` passes; return its last value."""
+    deadline = time.monotonic() + timeout
+    while not (result := condition()) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    return result
+
+
+def sleeper(token: str, seconds: int = 100) -> list[str]:
+    """A python child that sleeps and carries `token` in its command line."""
+    return [sys.executable, "-c", f"import time; print('ready', flush=True); time.sleep({seconds})", token]
+
+
+@pytest.fixture
+def token():
+    """A unique marker for the test's processes; survivors of a failed test are killed."""
+    value = marker()
+    yield value
+    for leftover in processes_with(value):
+        leftover.kill()
+
+
+@pytest.fixture
+def talker_dir(tmp_path):
+    (tmp_path / "course_talker.py").write_text(TALKER)
+    return tmp_path
+
+
+def test_talker_is_found_logged_and_stopped_cleanly(talker_dir, domain_id):
+    """A real rclpy talker appears in its domain's graph, its log has rclpy's stderr lines,
+    and SIGINT runs its try_shutdown path."""
+    with python_node("course_talker:main", cwd=talker_dir, domain_id=domain_id) as talker:
+        talker.wait_for_node("talker", timeout=30)
+        talker.wait_for_node("/talker", timeout=5)
+        assert wait_until(lambda: "Publishing hello" in talker.log), talker.log
+        code = talker.stop()
+    assert code in (0, -signal.SIGINT), talker.describe_exit()
+    assert talker.exit_reason == "stopped"
+    assert "[INFO]" in talker.log and "[talker]" in talker.log  # rclpy's logger writes to stderr
+    assert "talker shut down cleanly" in talker.log
+    assert not talker.running()
+
+
+def test_node_in_another_namespace_is_not_mistaken(talker_dir, domain_id):
+    """wait_for_node with a namespace only accepts the node in that namespace."""
+    with python_node("course_talker:main", "--ros-args", "-r", "__ns:=/robot1",
+                     cwd=talker_dir, domain_id=domain_id) as talker:
+        talker.wait_for_node("/robot1/talker", timeout=30)
+        with pytest.raises(TimeoutError, match="'/robot2/talker' did not appear"):
+            talker.wait_for_node("talker", namespace="robot2", timeout=1.0)
+
+
+def test_module_target_runs_with_arguments(tmp_path):
+    """'package.module' runs as python -m with the given arguments."""
+    (tmp_path / "echo_args.py").write_text("import sys\nprint('args', sys.argv[1:])\n")
+    process = python_node("echo_args", "a", "b c", cwd=tmp_path)
+    assert process.wait(timeout=30) == 0
+    assert "args ['a', 'b c']" in process.log
+    assert process.name == "echo_args"
+
+
+def test_entry_point_target_returns_its_exit_code(tmp_path):
+    """'module:function' calls the function like a console script; its return value is the exit code."""
+    (tmp_path / "entry.py").write_text("import sys\ndef main():\n    print('argv0', sys.argv[0])\n    return 4\n")
+    process = python_node("entry:main", cwd=tmp_path)
+    assert process.wait(timeout=30) == 4
+    assert "argv0 entry:main" in process.log
+
+
+@pytest.mark.parametrize("target", ["", "a-b.c", "pkg:", "pkg:main()", "pkg mod"])
+def test_bad_targets_are_refused_with_the_forms(target):
+    with pytest.raises(ValueError, match="package.module:function"):
+        python_node(target)
+
+
+def test_missing_program_raises_file_not_found():
+    with pytest.raises(FileNotFoundError, match="no such file or program"):
+        NodeProcess(["course-lib-no-such-program"]).start()
+
+
+def test_child_that_ignores_sigint_is_killed_after_the_timeout(token):
+    code = "import signal, time; signal.signal(signal.SIGINT, signal.SIG_IGN); print('ready', flush=True); time.sleep(100)"
+    process = NodeProcess([sys.executable, "-c", code, token]).start()
+    assert wait_until(lambda: "ready" in process.log), process.log
+    assert process.stop(timeout=0.5) == -signal.SIGKILL
+    assert "SIGKILL" in process.describe_exit()
+    assert processes_with(token) == []
+
+
+def sleeper_script(token: str) -> str:
+    """A shell line that runs a sleeping python carrying `token` (python -S starts fast)."""
+    return f"{sys.executable} -S -c 'import time; time.sleep(100)' {token}"
+
+
+def sleepers(token: str) -> list[psutil.Process]:
+    return [p for p in processes_with(token) if p.info["cmdline"][-1] == token]
+
+
+def test_grandchildren_are_killed_by_stop_even_if_they_left_the_group(token):
+    """sh's background children, one in its process group and one in a new session, die with it."""
+    run = sleeper_script(token)
+    process = NodeProcess(["sh", "-c", f"{run} & setsid {run} & echo started; exec {run}"]).start()
+    assert wait_until(lambda: len(sleepers(token)) == 3), process.log
+    process.stop(timeout=2)
+    assert processes_with(token) == []
+
+
+def test_leftovers_die_when_the_child_exits_on_its_own(token):
+    """A child that exits normally does not leave its background processes running."""
+    process = NodeProcess(["sh", "-c", f"{sleeper_script(token)} & echo started"]).start()
+    assert process.wait(timeout=30) == 0
+    assert "started" in process.log
+    assert processes_with(token) == []
+
+
+def test_wait_for_node_names_the_exit_code_of_a_crashing_child(domain_id):
+    code = "import sys; print('about to fail', flush=True); sys.exit(3)"
+    process = NodeProcess([sys.executable, "-c", code], domain_id=domain_id).start()
+    with pytest.raises(RuntimeError, match=r"exit code 3(.|\n)*about to fail"):
+        process.wait_for_node("talker", timeout=30)
+
+
+def test_wait_for_node_times_out_with_the_log_tail(domain_id, token):
+    with NodeProcess(sleeper(token), domain_id=domain_id) as process:
+        assert wait_until(lambda: "ready" in process.log)
+        with pytest.raises(TimeoutError, match=r"did not appear(.|\n)*ready"):
+            process.wait_for_node("talker", timeout=0.5)
+        assert process.running()
+    assert processes_with(token) == []
+
+
+def test_loud_child_does_not_block_and_its_log_is_bounded():
+    """64 MB of output: the child finishes, the log keeps head and tail, memory stays small."""
+    code = ("import sys\nsys.stdout.write('first line\\n')\nline = 'x' * 1023 + '\\n'\n"
+            "for _ in range(64 * 1024):\n    sys.stdout.write(line)\nsys.stdout.write('last line\\n')\n")
+    process = NodeProcess([sys.executable, "-c", code]).start()
+    assert process.wait(timeout=120) == 0
+    log = process.log
+    assert log.startswith("first line\n") and log.endswith("last line\n")
+    assert "bytes of output omitted" in log
+    assert len(log) <= processes.LOG_HEAD_BYTES + processes.LOG_TAIL_BYTES + 100
+    assert process.usage["supervisor_max_rss_kb"] < 100 * 1024  # it streamed, it did not buffer
+
+
+def test_log_survives_stop_and_its_files_are_removed():
+    process = NodeProcess(["sh", "-c", "echo kept; exec sleep 100"]).start()
+    log_dir = process._log_dir
+    assert wait_until(lambda: "kept" in process.log)
+    process.stop(timeout=2)
+    assert process.log == "kept\n"
+    assert not log_dir.exists()
+    assert process.stop() == process.returncode  # idempotent
+
+
+def test_context_manager_stops_the_child_on_an_exception(token):
+    with pytest.raises(ZeroDivisionError):
+        with NodeProcess(sleeper(token)).start():
+            assert wait_until(lambda: processes_with(token))
+            1 / 0
+    assert processes_with(token) == []
+
+
+def test_stop_all_stops_every_running_child():
+    tokens = [marker(), marker()]
+    started = [NodeProcess(sleeper(token)).start() for token in tokens]
+    processes.stop_all(timeout=2)
+    assert all(not p.running() for p in started)
+    assert all(processes_with(token) == [] for token in tokens)
+
+
+def test_a_forked_child_neither_stops_nor_pins_the_parents_nodes(token):
+    """A process forked by the caller (multiprocessing's fork) leaves the caller's nodes alone."""
+    process = NodeProcess(sleeper(token)).start()
+    try:
+        pid = os.fork()
+        if pid == 0:  # the forked child does what its atexit would do, then checks it owns nothing
+            processes.stop_all(timeout=1)
+            os._exit(0 if process.stop() is None and not process.running() else 1)
+        _, status = os.waitpid(pid, 0)
+        assert os.waitstatus_to_exitcode(status) == 0
+        assert process.running()
+    finally:
+        process.stop()
+    assert processes_with(token) == []
+
+
+def test_starting_a_named_process_again_replaces_the_old_one():
+    """Re-running a notebook cell that starts 'sleeper' does not leave two running."""
+    first = NodeProcess(sleeper(marker()), name="sleeper").start()
+    second = NodeProcess(sleeper(marker()), name="sleeper").start()
+    try:
+        assert not first.running() and first.exit_reason == "stopped"
+        assert second.running()
+    finally:
+        second.stop()
+
+
+CALLER = """
+import os, signal, sys, time
+import rclpy
+from course_lib.processes import NodeProcess
+# Like a notebook kernel, the caller runs DDS threads. Without rclpy's signal handlers, so that
+# SIGTERM ends it (rclpy's handler would only shut the context down and keep the caller alive).
+rclpy.init(signal_handler_options=rclpy.signals.SignalHandlerOptions.NO)
+node = rclpy.create_node("caller")
+process = NodeProcess([sys.executable, "-c", "import time; time.sleep(100)", sys.argv[2]]).start()
+print("started", flush=True)
+if sys.argv[1] == "exit":
+    sys.exit(0)  # no stop(): atexit must do it
+if sys.argv[1] == "exception":
+    with process:
+        raise KeyboardInterrupt
+time.sleep(100)
+"""
+
+
+@pytest.mark.parametrize("ending", ["exit", "exception", "SIGTERM", "SIGKILL"])
+def test_children_never_outlive_their_caller(ending, token):
+    """However a caller running rclpy ends (exit, KeyboardInterrupt, SIGTERM, SIGKILL), its child dies."""
+    caller = subprocess.Popen([sys.executable, "-c", CALLER, ending, token], stdout=subprocess.PIPE,
+                              stderr=subprocess.PIPE, text=True)
+    try:
+        assert caller.stdout.readline() == "started\n", caller.stderr.read()
+        if ending.startswith("SIG"):
+            assert processes_with(token)
+            caller.send_signal(getattr(signal, ending))
+        caller.wait(timeout=30)
+        assert wait_until(lambda: not processes_with(token), timeout=10), processes_with(token)
+    finally:
+        caller.kill()
+        caller.wait()
+
+
+def test_wall_limit_stops_a_sleeper(token):
+    process = NodeProcess(sleeper(token), limits=Limits(wall_seconds=0.5, grace_seconds=1)).start()
+    code = process.wait(timeout=30)
+    assert process.exit_reason == "wall_seconds"
+    assert code != 0 and "wall-time limit of 0.5 s" in process.describe_exit()
+    assert processes_with(token) == []
+
+
+def test_memory_limit_stops_a_child_that_allocates_too_much():
+    code = "block = bytearray(400 * 1024 * 1024); print('allocated', flush=True)"
+    process = NodeProcess([sys.executable, "-c", code], limits=Limits(memory_mb=200)).start()
+    assert process.wait(timeout=30) != 0
+    assert "MemoryError" in process.log and "allocated" not in process.log
+
+
+def test_cpu_limit_ends_a_busy_loop_with_sigxcpu():
+    process = NodeProcess([sys.executable, "-c", "while True: pass"], limits=Limits(cpu_seconds=1)).start()
+    assert process.wait(timeout=60) == -signal.SIGXCPU
+    assert "CPU time limit" in process.describe_exit()
+
+
+@pytest.mark.parametrize("field", ["wall_seconds", "memory_mb", "max_processes"])
+def test_limits_refuse_non_positive_values(field):
+    with pytest.raises(ValueError, match=f"Limits.{field}.*positive"):
+        Limits(**{field: 0})
+
+
+needs_root = pytest.mark.skipif(os.geteuid() != 0, reason="dropping to another user needs root")
+
+
+@needs_root
+def test_child_runs_as_the_limits_user_with_a_process_limit():
+    """As root, Limits.user makes RLIMIT_NPROC bite: the child cannot fork past it."""
+    import pwd
+
+    nobody = pwd.getpwnam("nobody")
+    script = "id -u; for i in 1 2 3 4 5 6 7 8; do sleep 1 & done; wait; echo done"
+    process = NodeProcess(["sh", "-c", script], cwd="/",
+                          limits=Limits(user="nobody", max_processes=4)).start()
+    process.wait(timeout=60)
+    lines = process.log.splitlines()
+    assert lines[0] == str(nobody.pw_uid)
+    assert "fork" in process.log.lower() or "resource temporarily unavailable" in process.log.lower(), process.log
+
+
+def test_wait_for_output_sees_a_line_and_reports_an_early_exit():
+    with processes.NodeProcess([sys.executable, "-c", "import time; print('ready', flush=True); time.sleep(30)"],
+                               name="printer").start() as proc:
+        assert "ready" in proc.wait_for_output("ready", timeout=10)
+        with pytest.raises(TimeoutError, match="did not print 'never'"):
+            proc.wait_for_output("never", timeout=0.3)
+    with processes.NodeProcess([sys.executable, "-c", "raise SystemExit(4)"], name="quitter").start() as proc:
+        with pytest.raises(RuntimeError, match=r"quitter ended \(exit code 4\) before printing"):
+            proc.wait_for_output("ready", timeout=10)
