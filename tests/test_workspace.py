@@ -1,0 +1,376 @@
+"""Tests for course_lib.workspace: package layout, real colcon builds, nodes run from a workspace.
+
+The slow tests share one workspace, built once per test run by the `built_ws` fixture: the
+interface package tutorial_interfaces (msg/MsgTutorial.msg) and the ament_python package
+tutorial_nodes that uses it.
+"""
+
+import ast
+import os
+import re
+import signal
+import subprocess
+import sys
+import threading
+import time
+import xml.etree.ElementTree as ElementTree
+from pathlib import Path
+
+import pytest
+
+from course_lib import rosenv, workspace
+
+MSG_TUTORIAL = "builtin_interfaces/Time stamp\nint32 data\n"
+
+PUBLISHER = '''import rclpy
+from rclpy.executors import ExternalShutdownException
+from rclpy.node import Node
+
+from tutorial_interfaces.msg import MsgTutorial
+
+
+class TopicPublisher(Node):
+    """Publish MsgTutorial at 10 Hz with a growing counter."""
+
+    def __init__(self):
+        super().__init__('topic_publisher')
+        self.count = self.declare_parameter('start', 0).value
+        self.publisher = self.create_publisher(MsgTutorial, 'topic', 100)
+        self.timer = self.create_timer(0.1, self.publish)
+
+    def publish(self):
+        msg = MsgTutorial()
+        msg.stamp = self.get_clock().now().to_msg()
+        msg.data = self.count
+        self.publisher.publish(msg)
+        self.count += 1
+
+
+def main(args=None):
+    rclpy.init(args=args)
+    node = None
+    try:
+        node = TopicPublisher()
+        rclpy.spin(node)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()
+'''
+
+SUBSCRIBER = '''import rclpy
+from rclpy.executors import ExternalShutdownException
+from rclpy.node import Node
+
+from tutorial_interfaces.msg import MsgTutorial
+
+
+class TopicSubscriber(Node):
+    """Log every field of each MsgTutorial received."""
+
+    def __init__(self):
+        super().__init__('topic_subscriber')
+        self.subscription = self.create_subscription(MsgTutorial, 'topic', self.listen, 100)
+
+    def listen(self, msg):
+        self.get_logger().info(
+            f'Received: stamp={msg.stamp.sec}.{msg.stamp.nanosec:09d} data={msg.data}')
+
+
+def main(args=None):
+    rclpy.init(args=args)
+    node = None
+    try:
+        node = TopicSubscriber()
+        rclpy.spin(node)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()
+'''
+
+
+def make_tutorial_workspace(ws: Path) -> None:
+    workspace.create_interface_package(ws, "tutorial_interfaces", {"MsgTutorial": MSG_TUTORIAL})
+    package = workspace.create_package(ws, "tutorial_nodes", dependencies=["rclpy", "tutorial_interfaces"],
+                                       node_name=["hello_node", "topic_publisher", "topic_subscriber"])
+    (package / "tutorial_nodes" / "topic_publisher.py").write_text(PUBLISHER)
+    (package / "tutorial_nodes" / "topic_subscriber.py").write_text(SUBSCRIBER)
+
+
+@pytest.fixture(scope="session")
+def built_ws(tmp_path_factory):
+    """A workspace with tutorial_interfaces and tutorial_nodes, built once with the real colcon."""
+    ws = tmp_path_factory.mktemp("tutorial_ws")
+    make_tutorial_workspace(ws)
+    result = workspace.build(ws, timeout=600)
+    print(f"\ncolcon built {result.finished} in {result.seconds:.1f} s")
+    return ws
+
+
+def wait_for_log(process, pattern: str, count: int, timeout: float) -> list[re.Match]:
+    """Poll a NodeProcess log until `count` lines match (bounded by timeout); return the matches."""
+    deadline = time.monotonic() + timeout
+    while True:
+        matches = list(re.finditer(pattern, process.log))
+        if len(matches) >= count or time.monotonic() > deadline or not process.running():
+            return matches
+        time.sleep(0.1)
+
+
+# --- layout (fast) -----------------------------------------------------------------------------
+
+def test_create_package_lays_out_an_ament_python_package(tmp_path):
+    package = workspace.create_package(tmp_path, "my_nodes", dependencies=["rclpy", "std_msgs"],
+                                       node_name="talker")
+    assert package == tmp_path / "src" / "my_nodes"
+    for relative in ["package.xml", "setup.py", "setup.cfg", "resource/my_nodes", "my_nodes/__init__.py",
+                     "my_nodes/talker.py", "test/test_copyright.py", "test/test_flake8.py",
+                     "test/test_pep257.py"]:
+        assert (package / relative).is_file(), relative
+    assert (package / "resource/my_nodes").read_text() == ""
+
+    root = ElementTree.parse(package / "package.xml").getroot()
+    assert root.tag == "package" and root.get("format") == "3"
+    assert root.findtext("name") == "my_nodes"
+    assert [d.text for d in root.findall("depend")] == ["rclpy", "std_msgs"]
+    assert [d.text for d in root.findall("test_depend")] == ["ament_copyright", "ament_flake8", "ament_pep257",
+                                                             "python3-pytest"]
+    assert root.findtext("export/build_type") == "ament_python"
+
+    setup = ast.parse((package / "setup.py").read_text())
+    call = next(node for node in ast.walk(setup) if isinstance(node, ast.Call)
+                and getattr(node.func, "id", None) == "setup")
+    keywords = {k.arg: k.value for k in call.keywords}
+    entry_points = ast.literal_eval(keywords["entry_points"])
+    assert entry_points == {"console_scripts": ["talker = my_nodes.talker:main"]}
+    assert "resource/" in ast.unparse(keywords["data_files"]) and "package.xml" in ast.unparse(keywords["data_files"])
+
+    cfg = (package / "setup.cfg").read_text()
+    assert "[develop]\nscript_dir=$base/lib/my_nodes" in cfg and "[install]\ninstall_scripts=$base/lib/my_nodes" in cfg
+    node = (package / "my_nodes/talker.py").read_text()
+    compile(node, "talker.py", "exec")
+    assert "Node started!" in node and "rclpy.try_shutdown()" in node and "with rclpy.init" not in node
+
+
+def test_create_package_refuses_to_overwrite_but_can_rerun(tmp_path):
+    package = workspace.create_package(tmp_path, "my_nodes", dependencies=["rclpy"], node_name="talker")
+    (package / "my_nodes/talker.py").write_text("# my own work\n")
+    with pytest.raises(FileExistsError, match="exist_ok=True"):
+        workspace.create_package(tmp_path, "my_nodes")
+    workspace.create_package(tmp_path, "my_nodes", dependencies=["rclpy", "std_msgs"], node_name="talker",
+                             exist_ok=True)
+    assert (package / "my_nodes/talker.py").read_text() == "# my own work\n"
+    assert "<depend>std_msgs</depend>" in (package / "package.xml").read_text()
+
+
+@pytest.mark.parametrize("name", ["MyNodes", "2nodes", "my-nodes", ""])
+def test_invalid_package_names_are_refused_with_the_rule(tmp_path, name):
+    with pytest.raises(ValueError, match="lower case"):
+        workspace.create_package(tmp_path, name)
+
+
+def test_only_ament_python_packages_are_created_by_create_package(tmp_path):
+    with pytest.raises(ValueError, match="create_interface_package"):
+        workspace.create_package(tmp_path, "my_nodes", build_type="ament_cmake")
+
+
+def test_create_interface_package_declares_the_generators(tmp_path):
+    package = workspace.create_interface_package(tmp_path, "tutorial_interfaces", {"MsgTutorial": MSG_TUTORIAL})
+    assert (package / "msg/MsgTutorial.msg").read_text() == MSG_TUTORIAL
+    cmake = (package / "CMakeLists.txt").read_text()
+    assert "find_package(rosidl_default_generators REQUIRED)" in cmake
+    assert "find_package(builtin_interfaces REQUIRED)" in cmake
+    assert re.search(r'rosidl_generate_interfaces\(\$\{PROJECT_NAME\}\s+"msg/MsgTutorial.msg"\s+'
+                     r"DEPENDENCIES builtin_interfaces\s*\)", cmake), cmake
+    assert "ament_export_dependencies(rosidl_default_runtime)" in cmake
+    root = ElementTree.parse(package / "package.xml").getroot()
+    assert root.get("format") == "3"
+    assert [d.text for d in root.findall("buildtool_depend")] == ["ament_cmake", "rosidl_default_generators"]
+    assert [d.text for d in root.findall("exec_depend")] == ["rosidl_default_runtime"]
+    assert [d.text for d in root.findall("depend")] == ["builtin_interfaces"]
+    assert root.findtext("member_of_group") == "rosidl_interface_packages"
+    assert root.findtext("export/build_type") == "ament_cmake"
+
+
+def test_message_names_must_be_camel_case(tmp_path):
+    with pytest.raises(ValueError, match="CamelCase"):
+        workspace.create_interface_package(tmp_path, "my_interfaces", {"msg_tutorial": "int32 data"})
+
+
+def test_build_without_src_names_the_fix(tmp_path):
+    with pytest.raises(FileNotFoundError, match="create_package"):
+        workspace.build(tmp_path)
+
+
+def _fake_install(ws: Path) -> None:
+    lib = ws / "install" / "demo" / "lib" / "demo"
+    lib.mkdir(parents=True)
+    (ws / "install" / "setup.bash").write_text("")
+    (lib / "talker").write_text("#!/bin/sh\n")
+    (lib / "talker").chmod(0o755)
+    (lib / "listener").write_text("#!/bin/sh\n")
+    (lib / "listener").chmod(0o755)
+
+
+def test_executable_command_builds_ros_args_like_ros2_run(tmp_path):
+    _fake_install(tmp_path)
+    command = workspace.executable_command(
+        tmp_path, "demo", "talker", remap={"chatter": "news", "__node": "loud"},
+        params={"rate": 2.5, "verbose": True, "names": ["a", "b"]}, params_file=tmp_path / "p.yaml",
+        ros_args=["--log-level", "debug"])
+    assert command == [str(tmp_path / "install/demo/lib/demo/talker"), "--ros-args",
+                       "-r", "chatter:=news", "-r", "__node:=loud",
+                       "-p", "rate:=2.5", "-p", "verbose:=true", "-p", "names:=[a, b]",
+                       "--params-file", str(tmp_path / "p.yaml"), "--log-level", "debug"]
+    assert workspace.executable_command(tmp_path, "demo", "talker") == [command[0]]
+
+
+def test_missing_executables_and_packages_are_listed(tmp_path):
+    _fake_install(tmp_path)
+    with pytest.raises(FileNotFoundError, match="available: listener, talker"):
+        workspace.executable_command(tmp_path, "demo", "speaker")
+    with pytest.raises(FileNotFoundError, match="built packages: demo"):
+        workspace.executable_command(tmp_path, "other", "talker")
+    with pytest.raises(FileNotFoundError, match="build the workspace first"):
+        workspace.executable_command(tmp_path / "nowhere", "demo", "talker")
+
+
+# --- real builds (slow) ------------------------------------------------------------------------
+
+@pytest.mark.slow
+def test_built_workspace_installs_both_packages_like_colcon_does(built_ws):
+    install = built_ws / "install"
+    assert (install / "setup.bash").is_file()
+    assert workspace.executables(built_ws, "tutorial_nodes") == ["hello_node", "topic_publisher",
+                                                                 "topic_subscriber"]
+    assert list((install / "tutorial_interfaces/lib").glob("libtutorial_interfaces__rosidl_typesupport_c.so"))
+
+
+@pytest.mark.slow
+def test_generated_node_logs_and_takes_remaps(built_ws, domain_id):
+    command = workspace.executable_command(built_ws, "tutorial_nodes", "hello_node",
+                                           remap={"__node": "renamed_hello"}, params={"use_sim_time": False})
+    env = workspace.workspace_environment(built_ws, domain_id=domain_id)
+    process = subprocess.Popen(command, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    lines, greeted = [], threading.Event()
+
+    def read():
+        for line in process.stdout:
+            lines.append(line)
+            if "Node started!" in line:
+                greeted.set()
+
+    reader = threading.Thread(target=read, daemon=True)
+    reader.start()
+    try:
+        greeted.wait(timeout=30)  # the node spins forever: stop it once it has greeted
+    finally:
+        process.send_signal(signal.SIGINT)
+        try:
+            process.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            process.kill()
+            process.wait(timeout=10)
+        reader.join(timeout=10)
+    output = "".join(lines)
+    assert process.returncode == 0, output  # SIGINT ends the node cleanly (try/finally + try_shutdown)
+    assert re.search(r"\[renamed_hello\]: Node started!", output), output
+
+
+@pytest.mark.slow
+def test_messages_import_in_a_subprocess_with_the_workspace_environment(built_ws):
+    code = ("from tutorial_interfaces.msg import MsgTutorial\n"
+            "from rclpy.serialization import serialize_message, deserialize_message\n"
+            "m = deserialize_message(serialize_message(MsgTutorial(data=41)), MsgTutorial)\n"
+            "print(type(m).__name__, m.data, m.stamp.sec)\n")
+    env = workspace.workspace_environment(built_ws)
+    assert str(built_ws / "install/tutorial_interfaces/lib") in env["LD_LIBRARY_PATH"].split(os.pathsep)
+    assert "" not in env["LD_LIBRARY_PATH"].split(os.pathsep)
+    done = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=60)
+    assert done.stdout.split() == ["MsgTutorial", "41", "0"], done.stderr
+
+
+@pytest.mark.slow
+def test_use_workspace_imports_messages_in_a_running_interpreter(built_ws):
+    # A fresh interpreter whose LD_LIBRARY_PATH knows nothing of the workspace, like a kernel
+    # started before the build.
+    code = ("import sys\n"
+            "from course_lib import workspace\n"
+            f"print(workspace.use_workspace({str(built_ws)!r}))\n"
+            "from tutorial_interfaces.msg import MsgTutorial\n"
+            "from rclpy.serialization import serialize_message, deserialize_message\n"
+            "m = MsgTutorial(data=7); m.stamp.sec = 3\n"
+            "back = deserialize_message(serialize_message(m), MsgTutorial)\n"
+            "print(back.data, back.stamp.sec)\n")
+    env = rosenv.ros_environment()
+    assert str(built_ws) not in env.get("LD_LIBRARY_PATH", "")
+    done = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=60)
+    assert done.stdout.splitlines() == ["['tutorial_interfaces', 'tutorial_nodes']", "7 3"], done.stderr
+
+
+@pytest.mark.slow
+def test_publisher_reaches_subscriber_across_two_processes(built_ws, domain_id):
+    subscriber = workspace.run(built_ws, "tutorial_nodes", "topic_subscriber", remap={"topic": "tutorial_topic"},
+                               domain_id=domain_id, name="test_topic_subscriber")
+    publisher = None
+    try:
+        subscriber.wait_for_node("topic_subscriber", timeout=20)
+        publisher = workspace.run(built_ws, "tutorial_nodes", "topic_publisher", domain_id=domain_id,
+                                  remap={"topic": "tutorial_topic"}, params={"start": 100},
+                                  name="test_topic_publisher")
+        received = wait_for_log(subscriber, r"Received: stamp=(\d+)\.(\d{9}) data=(\d+)", count=5, timeout=30)
+    finally:
+        if publisher is not None:
+            publisher.stop()
+        subscriber.stop()
+    assert len(received) >= 5, f"subscriber log:\n{subscriber.log}\npublisher log:\n{publisher.log}"
+    data = [int(m.group(3)) for m in received]
+    stamps = [(int(m.group(1)), int(m.group(2))) for m in received]
+    assert data[0] >= 100, data  # the start parameter reached the publisher
+    assert data == sorted(data) and len(set(data)) == len(data), data
+    assert stamps == sorted(stamps) and stamps[0][0] > 0, stamps
+
+
+@pytest.mark.slow
+def test_command_line_build_prints_what_to_source(built_ws):
+    done = subprocess.run([sys.executable, "-m", "course_lib", "build", str(built_ws),
+                           "--packages-select", "tutorial_nodes"],
+                          capture_output=True, text=True, timeout=300, env=rosenv.ros_environment())
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "Finished <<< tutorial_nodes" in done.stdout
+    assert f"source {built_ws / 'install' / 'setup.bash'}" in done.stdout
+
+
+@pytest.mark.slow
+def test_broken_package_gives_a_build_error_with_the_log_tail(tmp_path):
+    package = workspace.create_interface_package(tmp_path, "broken_interfaces", {"Broken": "int32 data"})
+    cmake = package / "CMakeLists.txt"
+    # Early in the file, so that CMake fails within seconds instead of after generating code.
+    cmake.write_text(cmake.read_text().replace("find_package(ament_cmake REQUIRED)",
+                                               "find_package(ament_cmake REQUIRED)\nthis_command_does_not_exist()"))
+    with pytest.raises(workspace.BuildError) as caught:
+        workspace.build(tmp_path, timeout=300)
+    message = str(caught.value)
+    assert "failed in package 'broken_interfaces'" in message
+    assert "this_command_does_not_exist" in message  # from the tail of the package's log
+    assert caught.value.result.failed == ["broken_interfaces"] and caught.value.result.returncode != 0
+
+
+@pytest.mark.slow
+def test_command_line_build_failure_exits_nonzero(tmp_path):
+    package = workspace.create_package(tmp_path, "bad_python_pkg")
+    (package / "setup.py").write_text("raise SystemExit('setup.py is broken on purpose')\n")
+    done = subprocess.run([sys.executable, "-m", "course_lib", "build", str(tmp_path)],
+                          capture_output=True, text=True, timeout=300, env=rosenv.ros_environment())
+    assert done.returncode == 1
+    assert "failed in package 'bad_python_pkg'" in done.stderr
+
+
+def test_build_errors_name_a_missing_cmake_package_and_its_wheel():
+    log = ('Could not find a package configuration file provided by "rosidl_core_generators" with any')
+    assert "pip install ros-jazzy-rosidl-core-generators==0.2.0" in workspace._hint(log)
