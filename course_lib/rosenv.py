@@ -143,6 +143,10 @@ def ros_environment(domain_id: int | None = None, base: dict[str, str] | None = 
     return env
 
 
+#: Environment variables that prepare_current_process() set because the user had not.
+DEFAULTS_APPLIED: set[str] = set()
+
+
 def prepare_current_process() -> None:
     """Give this interpreter what sourcing a ROS setup file would: the ament index and the
     course's discovery range (kept when the user set one). Called when course_lib is imported.
@@ -156,8 +160,9 @@ def prepare_current_process() -> None:
     missing = [str(p) for p in install.prefixes if str(p) not in paths]
     if missing:
         os.environ["AMENT_PREFIX_PATH"] = os.pathsep.join(paths + missing)
-    if "ROS_LOCALHOST_ONLY" not in os.environ:
-        os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
+    if "ROS_LOCALHOST_ONLY" not in os.environ and "ROS_AUTOMATIC_DISCOVERY_RANGE" not in os.environ:
+        os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+        DEFAULTS_APPLIED.add("ROS_AUTOMATIC_DISCOVERY_RANGE")
 
 
 def check_domain_id(domain_id: int) -> int:

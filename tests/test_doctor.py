@@ -1,0 +1,56 @@
+"""Tests for course_lib.doctor: it passes here, and each failure it can find names the fix."""
+
+import os
+import subprocess
+import sys
+
+from course_lib import doctor
+
+
+def run_doctor(*args, **env_changes):
+    env = dict(os.environ)
+    for name, value in env_changes.items():
+        if value is None:
+            env.pop(name, None)
+        else:
+            env[name] = value
+    return subprocess.run([sys.executable, "-m", "course_lib", "doctor", *args], capture_output=True,
+                          text=True, env=env, timeout=120)
+
+
+def test_doctor_passes_with_a_live_round_trip_between_two_processes():
+    result = run_doctor()
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert "[ok  ] pub/sub round trip: a second process answered" in result.stdout
+    assert "pip wheels" in result.stdout and "rmw_fastrtps_cpp" in result.stdout
+
+
+def test_a_bad_domain_id_fails_with_the_fix():
+    result = run_doctor("--no-live", ROS_DOMAIN_ID="300")
+    assert result.returncode == 1
+    assert "[FAIL] ROS_DOMAIN_ID" in result.stdout and "export ROS_DOMAIN_ID=<0..101>" in result.stdout
+
+
+def test_discovery_switched_off_fails_the_round_trip_with_advice():
+    result = run_doctor("--timeout", "4", ROS_AUTOMATIC_DISCOVERY_RANGE="OFF")
+    assert result.returncode == 1, result.stdout
+    assert "[FAIL] pub/sub round trip: no answer from a second process within 4 s" in result.stdout
+    assert "ROS_AUTOMATIC_DISCOVERY_RANGE is not OFF" in result.stdout
+    assert "[warn] discovery" in result.stdout  # OFF is also reported as a setting to change
+
+
+def test_deprecated_localhost_only_is_a_warning_not_a_failure(monkeypatch):
+    monkeypatch.setenv("ROS_LOCALHOST_ONLY", "1")
+    report = doctor.run(live=False)
+    line = next(c for c in report.checks if c.name == "discovery")
+    assert line.ok and line.warning and "unset ROS_LOCALHOST_ONLY" in line.fix
+
+
+def test_notebook_call_raises_naming_the_failed_check(monkeypatch):
+    monkeypatch.setenv("ROS_DOMAIN_ID", "banana")
+    try:
+        doctor.check(live=False)
+    except RuntimeError as error:
+        assert "ROS_DOMAIN_ID='banana' is not a valid domain id" in str(error)
+    else:
+        raise AssertionError("doctor.check() accepted ROS_DOMAIN_ID=banana")
