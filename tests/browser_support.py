@@ -1,0 +1,478 @@
+"""Drive the course in JupyterLab as a student does: a real server, headless Chromium, the menus.
+
+The pieces, each usable on its own:
+
+- ``find_chromium`` / ``launched_chromium``: Debian's chromium driven by Playwright;
+- ``running_jupyterlab``: a JupyterLab server on a directory, with a token and a free port,
+  whose settings and workspaces live in a scratch directory (nothing in ~/.jupyter changes);
+- ``open_notebook`` and ``click_toolbar_button``: open a notebook by path, press a notebook
+  toolbar button by its label (the way in for nbgrader's "Validate" button);
+- ``run_notebook``: Run > Run All Cells, wait for the kernel, and report what the student sees.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import json
+import os
+import re
+import secrets
+import shutil
+import signal
+import socket
+import subprocess
+import sys
+import time
+import urllib.error
+import urllib.parse
+import urllib.request
+from pathlib import Path
+
+import psutil
+
+CHROMIUM = "chromium"
+CHROMIUM_FIX = "install Debian's chromium: apt-get install chromium (`make test` does this when run as root)"
+# Without the background-networking flags Chromium keeps calling Google services, which on a
+# closed network floods the log and slows every page.
+CHROMIUM_ARGS = [
+    "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+    "--disable-background-networking", "--disable-component-update", "--disable-sync",
+]
+VIEWPORT = {"width": 1280, "height": 900}
+# A screenshot taller than this is cut: Chromium cannot capture arbitrarily tall pages.
+MAX_SCREENSHOT_HEIGHT = 16000
+
+# JupyterLab settings for the test server. windowingMode "none" attaches and lays out every
+# cell, so every output is in the DOM (images decoded, prompts present) and the screenshot can
+# show the whole notebook; the student default only lays out cells near the viewport.
+LAB_SETTINGS = {
+    "@jupyterlab/notebook-extension/tracker.jupyterlab-settings": {"windowingMode": "none"},
+    # No news or update checks: the test is offline, and the prompt would cover the notebook.
+    "@jupyterlab/apputils-extension/notification.jupyterlab-settings": {
+        "fetchNews": "false", "checkForUpdates": False},
+}
+
+ERROR_MIME = "application/vnd.jupyter.error"
+IMAGE_MIMES = ("image/png", "image/jpeg", "image/gif", "image/svg+xml", "image/webp", "image/bmp")
+
+
+class ChromiumUnavailable(RuntimeError):
+    """Chromium is missing or does not start; the message says what was tried and the fix."""
+
+
+def find_chromium() -> str:
+    """Return the path of the chromium executable on PATH.
+
+    Raises:
+        ChromiumUnavailable: when there is none.
+    """
+    path = shutil.which(CHROMIUM)
+    if path is None:
+        raise ChromiumUnavailable(f"no `{CHROMIUM}` executable on PATH ({os.environ.get('PATH', '')}); "
+                                  f"{CHROMIUM_FIX}")
+    return path
+
+
+@contextlib.contextmanager
+def launched_chromium(user_data_dir: Path):
+    """Start headless Chromium with a fresh profile in user_data_dir; yield a Playwright context.
+
+    Raises:
+        ChromiumUnavailable: when chromium is missing or fails to start.
+    """
+    from playwright.sync_api import Error as PlaywrightError
+    from playwright.sync_api import sync_playwright
+
+    executable = find_chromium()
+    with sync_playwright() as playwright:
+        try:
+            context = playwright.chromium.launch_persistent_context(
+                str(user_data_dir), executable_path=executable, headless=True, args=CHROMIUM_ARGS,
+                viewport=VIEWPORT, timeout=60_000)
+        except PlaywrightError as error:
+            lines = str(error).splitlines()
+            stderr = list(dict.fromkeys(line.strip(" -") for line in lines if "[err]" in line))
+            said = "\n".join(lines[:1] + stderr[:8])
+            raise ChromiumUnavailable(f"{executable} did not start under Playwright: {said}\n"
+                                      f"Check that it runs: {executable} --headless --dump-dom about:blank; "
+                                      f"or {CHROMIUM_FIX}") from error
+        try:
+            yield context
+        finally:
+            context.close()
+
+
+@dataclasses.dataclass
+class JupyterLab:
+    """A running JupyterLab server.
+
+    Attributes:
+        url: base URL, without a trailing slash.
+        token: the access token.
+        root_dir: the directory the server shows; notebook paths are relative to it.
+        process: the server process.
+        log_path: where the server writes its log.
+        startup_seconds: time from launch until the server answered.
+    """
+
+    url: str
+    token: str
+    root_dir: Path
+    process: subprocess.Popen
+    log_path: Path
+    startup_seconds: float
+
+    def lab_url(self, path: str) -> str:
+        """The URL that opens the notebook at path in a workspace of its own (no restored tabs)."""
+        workspace = "test-" + "".join(c if c.isalnum() else "-" for c in path)
+        return (f"{self.url}/lab/workspaces/{workspace}/tree/{urllib.parse.quote(path)}"
+                f"?token={self.token}")
+
+    def api(self, method: str, endpoint: str, timeout: float = 30):
+        """Call the Jupyter server REST API; return the decoded JSON (None for an empty body)."""
+        request = urllib.request.Request(f"{self.url}/api/{endpoint}", method=method,
+                                         headers={"Authorization": f"token {self.token}"})
+        with urllib.request.urlopen(request, timeout=timeout) as response:
+            body = response.read()
+        return json.loads(body) if body else None
+
+    def descendants(self) -> list[psutil.Process]:
+        with contextlib.suppress(psutil.NoSuchProcess):
+            return psutil.Process(self.process.pid).children(recursive=True)
+        return []
+
+    def shut_down_kernels_of(self, path: str, timeout: float = 30) -> None:
+        """End the sessions (and kernels) of the notebook at path, and whatever those kernels started.
+
+        A node process a kernel started outlives the kernel as an orphan; it is ended here
+        (by pid, after a grace period), since the server no longer knows about it.
+        """
+        before = self.descendants()
+        kernel_ids = set()
+        for session in self.api("GET", "sessions"):
+            if session.get("path") == path:
+                kernel_ids.add((session.get("kernel") or {}).get("id"))
+                self.api("DELETE", f"sessions/{session['id']}")
+        deadline = time.monotonic() + timeout
+        while kernel_ids & {k["id"] for k in self.api("GET", "kernels")} and time.monotonic() < deadline:
+            time.sleep(0.25)
+        still_served = set(self.descendants())
+        _end_processes([p for p in before if p not in still_served], grace=10)
+
+    def log_tail(self, lines: int = 30) -> str:
+        text = self.log_path.read_text(errors="replace") if self.log_path.exists() else ""
+        return "\n".join(text.splitlines()[-lines:])
+
+
+def free_port() -> int:
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        return sock.getsockname()[1]
+
+
+@contextlib.contextmanager
+def running_jupyterlab(root_dir: Path, state_dir: Path, timeout: float = 120):
+    """Start JupyterLab on root_dir (settings, workspaces, log in state_dir); yield a JupyterLab.
+
+    The server inherits os.environ, so its kernels get the test run's ROS_DOMAIN_ID and
+    COURSE_LIB_UNDER_TEST. On exit the server, its kernels and their children are ended.
+
+    Raises:
+        RuntimeError: when the server exits or does not answer within timeout seconds.
+    """
+    settings_dir = state_dir / "settings"
+    for name, values in LAB_SETTINGS.items():
+        target = settings_dir / name
+        target.parent.mkdir(parents=True, exist_ok=True)
+        target.write_text(json.dumps(values))
+    env = dict(os.environ,
+               JUPYTERLAB_SETTINGS_DIR=str(settings_dir),
+               JUPYTERLAB_WORKSPACES_DIR=str(state_dir / "workspaces"),
+               JUPYTER_RUNTIME_DIR=str(state_dir / "runtime"))
+    token, port = secrets.token_hex(16), free_port()
+    command = [
+        sys.executable, "-m", "jupyterlab", "--no-browser", "--ip=127.0.0.1", f"--port={port}",
+        "--ServerApp.port_retries=0", f"--IdentityProvider.token={token}",
+        f"--ServerApp.root_dir={root_dir}",
+        # window.jupyterapp lets the checker read output models: JupyterLab renders an error
+        # with the same stderr renderer as a warning, so the DOM cannot tell them apart.
+        "--LabApp.expose_app_in_browser=True",
+        "--LabApp.news_url=None", "--LabApp.check_for_updates_class=jupyterlab.NeverCheckForUpdate",
+    ]
+    if os.geteuid() == 0:  # CI containers run as root; JupyterLab refuses that unless told
+        command.append("--allow-root")
+    log_path = state_dir / "jupyterlab.log"
+    started = time.monotonic()
+    with open(log_path, "wb") as log:
+        process = subprocess.Popen(command, cwd=root_dir, env=env, stdout=log, stderr=subprocess.STDOUT,
+                                   stdin=subprocess.DEVNULL, start_new_session=True)
+    lab = JupyterLab(f"http://127.0.0.1:{port}", token, Path(root_dir), process, log_path, 0.0)
+    try:
+        while True:
+            if process.poll() is not None:
+                raise RuntimeError(f"JupyterLab exited with {process.returncode}:\n{lab.log_tail()}")
+            try:
+                lab.api("GET", "status", timeout=5)
+                break
+            except (urllib.error.URLError, ConnectionError, TimeoutError):
+                pass
+            if time.monotonic() - started > timeout:
+                raise RuntimeError(f"JupyterLab did not answer on {lab.url} within {timeout:.0f} s:\n"
+                                   f"{lab.log_tail()}")
+            time.sleep(0.25)
+        lab.startup_seconds = time.monotonic() - started
+        yield lab
+    finally:
+        _end_process_tree(process)
+
+
+def _end_process_tree(process: subprocess.Popen, grace: float = 15) -> None:
+    """End a server and every process it started (kernels run in sessions of their own)."""
+    try:
+        descendants = psutil.Process(process.pid).children(recursive=True)
+    except psutil.NoSuchProcess:
+        descendants = []
+    if process.poll() is None:
+        process.send_signal(signal.SIGTERM)  # the server shuts its kernels down on SIGTERM
+        try:
+            process.wait(timeout=grace)
+        except subprocess.TimeoutExpired:
+            process.kill()
+            process.wait(timeout=grace)
+    _end_processes(descendants, grace)
+
+
+def _end_processes(processes: list[psutil.Process], grace: float) -> None:
+    """Give processes grace seconds to exit by themselves (they were told to), then kill them."""
+    _, alive = psutil.wait_procs(processes, timeout=grace)
+    for leftover in alive:
+        with contextlib.suppress(psutil.NoSuchProcess):
+            leftover.kill()
+    psutil.wait_procs(alive, timeout=grace)
+
+
+# --- the notebook UI -----------------------------------------------------------------------
+
+NOTEBOOK = ".jp-NotebookPanel:not(.lm-mod-hidden)"
+
+
+_KERNEL_READY_JS = """(notebookSelector) => {
+  const indicator = document.querySelector(notebookSelector + ' .jp-Notebook-ExecutionIndicator');
+  const widget = window.jupyterapp && window.jupyterapp.shell.currentWidget;
+  const kernel = widget && widget.sessionContext && widget.sessionContext.session
+      && widget.sessionContext.session.kernel;
+  return !!(indicator && indicator.dataset.status === 'idle' && kernel && kernel.status === 'idle');
+}"""
+
+_FIRST_CELL_STARTED_JS = """(notebookSelector) => {
+  const prompt = document.querySelector(notebookSelector + ' .jp-CodeCell .jp-InputArea-prompt');
+  return !prompt || prompt.innerText.trim() !== '[ ]:';
+}"""
+
+_KERNEL_READY_OR_DIALOG_JS = f"""(notebookSelector) =>
+  !!document.querySelector('.jp-Dialog .jp-mod-accept') || ({_KERNEL_READY_JS})(notebookSelector)"""
+
+
+def open_notebook(context, lab: JupyterLab, path: str, timeout: float = 120):
+    """Open the notebook at path (relative to lab.root_dir) in a new tab; wait until its kernel is idle.
+
+    Returns:
+        the Playwright page showing it.
+    """
+    page = context.new_page()
+    try:
+        page.set_default_timeout(timeout * 1000)
+        page.goto(lab.lab_url(path), wait_until="domcontentloaded")
+        page.locator(f"{NOTEBOOK} .jp-Notebook .jp-Cell").first.wait_for(state="attached")
+        # A notebook without kernel metadata asks which kernel to use; take the suggested one.
+        page.wait_for_function(_KERNEL_READY_OR_DIALOG_JS, arg=NOTEBOOK, polling=250)
+        accept = page.locator(".jp-Dialog .jp-mod-accept")
+        if accept.count():
+            accept.click()
+        # The toolbar indicator says "idle" for a moment before the kernel exists: ask the session.
+        page.wait_for_function(_KERNEL_READY_JS, arg=NOTEBOOK, polling=250)
+    except BaseException:
+        page.close()
+        raise
+    return page
+
+
+def toolbar_labels(page) -> list[str]:
+    """Labels of the open notebook's toolbar buttons: their visible text, else their tooltip."""
+    return page.locator(f"{NOTEBOOK} .jp-NotebookPanel-toolbar .jp-ToolbarButtonComponent").evaluate_all(
+        "buttons => buttons.map(b => (b.innerText.trim() || b.getAttribute('title') || '').trim())")
+
+
+def click_toolbar_button(page, label: str) -> None:
+    """Click the open notebook's toolbar button whose text or tooltip starts with label.
+
+    This is how a student presses e.g. nbgrader's "Validate" button.
+
+    Raises:
+        LookupError: naming the labels that are there, when no button or several match.
+    """
+    labels = toolbar_labels(page)
+    matches = [i for i, text in enumerate(labels) if text.lower().startswith(label.lower())]
+    if len(matches) != 1:
+        raise LookupError(f"{len(matches)} toolbar buttons match {label!r}; the toolbar has {labels}")
+    page.locator(f"{NOTEBOOK} .jp-NotebookPanel-toolbar .jp-ToolbarButtonComponent").nth(matches[0]).click()
+
+
+def click_menu(page, menu: str, item: str) -> None:
+    """Click item in menu of the main menu bar (e.g. "Run", "Run All Cells")."""
+    page.locator("#jp-MainMenu .lm-MenuBar-item", has=page.get_by_text(menu, exact=True)).click()
+    label = page.locator(".lm-Menu-itemLabel", has_text=re.compile(rf"^{re.escape(item)}$"))
+    page.locator(".lm-Menu .lm-Menu-item", has=label).click()
+
+
+@dataclasses.dataclass
+class NotebookRun:
+    """What a student sees after Run All Cells.
+
+    Attributes:
+        path: the notebook, relative to the server's root.
+        code_cells: number of code cells in the .ipynb file.
+        prompts: the execution prompt of every code cell on the page, e.g. "[3]:" or "[ ]:".
+        errors: "cell N: EName: value" for every error output.
+        images: number of <img> elements in output areas.
+        broken_images: "cell N" for every image that did not decode (naturalWidth 0).
+        image_outputs: number of outputs with an image MIME type in the notebook model.
+        stderr_outputs: number of outputs rendered as stderr (warnings, logs and errors alike).
+        seconds: time from clicking Run All Cells until the kernel was idle again.
+        screenshot: where the full-page screenshot was saved (None when not asked for).
+    """
+
+    path: str
+    code_cells: int
+    prompts: list[str]
+    errors: list[str]
+    images: int
+    broken_images: list[str]
+    image_outputs: int
+    stderr_outputs: int
+    seconds: float
+    screenshot: Path | None = None
+
+    @property
+    def unexecuted(self) -> list[str]:
+        return [f"cell {i}: {p}" for i, p in enumerate(self.prompts) if not p.strip("[]: ").isdigit()]
+
+    def problems(self) -> list[str]:
+        """Everything that makes this run a failure, each in words a course author can act on."""
+        found = [f"error output in {e}" for e in self.errors]
+        if len(self.prompts) != self.code_cells:
+            found.append(f"the page shows {len(self.prompts)} code cells, the file has {self.code_cells}")
+        found += [f"not executed (run stopped?): {u}" for u in self.unexecuted]
+        found += [f"image does not render in {b}" for b in self.broken_images]
+        if self.images < self.image_outputs:
+            found.append(f"{self.image_outputs} image outputs but only {self.images} <img> on the page")
+        return found
+
+
+_PAGE_STATE_JS = """
+([notebookSelector, errorMime, imageMimes]) => {
+  const panel = document.querySelector(notebookSelector);
+  const codeCells = [...panel.querySelectorAll('.jp-Notebook .jp-CodeCell')];
+  const prompts = codeCells.map(c => (c.querySelector('.jp-InputArea-prompt') || {}).innerText || '');
+  const images = [];
+  codeCells.forEach((c, i) => c.querySelectorAll('.jp-OutputArea img').forEach(img =>
+      images.push({cell: i, ok: img.complete && img.naturalWidth > 0})));
+  const stderr = panel.querySelectorAll('.jp-OutputArea-output[data-mime-type="application/vnd.jupyter.stderr"]').length;
+  const app = window.jupyterapp;
+  if (!app) return {error: 'window.jupyterapp is missing (start the server with expose_app_in_browser)'};
+  const widget = app.shell.currentWidget;
+  const errors = [];
+  let imageOutputs = 0;
+  let codeIndex = -1;
+  for (const cell of widget.content.model.cells) {
+    if (cell.type !== 'code') continue;
+    codeIndex += 1;
+    for (let k = 0; k < cell.outputs.length; k++) {
+      const data = cell.outputs.get(k).data;
+      if (data[errorMime]) errors.push(`cell ${codeIndex}: ${data[errorMime].ename}: ${data[errorMime].evalue}`);
+      if (imageMimes.some(m => m in data)) imageOutputs += 1;
+    }
+  }
+  return {prompts, images, errors, imageOutputs, stderr};
+}
+"""
+
+_RUNNING_JS = """(notebookSelector) => {
+  const panel = document.querySelector(notebookSelector);
+  const indicator = panel.querySelector('.jp-Notebook-ExecutionIndicator');
+  const busy = [...panel.querySelectorAll('.jp-CodeCell .jp-InputArea-prompt')]
+      .some(p => p.innerText.includes('*'));
+  return !busy && indicator && indicator.dataset.status === 'idle';
+}
+"""
+
+
+def run_notebook(page, path: str, code_cells: int, timeout: float, screenshot: Path | None = None) -> NotebookRun:
+    """Run > Run All Cells in the open notebook, wait until nothing runs, and report the result.
+
+    Args:
+        page: a page from open_notebook.
+        path: the notebook path, for the report.
+        code_cells: the number of code cells in the file, to check that the page shows them all.
+        timeout: seconds to allow for the whole run.
+        screenshot: where to save a full-page screenshot, or None.
+    """
+    from playwright.sync_api import TimeoutError as PlaywrightTimeout
+
+    started = time.monotonic()
+    click_menu(page, "Run", "Run All Cells")
+    # Run All queues every cell at once and marks each "[*]"; it has started when the first
+    # prompt changed, and it is done when no prompt shows "[*]" and the kernel is idle, twice
+    # in a row (the last outputs settle).
+    try:
+        page.wait_for_function(_FIRST_CELL_STARTED_JS, arg=NOTEBOOK, timeout=30_000, polling=100)
+        for _ in range(2):
+            remaining = max(1.0, timeout - (time.monotonic() - started))
+            page.wait_for_function(_RUNNING_JS, arg=NOTEBOOK, timeout=remaining * 1000, polling=250)
+            page.wait_for_timeout(300)
+    except PlaywrightTimeout:
+        prompts = page.locator(f"{NOTEBOOK} .jp-CodeCell .jp-InputArea-prompt").all_inner_texts()
+        if screenshot is not None:
+            save_full_notebook_screenshot(page, screenshot)
+        raise TimeoutError(f"{path} still running {time.monotonic() - started:.0f} s after Run All Cells; "
+                           f"prompts: {prompts}") from None
+    seconds = time.monotonic() - started
+    # Images decode asynchronously after their output is attached.
+    page.wait_for_function(f"""() => [...document.querySelectorAll('{NOTEBOOK} .jp-OutputArea img')]
+                               .every(img => img.complete)""", timeout=30_000)
+    state = page.evaluate(_PAGE_STATE_JS, [NOTEBOOK, ERROR_MIME, list(IMAGE_MIMES)])
+    if "error" in state:
+        raise RuntimeError(state["error"])
+    run = NotebookRun(
+        path=path, code_cells=code_cells, prompts=state["prompts"], errors=state["errors"],
+        images=len(state["images"]), broken_images=[f"cell {i['cell']}" for i in state["images"] if not i["ok"]],
+        image_outputs=state["imageOutputs"], stderr_outputs=state["stderr"], seconds=seconds)
+    if screenshot is not None:
+        save_full_notebook_screenshot(page, screenshot)
+        run.screenshot = screenshot
+    return run
+
+
+def save_full_notebook_screenshot(page, target: Path) -> None:
+    """Save a screenshot that shows the whole notebook: the window grows to fit it, then shrinks back.
+
+    JupyterLab scrolls the notebook inside a panel, so a plain full-page screenshot would show
+    only the first screen of it.
+    """
+    target.parent.mkdir(parents=True, exist_ok=True)
+    # How far the last cell reaches below the visible part of the notebook.
+    extra = page.evaluate(f"""() => {{
+        const scroller = document.querySelector('{NOTEBOOK} .jp-WindowedPanel-outer');
+        const cells = document.querySelectorAll('{NOTEBOOK} .jp-Notebook .jp-Cell');
+        if (!scroller || !cells.length) return 0;
+        const last = cells[cells.length - 1].getBoundingClientRect();
+        return last.bottom - scroller.getBoundingClientRect().bottom + scroller.scrollTop; }}""")
+    height = min(VIEWPORT["height"] + max(0, round(extra)) + 40, MAX_SCREENSHOT_HEIGHT)
+    page.set_viewport_size({"width": VIEWPORT["width"], "height": height})
+    try:
+        page.evaluate(f"() => document.querySelector('{NOTEBOOK} .jp-WindowedPanel-outer')?.scrollTo(0, 0)")
+        page.wait_for_timeout(500)  # let Lumino lay out the taller window
+        page.screenshot(path=str(target), full_page=True)
+    finally:
+        page.set_viewport_size(VIEWPORT)

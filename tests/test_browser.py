@@ -1,0 +1,151 @@
+"""Every course notebook runs clean in JupyterLab, as a student runs it: Run > Run All Cells.
+
+One JupyterLab server and one headless Chromium serve the whole module. The server's root is a
+scratch directory holding a copy of notebooks/ (outputs never reach the repository) and the
+checker's own small notebooks, which prove that the checker passes a good notebook and fails
+one that raises. Screenshots go to artifacts/browser/<notebook>.png.
+"""
+
+import contextlib
+import json
+import shutil
+from pathlib import Path
+
+import nbformat
+import pytest
+
+from browser_support import (NOTEBOOK, ChromiumUnavailable, click_toolbar_button, launched_chromium,
+                             open_notebook, run_notebook, running_jupyterlab, toolbar_labels)
+
+ROOT = Path(__file__).resolve().parents[1]
+NOTEBOOKS = ROOT / "notebooks"
+SCREENSHOTS = ROOT / "artifacts" / "browser"
+# Notebooks may start ROS nodes and take a minute on a busy 2-core machine; allow plenty.
+RUN_TIMEOUT = 300
+
+COURSE_NOTEBOOKS = sorted(str(p.relative_to(NOTEBOOKS)) for p in NOTEBOOKS.rglob("*.ipynb")
+                          if ".ipynb_checkpoints" not in p.parts)
+
+pytestmark = pytest.mark.browser
+
+CHECKER_NOTEBOOKS = {
+    "prints.ipynb": ["print('hello from the kernel')",
+                     "import sys\nprint('a warning is not an error', file=sys.stderr)\n6 * 7"],
+    "plots.ipynb": ["%matplotlib inline\nimport matplotlib.pyplot as plt",
+                    "plt.plot([0, 1, 2], [0, 1, 4])\nplt.title('a parabola')\nplt.show()"],
+    "raises.ipynb": ["x = 1", "1 / 0", "print('never reached')"],
+    "broken_image.ipynb": ["from IPython.display import Image\nImage(data=b'these bytes are no PNG', format='png')"],
+}
+
+
+def write_notebook(path: Path, sources: list[str]) -> None:
+    notebook = nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell(s) for s in sources])
+    notebook.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3 (ipykernel)",
+                                       "language": "python"}
+    nbformat.write(notebook, path)
+
+
+def code_cell_count(path: Path) -> int:
+    return sum(cell["cell_type"] == "code" for cell in json.loads(path.read_text())["cells"])
+
+
+@pytest.fixture(scope="module")
+def browser(tmp_path_factory):
+    """A headless Chromium context with a fresh profile; skips the module when Chromium is unavailable."""
+    with contextlib.ExitStack() as stack:
+        try:
+            context = stack.enter_context(launched_chromium(tmp_path_factory.mktemp("chromium-profile")))
+        except ChromiumUnavailable as why:
+            pytest.skip(f"browser tests need Chromium: {why}")
+        yield context
+
+
+@pytest.fixture(scope="module")
+def lab(tmp_path_factory):
+    """JupyterLab on a scratch root holding a copy of notebooks/ and the checker's notebooks."""
+    root = tmp_path_factory.mktemp("lab-root")
+    if NOTEBOOKS.is_dir():
+        # As in a fresh checkout: no checkpoints, no colcon output (git ignores both).
+        shutil.copytree(NOTEBOOKS, root / "notebooks",
+                        ignore=shutil.ignore_patterns(".ipynb_checkpoints", "build", "install", "log"))
+    (root / "checker").mkdir()
+    for name, sources in CHECKER_NOTEBOOKS.items():
+        write_notebook(root / "checker" / name, sources)
+    with running_jupyterlab(root, tmp_path_factory.mktemp("lab-state")) as server:
+        print(f"\nJupyterLab answered after {server.startup_seconds:.1f} s")
+        yield server
+
+
+def run_in_lab(browser, lab, path, screenshot=None):
+    """Open path in JupyterLab, run all cells, shut its kernel down; return the NotebookRun."""
+    page = open_notebook(browser, lab, path)
+    try:
+        run = run_notebook(page, path, code_cell_count(lab.root_dir / path), RUN_TIMEOUT, screenshot)
+    finally:
+        lab.shut_down_kernels_of(path)
+        page.close()
+    print(f"\n{path}: Run All Cells took {run.seconds:.1f} s")
+    return run
+
+
+@pytest.mark.timeout(RUN_TIMEOUT + 180)
+@pytest.mark.parametrize("notebook", COURSE_NOTEBOOKS or [
+    pytest.param(None, marks=pytest.mark.skip(reason=f"no notebooks in {NOTEBOOKS} yet"))])
+def test_course_notebook_runs_clean_in_jupyterlab(notebook, browser, lab):
+    """After Run All Cells every code cell has run, none shows an error, every image renders."""
+    screenshot = SCREENSHOTS / (notebook.removesuffix(".ipynb").replace("/", "__") + ".png")
+    run = run_in_lab(browser, lab, f"notebooks/{notebook}", screenshot)
+    assert not run.problems(), f"{notebook} in JupyterLab (screenshot {screenshot}):\n" + "\n".join(run.problems())
+
+
+# --- the checker itself ---------------------------------------------------------------------
+
+@pytest.mark.timeout(RUN_TIMEOUT)
+def test_checker_passes_text_output_and_does_not_take_stderr_for_an_error(browser, lab):
+    run = run_in_lab(browser, lab, "checker/prints.ipynb", SCREENSHOTS / "checker" / "prints.png")
+    assert run.problems() == []
+    assert run.prompts == ["[1]:", "[2]:"]
+    assert run.stderr_outputs == 1
+
+
+@pytest.mark.timeout(RUN_TIMEOUT)
+def test_checker_passes_a_notebook_whose_matplotlib_image_renders(browser, lab):
+    screenshot = SCREENSHOTS / "checker" / "plots.png"
+    run = run_in_lab(browser, lab, "checker/plots.ipynb", screenshot)
+    assert run.problems() == []
+    assert run.image_outputs == 1 and run.images == 1
+    assert screenshot.stat().st_size > 10_000
+
+
+@pytest.mark.timeout(RUN_TIMEOUT)
+def test_checker_fails_a_notebook_that_raises_and_names_the_error(browser, lab):
+    run = run_in_lab(browser, lab, "checker/raises.ipynb", SCREENSHOTS / "checker" / "raises.png")
+    assert run.errors == ["cell 1: ZeroDivisionError: division by zero"]
+    # Run All stops at the error, so the last cell never gets an execution count.
+    assert run.unexecuted == ["cell 2: [ ]:"]
+    assert any("ZeroDivisionError" in p for p in run.problems())
+
+
+@pytest.mark.timeout(RUN_TIMEOUT)
+def test_checker_fails_an_image_that_does_not_render(browser, lab):
+    run = run_in_lab(browser, lab, "checker/broken_image.ipynb")
+    assert run.errors == [] and run.image_outputs == 1
+    assert run.problems() == ["image does not render in cell 0"]
+
+
+@pytest.mark.timeout(RUN_TIMEOUT)
+def test_toolbar_buttons_are_clicked_by_their_label(browser, lab):
+    """click_toolbar_button presses the button named (the way in for nbgrader's Validate)."""
+    page = open_notebook(browser, lab, "checker/prints.ipynb")
+    try:
+        assert "Validate" in toolbar_labels(page), "nbgrader's Validate button is missing"
+        cells = f"{NOTEBOOK} .jp-Notebook .jp-Cell"
+        before = page.locator(cells).count()
+        click_toolbar_button(page, "Insert a cell below")
+        page.wait_for_function("([selector, n]) => document.querySelectorAll(selector).length === n",
+                               arg=[cells, before + 1], timeout=10_000)
+        with pytest.raises(LookupError, match="Insert a cell below"):
+            click_toolbar_button(page, "No such button")
+    finally:
+        lab.shut_down_kernels_of("checker/prints.ipynb")
+        page.close()
