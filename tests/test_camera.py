@@ -1,0 +1,90 @@
+"""Tests for course_lib.camera: the webcam node publishes real Images over Fast DDS."""
+
+import time
+
+import cv2
+import numpy as np
+import pytest
+import rclpy
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+from sensor_msgs.msg import Image
+
+from course_lib import camera, scenes
+from course_lib.images import msg_to_image
+
+
+def receive_frames(domain_id, count, **parameters):
+    """Run a WebcamNode and a subscriber in one executor until `count` frames arrived (20 s bound)."""
+    received = []
+    context = rclpy.Context()  # own context: no interference with other tests in this process
+    rclpy.init(context=context, domain_id=domain_id)
+    try:
+        overrides = [Parameter(name, value=value) for name, value in parameters.items()]
+        webcam = camera.WebcamNode(context=context, parameter_overrides=overrides)
+        viewer = Node("viewer", context=context)
+        viewer.create_subscription(Image, "image", received.append, 10)
+        executor = SingleThreadedExecutor(context=context)
+        executor.add_node(webcam)
+        executor.add_node(viewer)
+        deadline = time.monotonic() + 20.0  # a bound, not a speed goal: fails only if frames stop
+        while len(received) < count and time.monotonic() < deadline:
+            executor.spin_once(timeout_sec=0.1)
+        executor.shutdown()
+        webcam.destroy_node()
+        viewer.destroy_node()
+    finally:
+        rclpy.try_shutdown(context=context)
+    assert len(received) >= count, f"received {len(received)} of {count} frames within 20 s"
+    return received
+
+
+def stamps(messages):
+    return np.array([m.header.stamp.sec + m.header.stamp.nanosec * 1e-9 for m in messages])
+
+
+def test_simulated_frames_arrive_with_size_encoding_frame_and_rate(domain_id):
+    messages = receive_frames(domain_id, 12, rate=20.0, width=320, height=240)
+    for msg in messages:
+        assert (msg.width, msg.height, msg.encoding) == (320, 240, "bgr8")
+        assert msg.header.frame_id == "camera"
+    frames = [msg_to_image(m) for m in messages]
+    assert frames[0].shape == (240, 320, 3)
+    assert not np.array_equal(frames[0], frames[-1]), "the simulated camera moves"
+    # Markers are in view: the frames are the marker scenes.
+    _, ids, _ = scenes.detector().detectMarkers(frames[-1])
+    assert ids is not None and len(ids) >= 4
+    intervals = np.diff(stamps(messages))
+    assert np.all(intervals > 0), "stamps come from the node clock and increase"
+    # Loose: the median frame interval is within a factor of two of 1/rate.
+    assert 0.025 <= np.median(intervals) <= 0.1, np.median(intervals)
+
+
+def test_a_video_file_is_played_and_resized(domain_id, tmp_path):
+    path = str(tmp_path / "clip.avi")
+    writer = cv2.VideoWriter(path, cv2.VideoWriter_fourcc(*"MJPG"), 10, (160, 120))
+    assert writer.isOpened(), "OpenCV can write MJPG .avi files"
+    for level in (40, 120, 200):
+        writer.write(np.full((120, 160, 3), level, np.uint8))
+    writer.release()
+    messages = receive_frames(domain_id, 5, rate=30.0, width=80, height=60, source=path)
+    levels = [int(np.median(msg_to_image(m))) for m in messages]
+    assert all((m.width, m.height) == (80, 60) for m in messages)
+    assert {40, 120, 200} <= {round(level / 40) * 40 for level in levels}, levels  # the clip loops
+
+
+@pytest.mark.parametrize("overrides, message", [
+    ({"rate": 0.0}, "rate must be above 0"),
+    ({"source": "/no/such/clip.avi"}, "sim for the simulated camera"),
+    ({"source": "97"}, "source:=sim"),
+])
+def test_bad_parameters_are_refused_with_the_fix(domain_id, overrides, message):
+    context = rclpy.Context()
+    rclpy.init(context=context, domain_id=domain_id)
+    try:
+        with pytest.raises(ValueError, match=message):
+            camera.WebcamNode(context=context,
+                              parameter_overrides=[Parameter(k, value=v) for k, v in overrides.items()])
+    finally:
+        rclpy.try_shutdown(context=context)
