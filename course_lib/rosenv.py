@@ -71,9 +71,9 @@ def detect_install() -> RosInstall:
     rclpy_path = Path(next(iter(spec.submodule_search_locations))).resolve()
     prefixes = _env_prefixes()
     conda_prefix = os.environ.get("CONDA_PREFIX")
-    if _is_relative_to(rclpy_path, SYSTEM_PREFIX.resolve() if SYSTEM_PREFIX.exists() else SYSTEM_PREFIX):
+    if rclpy_path.is_relative_to(SYSTEM_PREFIX.resolve() if SYSTEM_PREFIX.exists() else SYSTEM_PREFIX):
         kind = "system"
-    elif conda_prefix and _is_relative_to(rclpy_path, Path(conda_prefix).resolve()):
+    elif conda_prefix and rclpy_path.is_relative_to(Path(conda_prefix).resolve()):
         kind = "conda"
         prefixes.append(Path(conda_prefix))
     elif _pip_wheels_installed():
@@ -90,14 +90,6 @@ def _pip_wheels_installed() -> bool:
     try:
         importlib.metadata.version("ros-jazzy-rclpy")
     except importlib.metadata.PackageNotFoundError:
-        return False
-    return True
-
-
-def _is_relative_to(path: Path, parent: Path) -> bool:
-    try:
-        path.relative_to(parent)
-    except ValueError:
         return False
     return True
 

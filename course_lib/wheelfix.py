@@ -113,7 +113,7 @@ def numpy_include_dir() -> Path:
 def cmake_files(prefix: Path) -> list[Path]:
     """The CMake files of the ROS packages installed under prefix (share/*/cmake, lib/cmake)."""
     found = set(prefix.glob("share/*/cmake/*.cmake")) | set(prefix.glob("lib/cmake/*/*.cmake"))
-    return sorted(p for p in found if p.is_file() and not _is_relative_to(p, prefix / RECORD_DIR))
+    return sorted(p for p in found if p.is_file() and not p.is_relative_to(prefix / RECORD_DIR))
 
 
 def foreign_paths(prefix: Path) -> dict[str, list[str]]:
@@ -146,7 +146,7 @@ def _default_prefix() -> Path:
 def _refuse_system_prefix(prefix: Path) -> None:
     resolved = prefix.resolve()
     for protected in (Path("/opt"), Path("/usr")):
-        if resolved == protected or _is_relative_to(resolved, protected):
+        if resolved == protected or resolved.is_relative_to(protected):
             raise ValueError(f"refusing to modify {resolved}: repair-wheels only edits a project's own "
                              "virtual environment, never a system install")
 
@@ -187,7 +187,7 @@ def repair(prefix: Path | str | None = None, *, python_include: Path | str | Non
         report.messages.append(_missing_headers_message(Path(python_include)))
     entries = []
     for path in cmake_files(prefix):
-        if not _is_relative_to(path.resolve(), prefix.resolve()):
+        if not path.resolve().is_relative_to(prefix.resolve()):
             continue  # a symlink out of the environment: not ours to edit
         original = path.read_bytes()
         text = original.decode("utf-8", errors="surrogateescape")
@@ -318,14 +318,6 @@ def build_environment(base: dict[str, str] | None = None, prefix: Path | str | N
     if "colcon_core.prefix_path.ament" not in blocked:
         env["COLCON_EXTENSION_BLOCKLIST"] = os.pathsep.join(blocked + ["colcon_core.prefix_path.ament"])
     return env
-
-
-def _is_relative_to(path: Path, parent: Path) -> bool:
-    try:
-        path.relative_to(parent)
-    except ValueError:
-        return False
-    return True
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -629,11 +629,7 @@ def _preload(libraries: list[Path]) -> None:
 
 
 def _is_inside(path: Path, parent: Path) -> bool:
-    try:
-        path.resolve().relative_to(parent.resolve())
-    except ValueError:
-        return False
-    return True
+    return path.resolve().is_relative_to(parent.resolve())
 
 
 # --- running nodes -----------------------------------------------------------------------------
