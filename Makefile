@@ -40,8 +40,11 @@ $(VENV)/.setup-done: environment.txt pyproject.toml course_lib/wheelfix.py
 	$(PY) -m course_lib repair-wheels
 	@touch $@
 
+# JupyterLab refuses to run as root unless told; containers and CI often are root.
+ALLOW_ROOT := $(if $(filter 0,$(shell id -u)),--allow-root)
+
 lab: setup
-	$(VENV)/bin/jupyter lab --no-browser --ip=127.0.0.1 --port=$(LAB_PORT) \
+	$(VENV)/bin/jupyter lab --no-browser --ip=127.0.0.1 --port=$(LAB_PORT) $(ALLOW_ROOT) \
 	  --ServerApp.root_dir="$(CURDIR)" --LabApp.default_url=/lab/tree/notebooks
 
 # Browser tests need Debian's chromium. Install it when we may (root with apt); otherwise the
