@@ -16,7 +16,7 @@ from course_lib import rosenv as _rosenv
 _rosenv.prepare_current_process()
 
 _MODULES = ("camera", "doctor", "graph", "images", "interfaces", "processes", "rosenv", "scenes",
-            "selfcheck", "session", "wheelfix", "workspace")
+            "selfcheck", "session", "vision", "wheelfix", "workspace")
 
 
 def __getattr__(name):

@@ -79,3 +79,132 @@ def task2_echo(messages, topic: str = "/chatter", text_prefix: str = "Hello Worl
     if not data.startswith(text_prefix):
         return _verdict(False, f"Got {data!r}, which the talker did not send: echo {topic}, not another topic.")
     return _verdict(True, f"Echoed {len(messages)} message(s) from {topic}; the first says {data!r}.")
+
+
+def _call(function, *args):
+    """(result, None) or (None, a Verdict naming the exception) for one call of a student's function."""
+    import warnings
+
+    import numpy as np
+
+    try:
+        # Overflow warnings would only repeat what the verdict explains.
+        with warnings.catch_warnings(), np.errstate(all="ignore"):
+            warnings.simplefilter("ignore", RuntimeWarning)
+            return function(*args), None
+    except NotImplementedError:
+        return None, _verdict(False, "Not done yet: replace the raise NotImplementedError with your code.")
+    except Exception as error:  # a check never raises on a wrong answer
+        shown = ", ".join(repr(a.tolist() if hasattr(a, "tolist") and getattr(a, "ndim", 0) else a) for a in args)
+        return None, _verdict(False, f"Calling it with ({shown}) raised {type(error).__name__}: {error}")
+
+
+def task3_brightness_on_change(function) -> Verdict:
+    """Task 3 (lesson 02): should_publish(last_sent, current, threshold), true when the change is more than threshold."""
+    import numpy as np
+
+    hint = ("Write should_publish(last_sent, current, threshold) so that it returns True when nothing was "
+            "sent yet (last_sent is None) or the brightness moved by more than threshold, else False.")
+    if (result := _not_done(function, hint)) is not None:
+        return result
+    if not callable(function):
+        return _verdict(False, f"Pass the function itself (should_publish, without brackets), not a "
+                               f"{type(function).__name__}.")
+    first, problem = _call(function, None, 120, 5)
+    if problem is not None:
+        if "Not done yet" in problem.text:
+            return problem
+        return _verdict(False, problem.text + ". Before anything was sent last_sent is None, and the first "
+                                              "brightness must be published: test `last_sent is None` first.")
+    if first is None:
+        return _verdict(False, "Not done yet: should_publish returns None. " + hint)
+    # (last_sent, current, threshold, expected, what is wrong when the answer differs)
+    cases = [
+        (None, 120, 5, True, "nothing was sent yet (last_sent is None), so the first brightness must be "
+                             "published: test `last_sent is None` first"),
+        (100, 100, 5, False, "the brightness did not change, so nothing should be published"),
+        (100, 103, 5, False, "a change of 3 is not more than 5"),
+        (100, 106, 5, True, "a rise of 6 is more than 5 and must be published"),
+        (100, 94, 5, True, "a drop of 6 counts too: compare abs(current - last_sent) with threshold"),
+        (100, 105, 5, False, "a change of exactly 5 is not *more than* 5: use >, not >="),
+        (100, 101, 0, True, "with threshold 0 every change must be published"),
+        (np.uint8(100), np.uint8(103), 5, False,
+         "with numpy uint8 values (what a frame's pixels are) 100 - 103 is 253, not -3: uint8 arithmetic "
+         "wraps around. Convert to int before subtracting: int(current) - int(last_sent)"),
+        (np.uint8(103), np.uint8(100), 5, False,
+         "with numpy uint8 values (what a frame's pixels are) 100 - 103 is 253, not -3: uint8 arithmetic "
+         "wraps around. Convert to int before subtracting: int(current) - int(last_sent)"),
+    ]
+    for last_sent, current, threshold, expected, why in cases:
+        answer, problem = _call(function, last_sent, current, threshold)
+        if problem is not None:
+            return problem
+        if answer is None or bool(answer) != expected:
+            return _verdict(False, f"should_publish({last_sent!r}, {current!r}, {threshold}) returned {answer!r}, "
+                                   f"expected {expected}: {why}.")
+    return _verdict(True, "should_publish publishes the first value and every change of more than threshold, "
+                          "up or down, and no other.")
+
+
+def task4_order_corners(function) -> Verdict:
+    """Task 4 (lesson 03): order_corners(points) returns four points as top-left, top-right, bottom-right, bottom-left."""
+    import math
+
+    import numpy as np
+
+    hint = ("Write order_corners(points): given 4 (x, y) points in any order, return them as a (4, 2) array in "
+            "the order top-left, top-right, bottom-right, bottom-left (clockwise on screen).")
+    if (result := _not_done(function, hint)) is not None:
+        return result
+    if not callable(function):
+        return _verdict(False, f"Pass the function itself (order_corners, without brackets), not a "
+                               f"{type(function).__name__}.")
+    a = math.radians(30)
+    thin = np.array([[0, 0], [160 * math.cos(a), -160 * math.sin(a)],
+                     [160 * math.cos(a) + 40 * math.sin(a), -160 * math.sin(a) + 40 * math.cos(a)],
+                     [40 * math.sin(a), 40 * math.cos(a)]]) + [100, 200]
+    b = math.radians(-20)
+    rotated = np.array([[math.cos(b) * x - math.sin(b) * y, math.sin(b) * x + math.cos(b) * y]
+                        for x, y in [(-50, -50), (50, -50), (50, 50), (-50, 50)]]) + [300, 240]
+    # (name, the corners in the right order, the order in which the function gets them)
+    cases = [
+        ("an upright square", [[10, 10], [90, 10], [90, 90], [10, 90]], (2, 0, 3, 1)),
+        ("a square turned by 20 degrees", rotated, (3, 1, 0, 2)),
+        ("a trapezoid seen in perspective", [[120, 50], [260, 70], [300, 200], [80, 220]], (1, 3, 2, 0)),
+        ("a long rectangle tilted by 30 degrees (its top-right corner is higher than its top-left and "
+         "its bottom-right corner is higher than its top-left too, so 'the two highest points are the top' fails)",
+         thin, (0, 2, 3, 1)),
+        ("points already in order", [[15, 12], [95, 18], [92, 88], [10, 80]], (0, 1, 2, 3)),
+    ]
+    names = ("top-left", "top-right", "bottom-right", "bottom-left")
+    for name, expected, shuffle in cases:
+        expected = np.asarray(expected, dtype=np.float32)
+        given = expected[list(shuffle)]
+        answer, problem = _call(function, given.copy())
+        if problem is not None:
+            return problem
+        if answer is None:
+            return _verdict(False, "Not done yet: order_corners returns None. " + hint)
+        try:
+            answer = np.asarray(answer, dtype=np.float32).reshape(4, 2)
+        except (TypeError, ValueError):
+            return _verdict(False, f"order_corners should return 4 points, a (4, 2) array; for {name} it "
+                                   f"returned {answer!r}.")
+        if np.allclose(answer, expected, atol=1e-3):
+            continue
+        matches = [next((i for i in range(4) if np.allclose(p, expected[i], atol=1e-3)), None) for p in answer]
+        if None in matches or sorted(matches) != [0, 1, 2, 3]:
+            return _verdict(False, f"For {name}, order_corners returned {answer.tolist()}, which are not the four "
+                                   f"points it was given ({given.tolist()}) in a new order: return the same points, "
+                                   "reordered.")
+        if matches == [0, 3, 2, 1]:
+            return _verdict(False, f"For {name} the order goes anticlockwise on screen. Remember that image y "
+                                   "points down: after top-left comes top-right, then bottom-right.")
+        steps = (matches[0]) % 4
+        if all(m == (i + steps) % 4 for i, m in enumerate(matches)):
+            return _verdict(False, f"For {name} the order is clockwise but starts at the {names[matches[0]]} "
+                                   "corner: start at the top-left one (the corner with the smallest x + y).")
+        return _verdict(False, f"For {name} you returned the corners as "
+                               f"{', '.join(names[m] for m in matches)}; expected {', '.join(names)}.")
+    return _verdict(True, "order_corners puts four corners in the order top-left, top-right, bottom-right, "
+                          "bottom-left, for tilted and perspective shapes too.")

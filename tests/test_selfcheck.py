@@ -55,3 +55,72 @@ def test_task2_verdicts():
     assert "which the talker did not send" in str(selfcheck.task2_echo([String(data="hi")]))
     assert selfcheck.task2_echo([String(data="Hello World: 7")])
     assert selfcheck.task2_echo(String(data="Hello World: 7")), "a single message (not a list) is fine too"
+
+
+# --- Task 3 (lesson 02): publish brightness only when it changes by more than a threshold -----
+
+def _publish_on_change(last_sent, current, threshold):
+    return last_sent is None or abs(int(current) - int(last_sent)) > threshold
+
+
+@pytest.mark.parametrize("stub", [None, lambda last, current, threshold: None])
+def test_task3_stub_is_not_done_yet(stub):
+    verdict = selfcheck.task3_brightness_on_change(stub)
+    assert not verdict and "Not done yet" in str(verdict)
+
+
+def test_task3_accepts_a_correct_filter():
+    assert selfcheck.task3_brightness_on_change(_publish_on_change)
+
+
+@pytest.mark.parametrize("wrong, named", [
+    (lambda last, current, threshold: abs(int(current) - int(last)) > threshold, "last_sent is None"),
+    (lambda last, current, threshold: last is None or int(current) - int(last) > threshold, "a drop of 6 counts too"),
+    (lambda last, current, threshold: last is None or abs(int(current) - int(last)) >= threshold, "use >, not >="),
+    (lambda last, current, threshold: last is None or abs(current - last) > threshold, "uint8 arithmetic wraps"),
+    (lambda last, current, threshold: 1 / 0, "raised ZeroDivisionError"),
+])
+def test_task3_names_what_is_wrong(wrong, named):
+    verdict = selfcheck.task3_brightness_on_change(wrong)
+    assert not verdict and named in str(verdict)
+
+
+# --- Task 4 (lesson 03): order four shuffled corners ------------------------------------------
+
+def _order_by_angle(points):
+    import numpy as np
+
+    points = np.asarray(points, dtype=float)
+    centre = points.mean(axis=0)
+    points = points[np.argsort(np.arctan2(points[:, 1] - centre[1], points[:, 0] - centre[0]))]
+    return np.roll(points, -int(np.argmin(points.sum(axis=1))), axis=0)
+
+
+def test_task4_stub_and_correct_answer():
+    assert "Not done yet" in str(selfcheck.task4_order_corners(None))
+    assert "Not done yet" in str(selfcheck.task4_order_corners(lambda points: None))
+    assert selfcheck.task4_order_corners(_order_by_angle)
+
+
+@pytest.mark.parametrize("wrong, named", [
+    (lambda p: _order_by_angle(p)[[0, 3, 2, 1]], "anticlockwise"),
+    (lambda p: __import__("numpy").roll(_order_by_angle(p), 1, axis=0), "starts at the bottom-left"),
+    (lambda p: _order_by_angle(p) * 2, "not the four points it was given"),
+    (lambda p: [1, 2, 3], "(4, 2) array"),
+])
+def test_task4_names_what_is_wrong(wrong, named):
+    verdict = selfcheck.task4_order_corners(wrong)
+    assert not verdict and named in str(verdict)
+
+
+def test_task4_catches_taking_the_two_highest_points_as_the_top():
+    import numpy as np
+
+    def two_highest_are_top(points):
+        points = np.asarray(points)
+        by_y = points[np.argsort(points[:, 1])]
+        top, bottom = by_y[:2][np.argsort(by_y[:2, 0])], by_y[2:][np.argsort(by_y[2:, 0])]
+        return np.array([top[0], top[1], bottom[1], bottom[0]])
+
+    verdict = selfcheck.task4_order_corners(two_highest_are_top)
+    assert not verdict and "long rectangle tilted by 30 degrees" in str(verdict)
