@@ -1,0 +1,1 @@
+"""One module per assignment; each holds that assignment's graded checks (see autograder.harness)."""

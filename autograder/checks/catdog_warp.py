@@ -1,0 +1,233 @@
+"""Checks of the catdog_warp assignment: ``crop_pictures`` and ``MarkerReader``, on generated scenes.
+
+The contract (also in the notebook and in assignments/README.md); the board convention is
+course_lib.scenes' (markers of DICT_4X4_50; "cat" framed by markers 1-4, "dog" by 5-8, in the
+order top-left, top-right, bottom-right, bottom-left; the picture's corners are those marker
+corners that touch it, scenes.CORNER_OF_MARKER):
+
+- ``crop_pictures(frame_bgr, size=(320, 240)) -> dict``: ``{"cat": crop, "dog": crop}`` with a
+  key only when all four of that picture's markers are found; each crop is a BGR uint8 image of
+  ``size`` (width, height), the picture's top-left corner at pixel (0, 0), upright, not mirrored.
+- ``MarkerReader()``: node ``marker_reader``; subscribes ``image`` (sensor_msgs/Image, any QoS);
+  for each frame publishes the crops it finds on ``cropped_img/cat`` and ``cropped_img/dog``
+  (sensor_msgs/CompressedImage, e.g. images.image_to_compressed(crop, "png")).
+- ``main(args=None)`` runs the node until Ctrl-C.
+
+Crops are compared with the ground truth of the generated scene (Scene.expected_crops) by
+scenes.crop_similarity, passing at scenes.SAME_CROP_THRESHOLD; colours are checked separately
+(crop_similarity compares grey levels, so a red/blue swap would pass it).
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from autograder import harness
+from autograder.harness import check
+
+ASSIGNMENT = "catdog_warp"
+SIZE = (320, 240)
+#: Largest difference of the per-channel means of a crop and its expected crop (grey levels).
+COLOUR_TOLERANCE = 20.0
+
+
+def selfcheck(name: str):
+    """Run check `name` with the self-check seed and print what is right and wrong."""
+    return harness.selfcheck(ASSIGNMENT, name)
+
+
+def grade(name: str):
+    """Run check `name` with a fresh seed (grading)."""
+    return harness.grade(ASSIGNMENT, name)
+
+
+def _seed(ctx) -> int:
+    return int(ctx.rng.integers(0, 2**31))
+
+
+def compare_crop(ctx, label: str, crop, expected, show: bool = False) -> bool:
+    """One item: the student's crop is the expected picture (shape, dtype, content, colours)."""
+    from course_lib import scenes
+
+    if not isinstance(crop, np.ndarray):
+        return ctx.item(False, f"{label}: the crop is a {type(crop).__name__}, not a numpy image")
+    want = (SIZE[1], SIZE[0], 3) if expected is None else expected.shape
+    if crop.shape != want or crop.dtype != np.uint8:
+        hint = " (size is (width, height): warpPerspective(frame, H, size))" if crop.shape[:2] == want[1::-1] else ""
+        return ctx.item(False, f"{label}: crop has shape {crop.shape} {crop.dtype}, expected {want} uint8{hint}")
+    similarity = scenes.crop_similarity(crop, expected)
+    if show:
+        ctx.image(f"{label}: yours ({similarity:.2f})", crop)
+        ctx.image(f"{label}: expected", expected)
+    if similarity < scenes.SAME_CROP_THRESHOLD:
+        hints = []
+        for name, variant in (("mirrored left-right", crop[:, ::-1]), ("upside down", crop[::-1, ::-1]),
+                              ("flipped top-bottom", crop[::-1])):
+            if scenes.crop_similarity(variant, expected) >= scenes.SAME_CROP_THRESHOLD:
+                hints.append(f"it is the expected picture {name}: check the order of the four corners "
+                             "(top-left, top-right, bottom-right, bottom-left) on both sides of the warp")
+        return ctx.item(False, f"{label}: similarity {similarity:.2f} < {scenes.SAME_CROP_THRESHOLD}"
+                               + (f"; {hints[0]}" if hints else ""))
+    mine, theirs = crop.reshape(-1, 3).mean(axis=0), expected.reshape(-1, 3).mean(axis=0)
+    if np.abs(mine - theirs).max() > COLOUR_TOLERANCE:
+        swapped = np.abs(mine[::-1] - theirs).max() <= COLOUR_TOLERANCE
+        return ctx.item(False, f"{label}: the right picture in the wrong colours" +
+                        ("; red and blue are swapped: OpenCV images are BGR, keep them BGR" if swapped else ""))
+    return ctx.item(True, f"{label}: matches (similarity {similarity:.2f})")
+
+
+def _check_scene(ctx, label: str, scene, outcome, show: bool = False) -> None:
+    from course_lib import scenes
+
+    if not outcome.ok:
+        hint = " (replace `raise NotImplementedError()` with your code)" if outcome.error.startswith("NotImplementedError") else ""
+        ctx.item(False, f"{label}: crop_pictures failed: {outcome.error}{hint}")
+        return
+    result = outcome.value
+    if not isinstance(result, dict):
+        ctx.item(False, f"{label}: crop_pictures returned a {outcome.pytype}, not a dict like {{'cat': crop}}")
+        return
+    unknown = sorted(set(result) - set(scenes.PICTURES))
+    if unknown:
+        ctx.item(False, f"{label}: unexpected keys {unknown}; the keys are 'cat' and 'dog'")
+    expected = scene.expected_crops(SIZE) if scene is not None else {}
+    framed = scene.fully_framed if scene is not None else ()
+    visible = set(scene.visible_ids) if scene is not None else set()
+    for name, markers in scenes.PICTURES.items():
+        if name in framed:
+            if name not in result:
+                ctx.item(False, f"{label}: no '{name}' although its markers {markers} are all in view")
+            else:
+                compare_crop(ctx, f"{label}, {name}", result[name], expected[name], show=show)
+        elif not visible.issuperset(markers):
+            missing = sorted(set(markers) - visible)
+            ok = name not in result
+            ctx.item(ok, f"{label}: no '{name}' (markers {missing} are not in view)" if ok else
+                     f"{label}: returned '{name}' although markers {missing} are not in view: add a key "
+                     "only when all four of its markers were detected")
+
+
+def _run_scenes(ctx, cases, show_first: bool = True) -> None:
+    outcomes = ctx.call("crop_pictures", [((scene.frame,), {"size": list(SIZE)}) for _, scene in cases])
+    for index, ((label, scene), outcome) in enumerate(zip(cases, outcomes)):
+        _check_scene(ctx, label, scene, outcome, show=show_first and index == 0)
+
+
+@check(points=3, timeout=60)
+def easy(ctx: harness.Context) -> None:
+    """crop_pictures finds and warps both pictures on easy (mildly tilted) views."""
+    from course_lib import scenes
+
+    _run_scenes(ctx, [(f"easy scene {i + 1}", scenes.render_scene(_seed(ctx), difficulty="easy")) for i in range(3)])
+
+
+@check(points=2, timeout=60)
+def hard(ctx: harness.Context) -> None:
+    """crop_pictures on hard views: steep, rotated, partly off-frame; only fully framed pictures."""
+    from course_lib import scenes
+
+    cases = []
+    for attempt in range(40):  # two scenes that show a whole picture, then one of any kind
+        scene = scenes.render_scene(_seed(ctx), difficulty="hard")
+        if scene.fully_framed or len(cases) >= 2:
+            cases.append((f"hard scene {len(cases) + 1}", scene))
+        if len(cases) == 3:
+            break
+    _run_scenes(ctx, cases)
+
+
+@check(points=2, timeout=60)
+def missing_and_none(ctx: harness.Context) -> None:
+    """A picture with a marker missing is left out; frames without markers give an empty dict."""
+    from course_lib import scenes
+
+    gone = int(ctx.rng.choice([i for ids in scenes.PICTURES.values() for i in ids]))
+    one_missing = scenes.render_scene(_seed(ctx), difficulty="easy", missing_markers=[gone])
+    no_markers = scenes.render_scene(_seed(ctx), difficulty="easy", missing_markers=list(range(1, 9)))
+    noise = ctx.rng.integers(0, 256, size=(480, 640, 3), dtype=np.uint8)
+    cases = [(f"marker {gone} missing", one_missing), ("no markers on the board", no_markers), ("noise", None)]
+    outcomes = ctx.call("crop_pictures", [((one_missing.frame,), {"size": list(SIZE)}),
+                                          ((no_markers.frame,), {"size": list(SIZE)}),
+                                          ((noise,), {"size": list(SIZE)})])
+    for (label, scene), outcome in zip(cases, outcomes):
+        if scene is None:
+            ok = outcome.ok and outcome.value == {}
+            ctx.item(ok, f"{label}: returns {{}}" if ok else f"{label}: expected {{}}, got " +
+                     (outcome.error if not outcome.ok else f"keys {sorted(outcome.value) if isinstance(outcome.value, dict) else outcome.value}"))
+        else:
+            _check_scene(ctx, label, scene, outcome)
+
+
+@check(points=1, timeout=60)
+def noisy(ctx: harness.Context) -> None:
+    """crop_pictures copes with sensor noise, blur and JPEG artefacts, and with another crop size."""
+    from course_lib import scenes
+
+    base = scenes.render_scene(_seed(ctx), difficulty="easy")
+    look = scenes.Look(noise=7.0, blur=1.0, jpeg_quality=60, gain=0.9)
+    scene = scenes.render_scene(_seed(ctx), difficulty="easy", pose=base.pose, look=look)
+    small = (200, 150)
+    outcomes = ctx.call("crop_pictures", [((scene.frame,), {"size": list(SIZE)}),
+                                          ((scene.frame,), {"size": list(small)})])
+    _check_scene(ctx, "noisy, blurred scene", scene, outcomes[0])
+    if outcomes[1].ok and isinstance(outcomes[1].value, dict) and "cat" in outcomes[1].value:
+        crop = outcomes[1].value["cat"]
+        ok = isinstance(crop, np.ndarray) and crop.shape == (small[1], small[0], 3)
+        ctx.item(ok, f"size={small}: the crop is {small[0]}x{small[1]}" if ok else
+                 f"size={small}: crop shape {getattr(crop, 'shape', None)}, expected {(small[1], small[0], 3)}; "
+                 "use the size argument, (width, height)")
+    else:
+        ctx.item(False, f"size={small}: no 'cat' crop ({outcomes[1].error or 'missing key'})")
+
+
+@check(points=3, timeout=90)
+def node(ctx: harness.Context) -> None:
+    """MarkerReader: node marker_reader turns frames on image into crops on cropped_img/cat and cropped_img/dog."""
+    from course_lib import images, scenes
+    from rclpy.qos import QoSProfile, ReliabilityPolicy
+    from sensor_msgs.msg import CompressedImage, Image
+
+    proc = ctx.start_node()
+    try:
+        with ctx.probe() as probe:
+            got: dict[str, list] = {"cat": [], "dog": []}
+            # Reliable publisher and best-effort subscriptions match every QoS the student may pick.
+            pub = probe.node.create_publisher(Image, "image", QoSProfile(depth=5, reliability=ReliabilityPolicy.RELIABLE))
+            for name in got:
+                probe.node.create_subscription(CompressedImage, f"cropped_img/{name}", got[name].append,
+                                               QoSProfile(depth=10, reliability=ReliabilityPolicy.BEST_EFFORT))
+            names = lambda: {n for n, _ in probe.node.get_node_names_and_namespaces()}  # noqa: E731
+            probe.spin_until(lambda: "marker_reader" in names() or not proc.running(), 25.0)
+            if not proc.running():
+                ctx.item(False, f"the node process ended ({proc.describe_exit()}):\n{harness.clip(proc.log_tail(6))}")
+                return
+            if not ctx.item("marker_reader" in names(), "node marker_reader runs" if "marker_reader" in names() else
+                            f"no node named marker_reader (nodes: {sorted(names())})"):
+                return
+            scene = scenes.render_scene(_seed(ctx), difficulty="easy")
+            expected = scene.expected_crops(SIZE)
+            msg = images.image_to_msg(scene.frame, "bgr8")
+            deadline = time.monotonic() + 8.0
+            while time.monotonic() < deadline and not (got["cat"] and got["dog"]):
+                pub.publish(msg)
+                probe.spin_until(lambda: bool(got["cat"] and got["dog"]), 0.5)
+            types = dict(probe.node.get_topic_names_and_types())
+    finally:
+        proc.stop(timeout=2)
+    for name in ("cat", "dog"):
+        topic = f"/cropped_img/{name}"
+        if not got[name]:
+            seen = types.get(topic)
+            ctx.item(False, f"nothing arrived on {topic} within 8 s" +
+                     (f" (it carries {seen}; the contract says sensor_msgs/msg/CompressedImage)" if seen and
+                      seen != ["sensor_msgs/msg/CompressedImage"] else "") +
+                     "; the node's output:\n" + harness.clip(proc.log_tail(4)))
+            continue
+        try:
+            crop = images.compressed_to_image(got[name][-1], want="bgr8")
+        except Exception as error:  # what the student sent is not a decodable image
+            ctx.item(False, f"{topic}: the message does not decode ({error}); use images.image_to_compressed(crop, 'png')")
+            continue
+        compare_crop(ctx, topic, crop, expected[name], show=True)

@@ -1,0 +1,626 @@
+"""What a graded check is, and how it runs: the same code for the self-check and the autograder.
+
+A check is a function in ``autograder/checks/<assignment>.py`` decorated with :func:`check`,
+which gives it its points and its time limit; its docstring's first line says what it checks::
+
+    @check(points=4, timeout=40)
+    def values(ctx):
+        \"\"\"average_brightness returns the floor of the mean byte for colour and grey images.\"\"\"
+        for outcome, expected in ...:
+            ctx.item(outcome.value == expected, "...")
+
+Where things run:
+
+- the notebook kernel only starts the check and prints its verdict (:func:`run_check`): the check
+  runs in a process of its own (``python -m autograder.harness run ...``) with a wall-time bound,
+  so nothing a check does can hang or crash the kernel, and nothing the kernel's state holds
+  (a node the student left spinning, a patched module) changes the check;
+- the student's code runs in a third process, started by the check (:meth:`Context.call` for
+  plain functions, :meth:`Context.start_node` for nodes), with its own resource limits and, for
+  ROS, a ROS_DOMAIN_ID reserved for the check. A student process that loops, crashes or exits
+  costs the points of that check and nothing else.
+
+Seeds: a self-check uses fixed seeds (the same frames every time, so a student can debug);
+:func:`grade` draws a fresh seed at grading time (or takes AUTOGRADER_SEED to reproduce a grade)
+and prints it, so that the feedback records it. Expected answers are computed from the seed in
+the check process; nothing the student's process can read holds them.
+
+Points: the check's items each pass or fail; the check earns ``points × passed weight / total
+weight``. The value of the test cell is that number, which nbgrader 0.9 takes as partial credit
+(an ``execute_result`` that converts to float; an error or anything on stderr gives 0).
+"""
+
+from __future__ import annotations
+
+import argparse
+import base64
+import dataclasses
+import importlib
+import json
+import os
+import secrets
+import shutil
+import sys
+import tempfile
+import time
+import traceback
+from pathlib import Path
+
+#: Seconds a student's module gets to import (rclpy alone needs one or two on a busy machine).
+IMPORT_TIMEOUT = 25.0
+
+#: Memory (address space, MB) of a student's process. rclpy with Fast DDS maps a few hundred MB.
+STUDENT_MEMORY_MB = 2048
+
+#: Largest file a student's process may write, MB.
+STUDENT_FILE_MB = 128
+
+#: Written into the work directory when the student's module did not import in time, so that
+#: later checks fail at once with the same reason instead of waiting again.
+IMPORT_HANG_MARK = ".autograder-import-hang"
+
+#: Fast DDS profile of check and student processes: a shared-memory transport with 32 MB segments (so a student process needs RLIMIT_FSIZE above that).
+#: With the default transports, best-effort 1920x1080 frames (6 MB, sensor-data QoS) between two
+#: local processes lose most of their UDP fragments: 2-8 of 60 frames arrive. With it, all do.
+FASTDDS_PROFILE = Path(__file__).resolve().parent / "fastdds_large_data.xml"
+
+#: The fixed seed of self-checks (what the student sees when running the notebook).
+SELFCHECK_SEED = 2024
+
+
+@dataclasses.dataclass(frozen=True)
+class Check:
+    """One graded check of an assignment.
+
+    Attributes:
+        assignment: the assignment's name (the checks module's name).
+        name: the check's name, unique in the assignment (what selfcheck()/grade() take).
+        points: the most it earns.
+        timeout: seconds the check may take, student processes included.
+        description: the docstring's first line: what the check checks.
+        function: the check itself, called with a Context.
+    """
+
+    assignment: str
+    name: str
+    points: float
+    timeout: float
+    description: str
+    function: object
+
+
+_REGISTRY: dict[str, dict[str, Check]] = {}
+
+
+def check(points: float, timeout: float):
+    """Register a check function of an ``autograder.checks`` module (see the module docstring)."""
+    def register(function):
+        assignment = function.__module__.rsplit(".", 1)[-1]
+        doc = (function.__doc__ or "").strip().splitlines()
+        if not doc:
+            raise ValueError(f"Check {function.__name__} has no docstring: its first line says what it checks")
+        spec = Check(assignment, function.__name__, float(points), float(timeout), doc[0], function)
+        _REGISTRY.setdefault(assignment, {})[spec.name] = spec
+        return function
+    return register
+
+
+def checks_of(assignment: str) -> dict[str, Check]:
+    """The checks of an assignment, in the order they are defined (imports the checks module)."""
+    importlib.import_module(f"autograder.checks.{assignment}")
+    return dict(_REGISTRY.get(assignment, {}))
+
+
+def get_check(assignment: str, name: str) -> Check:
+    checks = checks_of(assignment)
+    if name not in checks:
+        raise KeyError(f"{assignment} has no check {name!r}; its checks are {sorted(checks)}")
+    return checks[name]
+
+
+# ---------------------------------------------------------------------------------------------
+# Results
+# ---------------------------------------------------------------------------------------------
+
+@dataclasses.dataclass
+class Result:
+    """What a check found: its items, the points earned, and pictures to show."""
+
+    assignment: str
+    name: str
+    points: float
+    max_points: float
+    seed: int
+    items: list[dict] = dataclasses.field(default_factory=list)
+    notes: list[str] = dataclasses.field(default_factory=list)
+    images: list[dict] = dataclasses.field(default_factory=list)
+    error: str | None = None
+    seconds: float = 0.0
+
+    def verdict_lines(self) -> list[str]:
+        lines = [f"{self.name}: {_fmt(self.points)} of {_fmt(self.max_points)} points"]
+        for item in self.items:
+            lines.append(("  ✔ " if item["ok"] else "  ✘ ") + item["message"])
+        lines.extend("  · " + note for note in self.notes)
+        if self.error:
+            lines.append("  ! " + self.error)
+        return lines
+
+
+def _fmt(value: float) -> str:
+    return f"{value:g}"
+
+
+# ---------------------------------------------------------------------------------------------
+# In the kernel: start a check and show its verdict
+# ---------------------------------------------------------------------------------------------
+
+def selfcheck(assignment: str, name: str) -> float | None:
+    """Run a check with the fixed self-check seed, print what passed and failed, return its points.
+
+    Under grading (COURSE_LIB_GRADING=1) it does nothing and returns None: the hidden test that
+    follows it in the same cell runs the check with a fresh seed.
+    """
+    from course_lib import rosenv
+
+    if rosenv.under_grading():
+        return None
+    return run_check(assignment, name, SELFCHECK_SEED)
+
+
+def grade(assignment: str, name: str) -> float:
+    """Run a check with a fresh seed (AUTOGRADER_SEED to reproduce one), print the seed and the
+    verdict, return the points earned (the test cell's value is the partial credit)."""
+    seed = os.environ.get("AUTOGRADER_SEED")
+    seed = int(seed) if seed else secrets.randbelow(2**31)
+    return run_check(assignment, name, seed, graded=True)
+
+
+def run_check(assignment: str, name: str, seed: int, graded: bool = False, workdir=None) -> float:
+    """Run one check in a separate process, print its verdict, display its pictures, return points."""
+    result = execute(assignment, name, seed, workdir=workdir)
+    header = f"[{'graded' if graded else 'self-check'} · seed {seed}] {get_check(assignment, name).description}"
+    print(header)
+    print("\n".join(result.verdict_lines()))
+    if graded:
+        print(f"  (reproduce with AUTOGRADER_SEED={seed})")
+    _display_images(result)
+    return round(result.points, 3)
+
+
+def execute(assignment: str, name: str, seed: int, workdir=None) -> Result:
+    """Run a check in its own process and return its Result (0 points when it failed to finish)."""
+    from course_lib import processes
+
+    spec = get_check(assignment, name)
+    workdir = Path(workdir or os.getcwd()).resolve()
+    out = Path(tempfile.mkdtemp(prefix="autograder-check-"))
+    started = time.monotonic()
+    command = [sys.executable, "-m", "autograder.harness", "run", assignment, name,
+               "--seed", str(seed), "--workdir", str(workdir), "--out", str(out)]
+    limits = processes.Limits(wall_seconds=spec.timeout + 10, grace_seconds=2.0)
+    proc = processes.NodeProcess(command, name=f"autograder-check-{name}", cwd=workdir, limits=limits,
+                                 env={"PYTHONPATH": _pythonpath(), "FASTRTPS_DEFAULT_PROFILES_FILE": str(FASTDDS_PROFILE)})
+    try:
+        proc.start()
+        try:
+            proc.wait(spec.timeout + 20)
+        except TimeoutError:
+            pass
+        proc.stop(timeout=3)
+        try:
+            data = json.loads((out / "result.json").read_text())
+            result = Result(**data)
+        except (OSError, ValueError, TypeError):
+            result = Result(assignment, name, 0.0, spec.points, seed,
+                            error=f"The check did not finish ({proc.describe_exit()}); "
+                                  f"its last output:\n{proc.log_tail(8)}")
+        for image in result.images:
+            path = out / image.pop("file", "")
+            if path.is_file():
+                image["png"] = base64.b64encode(path.read_bytes()).decode()
+    finally:
+        proc.stop(timeout=3)
+        shutil.rmtree(out, ignore_errors=True)
+    result.points = max(0.0, min(result.points, spec.points))
+    result.seconds = round(time.monotonic() - started, 2)
+    return result
+
+
+def _pythonpath() -> str:
+    """The directory holding the autograder package, first on the path of child processes."""
+    root = str(Path(__file__).resolve().parent.parent)
+    rest = [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p and p != root]
+    return os.pathsep.join([root] + rest)
+
+
+def _display_images(result: Result) -> None:
+    if not result.images:
+        return
+    try:
+        from IPython import get_ipython
+        from IPython.display import HTML, display
+    except ImportError:
+        return
+    if get_ipython() is None:
+        return
+    cells = "".join(
+        f"<figure style='display:inline-block;margin:4px'><img src='data:image/png;base64,{image['png']}'/>"
+        f"<figcaption style='font-size:small'>{_escape(image['label'])}</figcaption></figure>"
+        for image in result.images if "png" in image)
+    display(HTML(f"<div class='autograder-images'>{cells}</div>"))
+
+
+def _escape(text: str) -> str:
+    return text.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
+
+
+# ---------------------------------------------------------------------------------------------
+# In the check process
+# ---------------------------------------------------------------------------------------------
+
+class StudentError(Exception):
+    """The student's code failed (raised, crashed, hung); str() says how, for the feedback."""
+
+
+@dataclasses.dataclass
+class Outcome:
+    """What one call of a student's function gave: a value, or the error that prevented one.
+
+    Attributes:
+        value: the returned value (numpy arrays, Python scalars of the returned type, dicts).
+        pytype: the name of the returned value's type ("int", "float", "ndarray", ...).
+        error: None, or how the call failed ("NotImplementedError: ...", "the process was killed ...").
+    """
+
+    value: object = None
+    pytype: str = "NoneType"
+    error: str | None = None
+
+    @property
+    def ok(self) -> bool:
+        return self.error is None
+
+
+class Context:
+    """What a check function gets: the seed, the student's work directory, and ways to run the
+    student's code and to record what passed.
+
+    Attributes:
+        seed: this run's seed; rng: a numpy Generator seeded with it.
+        workdir: the directory of the student's notebook and module files.
+        domain_id: a ROS domain reserved for this check (student nodes and probes use it).
+    """
+
+    def __init__(self, spec: Check, seed: int, workdir: Path, out: Path):
+        import numpy as np
+
+        self.spec = spec
+        self.seed = seed
+        self.rng = np.random.default_rng(seed)
+        self.workdir = workdir
+        self.out = out
+        self.items: list[dict] = []
+        self.notes: list[str] = []
+        self.images: list[dict] = []
+        self._reservation = None
+        self._started = time.monotonic()
+
+    # -- recording -----------------------------------------------------------------------------
+
+    def item(self, ok: bool, message: str, weight: float = 1.0) -> bool:
+        """Record one checked claim; `message` says what was found (and the fix when it failed)."""
+        self.items.append({"ok": bool(ok), "message": clip(message), "weight": float(weight)})
+        return bool(ok)
+
+    def note(self, text: str) -> None:
+        """Record an informative line (no points)."""
+        self.notes.append(clip(text))
+
+    def image(self, label: str, image) -> None:
+        """Attach a picture (BGR or grey uint8) to the verdict, shown in the notebook and the feedback."""
+        import cv2
+        import numpy as np
+
+        image = np.asarray(image)
+        if image.dtype != np.uint8 or image.ndim not in (2, 3) or image.size == 0:
+            return
+        if image.shape[1] > 320:
+            scale = 320 / image.shape[1]
+            image = cv2.resize(image, (320, max(1, round(image.shape[0] * scale))), interpolation=cv2.INTER_AREA)
+        name = f"image{len(self.images)}.png"
+        cv2.imwrite(str(self.out / name), image)
+        self.images.append({"label": label, "file": name})
+
+    def remaining(self) -> float:
+        """Seconds left of this check's timeout (never below 1)."""
+        return max(1.0, self.spec.timeout - (time.monotonic() - self._started))
+
+    # -- the student's code --------------------------------------------------------------------
+
+    @property
+    def module(self) -> str:
+        """The student's module name: ``<assignment>_node`` (written by the notebook's %%writefile cell)."""
+        return MODULES[self.spec.assignment]
+
+    def require_module(self) -> None:
+        """Raise StudentError with the fix when the student's module file does not exist."""
+        path = self.workdir / f"{self.module}.py"
+        if not path.is_file():
+            raise StudentError(f"{path.name} does not exist next to the notebook: run the cell that starts "
+                               f"with %%writefile {path.name} (it writes your module)")
+        if (self.workdir / IMPORT_HANG_MARK).exists():
+            raise StudentError(f"importing {self.module} did not finish within {IMPORT_TIMEOUT:g} s in an "
+                               "earlier check: remove code that runs forever at import (loops, spin()) "
+                               "from the top level of the module; put it in main()")
+
+    def call(self, function: str, calls: list[tuple], timeout: float | None = None) -> list[Outcome]:
+        """Call the student's `function` once per entry of `calls` in one student process.
+
+        Args:
+            function: the name of a function of the student's module.
+            calls: (args, kwargs) per call; args may hold numpy arrays, kwargs plain JSON values.
+            timeout: seconds for all calls together (after the import); default: what is left.
+
+        Returns:
+            One Outcome per call. Calls that did not run because the process died or ran out of
+            time get an Outcome whose error says so.
+        """
+        from course_lib import processes
+
+        self.require_module()
+        job = Path(tempfile.mkdtemp(prefix="autograder-call-"))
+        try:
+            _write_calls(job, calls)
+            timeout = min(timeout or self.remaining(), self.remaining())
+            limits = processes.Limits(wall_seconds=IMPORT_TIMEOUT + timeout, memory_mb=STUDENT_MEMORY_MB,
+                                      file_size_mb=STUDENT_FILE_MB, grace_seconds=1.0)
+            command = [sys.executable, "-m", "autograder.student", "call", self.module, function, str(job)]
+            proc = processes.NodeProcess(command, name=f"student-{function}", cwd=self.workdir, limits=limits,
+                                         domain_id=self.domain_id, env=_student_env())
+            proc.start()
+            try:
+                imported = _wait_for_file(job / "imported", IMPORT_TIMEOUT, proc)
+                if not imported and proc.running():
+                    (self.workdir / IMPORT_HANG_MARK).touch()
+                    raise StudentError(f"importing {self.module} did not finish within {IMPORT_TIMEOUT:g} s: "
+                                       "remove code that runs forever at import (loops, spin()) from the "
+                                       "top level of the module; put it in main()")
+                if imported:
+                    try:
+                        proc.wait(timeout)
+                    except TimeoutError:
+                        pass
+            finally:
+                proc.stop(timeout=1)
+            if not (job / "imported").exists():
+                raise StudentError(f"{self.module} could not be imported ({proc.describe_exit()}):\n"
+                                   f"{_tail(proc.log, 6)}")
+            return _read_outcomes(job, len(calls), proc, timeout)
+        finally:
+            shutil.rmtree(job, ignore_errors=True)
+
+    def start_node(self, *ros_args: str, entry: str = "main"):
+        """Start the student's node (``<module>:main``) in this check's ROS domain; stopped at the end.
+
+        Returns:
+            The running course_lib.processes.NodeProcess (see its log, running(), describe_exit()).
+        """
+        from course_lib import processes
+
+        self.require_module()
+        limits = processes.Limits(wall_seconds=self.remaining() + 5, memory_mb=STUDENT_MEMORY_MB,
+                                  file_size_mb=STUDENT_FILE_MB, grace_seconds=1.0)
+        return processes.python_node(f"{self.module}:{entry}", *ros_args, name=f"student-{self.module}-{entry}",
+                                     cwd=self.workdir, domain_id=self.domain_id, limits=limits, env=_student_env())
+
+    @property
+    def domain_id(self) -> int:
+        if self._reservation is None:
+            from course_lib import rosenv
+
+            if rosenv.under_grading() and os.environ.get("ROS_DOMAIN_ID"):
+                # The grader reserved this domain for the whole submission, in a network
+                # namespace (and /dev/shm) of its own: nothing else can be in it.
+                self._reservation = _Fixed(int(os.environ["ROS_DOMAIN_ID"]))
+            else:
+                self._reservation = rosenv.reserve_domain_id()
+        return self._reservation.domain_id
+
+    def probe(self):
+        """A ROS node of the checker in this check's domain (see RosProbe); close() it or use `with`."""
+        return RosProbe(self.domain_id)
+
+    def close(self) -> None:
+        from course_lib import processes
+
+        processes.stop_all(timeout=1.0)
+        if self._reservation is not None:
+            self._reservation.release()
+
+
+class _Fixed:
+    def __init__(self, domain_id: int):
+        self.domain_id = domain_id
+
+    def release(self) -> None:
+        pass
+
+
+#: The student's module of each assignment (the notebook writes it with %%writefile).
+MODULES = {"brightness": "brightness_node", "pubsub": "pubsub_nodes", "catdog_warp": "marker_reader"}
+
+
+def _student_env() -> dict:
+    return {"PYTHONPATH": _pythonpath(), "AUTOGRADER_SEED": None, "PYTHONDONTWRITEBYTECODE": "1",
+            "FASTRTPS_DEFAULT_PROFILES_FILE": str(FASTDDS_PROFILE)}
+
+
+def clip(text: str, limit: int = 1500) -> str:
+    """At most `limit` characters of a message: its start and its end (student output can be huge)."""
+    if len(text) <= limit:
+        return text
+    return text[:limit // 3] + f" [... {len(text) - limit} characters ...] " + text[-(2 * limit) // 3:]
+
+
+def _tail(text: str, lines: int) -> str:
+    text = text.strip()
+    return "\n".join(text.splitlines()[-lines:]) if text else "(no output)"
+
+
+def _wait_for_file(path: Path, timeout: float, proc) -> bool:
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if path.exists():
+            return True
+        if not proc.running():
+            return path.exists()
+        time.sleep(0.02)
+    return path.exists()
+
+
+def _write_calls(job: Path, calls: list[tuple]) -> None:
+    import numpy as np
+
+    arrays, manifest = {}, []
+    for index, (args, kwargs) in enumerate(calls):
+        entry = []
+        for position, arg in enumerate(args):
+            key = f"c{index}_a{position}"
+            arrays[key] = np.asarray(arg)
+            entry.append(key)
+        manifest.append({"args": entry, "kwargs": kwargs})
+    np.savez(job / "inputs.npz", **arrays)
+    (job / "calls.json").write_text(json.dumps(manifest))
+
+
+def _read_outcomes(job: Path, count: int, proc, timeout: float) -> list[Outcome]:
+    import numpy as np
+
+    outcomes = []
+    for index in range(count):
+        meta_path = job / f"{index}.json"
+        if not meta_path.exists():
+            if proc.exit_reason == "wall_seconds" or proc.returncode is None or proc.exit_reason == "stopped":
+                why = f"did not return within {timeout:.0f} s (an endless loop?)"
+            else:
+                why = f"ended the process ({proc.describe_exit()}) before returning"
+            log = _tail(proc.log, 4)
+            outcomes.append(Outcome(error=f"the call {why}. Last output:\n{log}"))
+            outcomes.extend(Outcome(error="not run: an earlier call did not return") for _ in range(count - index - 1))
+            break
+        try:
+            meta = json.loads(meta_path.read_text())
+            arrays = np.load(job / f"{index}.npz", allow_pickle=False) if (job / f"{index}.npz").exists() else {}
+            outcomes.append(Outcome(value=_decode(meta["value"], arrays), pytype=meta["value"].get("pytype", "?"),
+                                    error=meta.get("error")))
+        except (OSError, ValueError, KeyError, TypeError) as error:
+            outcomes.append(Outcome(error=f"its result could not be read back ({error})"))
+    return outcomes
+
+
+def _decode(encoded: dict, arrays):
+    kind = encoded["type"]
+    if kind == "array":
+        return arrays[encoded["key"]]
+    if kind == "scalar":
+        return encoded["value"]
+    if kind == "dict":
+        return {key: _decode(value, arrays) for key, value in encoded["items"].items()}
+    if kind == "none":
+        return None
+    return encoded.get("repr")
+
+
+class RosProbe:
+    """The checker's side of a ROS exchange: a node in its own context, spun in bounded steps."""
+
+    def __init__(self, domain_id: int):
+        import rclpy
+        from rclpy.context import Context as RclContext
+        from rclpy.executors import SingleThreadedExecutor
+
+        self.context = RclContext()
+        rclpy.init(context=self.context, domain_id=domain_id)
+        self.node = rclpy.create_node(f"autograder_probe_{os.getpid()}", context=self.context,
+                                      enable_rosout=False, start_parameter_services=False)
+        self.executor = SingleThreadedExecutor(context=self.context)
+        self.executor.add_node(self.node)
+
+    def spin_until(self, condition, timeout: float) -> bool:
+        """Process callbacks until condition() is true or `timeout` seconds pass; returns condition()."""
+        deadline = time.monotonic() + timeout
+        while not condition():
+            left = deadline - time.monotonic()
+            if left <= 0:
+                return bool(condition())
+            self.executor.spin_once(timeout_sec=min(0.05, left))
+        return True
+
+    def spin_for(self, seconds: float) -> None:
+        self.spin_until(lambda: False, seconds)
+
+    def wait_for_subscriber(self, publisher, timeout: float) -> bool:
+        return self.spin_until(lambda: publisher.get_subscription_count() > 0, timeout)
+
+    def wait_for_publisher(self, subscription, timeout: float) -> bool:
+        return self.spin_until(lambda: subscription.get_publisher_count() > 0, timeout)
+
+    def close(self) -> None:
+        try:
+            self.executor.shutdown(timeout_sec=1.0)
+            self.node.destroy_node()
+        finally:
+            self.context.try_shutdown()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+
+def run_in_this_process(assignment: str, name: str, seed: int, workdir: Path, out: Path) -> Result:
+    """Run a check here (the check process) and return its Result."""
+    spec = get_check(assignment, name)
+    ctx = Context(spec, seed, workdir, out)
+    error = None
+    try:
+        spec.function(ctx)
+    except StudentError as failure:
+        error = str(failure)
+    except Exception:  # a bug in the check, not the student's fault: say so plainly
+        error = "The checker itself failed (tell your instructor):\n" + traceback.format_exc(limit=4)
+    finally:
+        ctx.close()
+    total = sum(item["weight"] for item in ctx.items)
+    if error and not any(item["ok"] for item in ctx.items):
+        points = 0.0
+    else:
+        passed = sum(item["weight"] for item in ctx.items if item["ok"])
+        points = spec.points * passed / total if total else 0.0
+    return Result(assignment, name, round(points, 3), spec.points, seed, ctx.items, ctx.notes, ctx.images, error)
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m autograder.harness", description="Run one graded check.")
+    sub = parser.add_subparsers(dest="command", required=True)
+    run = sub.add_parser("run")
+    run.add_argument("assignment")
+    run.add_argument("check")
+    run.add_argument("--seed", type=int, default=SELFCHECK_SEED)
+    run.add_argument("--workdir", default=".")
+    run.add_argument("--out", required=True)
+    args = parser.parse_args(argv)
+    out = Path(args.out)
+    result = run_in_this_process(args.assignment, args.check, args.seed, Path(args.workdir).resolve(), out)
+    (out / "result.json.tmp").write_text(json.dumps(dataclasses.asdict(result)))
+    os.replace(out / "result.json.tmp", out / "result.json")
+    return 0
+
+
+if __name__ == "__main__":
+    # Run through the imported module, so that the checks register where they are looked up.
+    from autograder.harness import main as _main
+
+    sys.exit(_main())

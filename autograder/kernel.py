@@ -1,0 +1,62 @@
+"""The kernel of a notebook under grading: ``python -m autograder.kernel CONNECTION_FILE``.
+
+The grader installs a kernelspec whose argv runs this module instead of ipykernel directly.
+When the grader runs as root it sets AUTOGRADER_KERNEL_UID, and this launcher (still root):
+
+- copies the connection file (jupyter_client writes it 0600 for root) to a private directory,
+- gives the kernel's working directory (the notebook's autograded copy) to that uid,
+- sets RLIMIT_NPROC (the kernel enforces it for non-root users only: a fork bomb stops there),
+- drops to the uid with no supplementary groups, and execs ipykernel.
+
+So the student's code never runs as root: it cannot read the gradebook (0600, root) or other
+students' files, and its process count is bounded per worker (each worker has its own uid).
+Without AUTOGRADER_KERNEL_UID (not root), it execs ipykernel unchanged.
+"""
+
+from __future__ import annotations
+
+import os
+import resource
+import shutil
+import sys
+import tempfile
+
+
+def _give(path: str, uid: int) -> None:
+    os.chown(path, uid, uid)
+    for directory, dirs, files in os.walk(path):
+        for name in dirs + files:
+            os.lchown(os.path.join(directory, name), uid, uid)
+
+
+def main(argv=None) -> int:
+    argv = sys.argv[1:] if argv is None else argv
+    connection = argv[0]
+    uid = os.environ.get("AUTOGRADER_KERNEL_UID")
+    if uid and os.geteuid() == 0:
+        uid = int(uid)
+        private = tempfile.mkdtemp(prefix="autograder-kernel-", dir=os.environ.get("AUTOGRADER_KERNEL_TMP"))
+        copy = os.path.join(private, "connection.json")
+        shutil.copyfile(connection, copy)
+        for name in ("home", "tmp"):
+            os.mkdir(os.path.join(private, name))
+        _give(private, uid)
+        os.chmod(private, 0o700)
+        _give(os.getcwd(), uid)
+        os.chmod(os.getcwd(), 0o700)
+        nproc = int(os.environ.get("AUTOGRADER_KERNEL_NPROC", "512"))
+        resource.setrlimit(resource.RLIMIT_NPROC, (nproc, nproc))
+        os.environ.update(HOME=os.path.join(private, "home"), TMPDIR=os.path.join(private, "tmp"),
+                          IPYTHONDIR=os.path.join(private, "home", ".ipython"),
+                          MPLCONFIGDIR=os.path.join(private, "home", ".matplotlib"))
+        os.environ.pop("ROS_LOG_DIR", None)
+        os.setgroups([])
+        os.setgid(uid)
+        os.setuid(uid)
+        connection = copy
+    os.execv(sys.executable, [sys.executable, "-m", "ipykernel_launcher", "-f", connection])
+    return 1  # not reached
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,82 @@
+"""Runs a student's function in a process of its own: ``python -m autograder.student call MODULE FUNCTION JOB``.
+
+The check that starts it (harness.Context.call) wrote JOB/calls.json and JOB/inputs.npz. This
+process imports the student's module from its working directory, touches JOB/imported, then for
+call i writes JOB/i.json (how the value was encoded, or the error) and JOB/i.npz (its arrays)
+as soon as the call returns, so results of earlier calls survive a later hang or crash.
+Nothing is pickled: the checker reads plain JSON and arrays only.
+"""
+
+from __future__ import annotations
+
+import importlib
+import json
+import os
+import sys
+import traceback
+from pathlib import Path
+
+
+def _encode(value, arrays: dict, prefix: str) -> dict:
+    import numpy as np
+
+    pytype = type(value).__name__
+    if value is None:
+        return {"type": "none", "pytype": pytype}
+    if isinstance(value, (bool, int, float, np.integer, np.floating, np.bool_)):
+        plain = value.item() if isinstance(value, np.generic) else value
+        return {"type": "scalar", "pytype": pytype, "value": plain}
+    if isinstance(value, np.ndarray):
+        key = f"{prefix}"
+        arrays[key] = value
+        return {"type": "array", "pytype": pytype, "key": key}
+    if isinstance(value, dict):
+        items = {str(key): _encode(item, arrays, f"{prefix}_{index}") for index, (key, item) in enumerate(value.items())}
+        return {"type": "dict", "pytype": pytype, "items": items}
+    return {"type": "other", "pytype": pytype, "repr": repr(value)[:200]}
+
+
+def _plain(value):
+    return tuple(value) if isinstance(value, list) else value
+
+
+def call(module: str, function: str, job: Path) -> int:
+    import numpy as np
+
+    sys.path.insert(0, os.getcwd())
+    mod = importlib.import_module(module)
+    (job / "imported").touch()
+    target = getattr(mod, function, None)
+    calls = json.loads((job / "calls.json").read_text())
+    inputs = np.load(job / "inputs.npz", allow_pickle=False)
+    for index, spec in enumerate(calls):
+        args = [inputs[key] for key in spec["args"]]
+        kwargs = {key: _plain(value) for key, value in spec["kwargs"].items()}
+        arrays: dict = {}
+        if target is None:
+            meta = {"value": {"type": "none"}, "error": f"{module}.py has no function {function}()"}
+        else:
+            try:
+                value = target(*args, **kwargs)
+                meta = {"value": _encode(value, arrays, f"r{index}")}
+            except BaseException as error:  # SystemExit and KeyboardInterrupt are the student's too
+                lines = traceback.format_exception(type(error), error, error.__traceback__)
+                meta = {"value": {"type": "none"}, "error": f"{type(error).__name__}: {error}".strip(),
+                        "traceback": "".join(lines[-3:])}
+        if arrays:
+            np.savez(job / f"{index}.npz", **arrays)
+        (job / f"{index}.json.tmp").write_text(json.dumps(meta))
+        os.replace(job / f"{index}.json.tmp", job / f"{index}.json")
+    return 0
+
+
+def main(argv=None) -> int:
+    argv = sys.argv[1:] if argv is None else argv
+    if len(argv) != 4 or argv[0] != "call":
+        print("usage: python -m autograder.student call MODULE FUNCTION JOB_DIR", file=sys.stderr)
+        return 2
+    return call(argv[1], argv[2], Path(argv[3]))
+
+
+if __name__ == "__main__":
+    sys.exit(main())

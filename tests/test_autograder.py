@@ -1,0 +1,202 @@
+"""The autograder: checks declared right, stubs that fail with a hint, typical mistakes named,
+and release -> reference solutions -> grade -> full marks for every assignment, then feedback."""
+
+from __future__ import annotations
+
+import shutil
+import sys
+from pathlib import Path
+
+import nbformat
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import zoo  # noqa: E402
+from autograder import config, grading, harness  # noqa: E402
+
+ASSIGNMENTS = ["brightness", "pubsub", "catdog_warp"]
+REPO = Path(__file__).resolve().parent.parent
+
+
+@pytest.mark.parametrize("assignment", ASSIGNMENTS)
+def test_every_check_has_points_timeout_and_description(assignment):
+    """Each check declares positive points, a timeout and a one-line description."""
+    checks = harness.checks_of(assignment)
+    assert checks
+    for spec in checks.values():
+        assert spec.points > 0 and spec.timeout > 0 and spec.description and "\n" not in spec.description
+
+
+@pytest.mark.parametrize("assignment", ASSIGNMENTS)
+def test_test_cells_match_the_checks(assignment):
+    """Each source notebook has one graded cell per check, with the check's points, a visible
+    self-check and a hidden graded run; and it is committed without outputs."""
+    nb = nbformat.read(REPO / "assignments" / "source" / assignment / f"{assignment}.ipynb", as_version=4)
+    graded = {c.metadata["nbgrader"]["grade_id"]: c for c in nb.cells
+              if c.metadata.get("nbgrader", {}).get("grade") and not c.metadata["nbgrader"].get("solution")}
+    checks = harness.checks_of(assignment)
+    assert set(graded) == {f"check_{name}" for name in checks}
+    for name, spec in checks.items():
+        cell = graded[f"check_{name}"]
+        assert cell.metadata["nbgrader"]["points"] == spec.points
+        assert f"checks.selfcheck({name!r})" in cell.source
+        assert "### BEGIN HIDDEN TESTS" in cell.source and f"checks.grade({name!r})" in cell.source
+    assert all(not c.get("outputs") for c in nb.cells if c.cell_type == "code")
+
+
+def test_build_script_reproduces_the_committed_notebooks(tmp_path, monkeypatch):
+    """assignments/build.py writes exactly the committed source notebooks (no drift)."""
+    sys.path.insert(0, str(REPO / "assignments"))
+    import build
+
+    monkeypatch.setattr(build, "SOURCE", tmp_path)
+    for path in build.build():
+        committed = REPO / "assignments" / "source" / path.relative_to(tmp_path)
+        assert path.read_text() == committed.read_text(), path.name
+
+
+def test_cell_timeouts_give_graded_cells_longer():
+    """Graded cells get the long timeout, every other cell the short one."""
+    graded = nbformat.v4.new_code_cell("x", metadata={"nbgrader": {"grade": True, "solution": False}})
+    assert config.cell_timeout(graded) == config.TEST_CELL_TIMEOUT
+    assert config.cell_timeout(nbformat.v4.new_code_cell("x")) == config.CELL_TIMEOUT
+
+
+def test_sandbox_hides_directories_and_keeps_the_command():
+    """As root the command runs under unshare with a network and mount namespace."""
+    command = grading.sandbox_command(["python", "-V"], [Path("/somewhere/course")])
+    assert command[-3:] == ["--", "python", "-V"]
+    if grading.isolation() == "root":
+        assert command[:3] == ["unshare", "--net", "--mount"] and "/somewhere/course" in command
+
+
+def _module_dir(tmp_path: Path, assignment: str, edits=()) -> Path:
+    nb = nbformat.read(REPO / "assignments" / "source" / assignment / f"{assignment}.ipynb", as_version=4)
+    source = zoo.solution_source(zoo.module_cell(nb).source)
+    first, body = source.split("\n", 1)
+    for old, new in edits:
+        assert old in body
+        body = body.replace(old, new, 1)
+    (tmp_path / first.split()[1]).write_text(body)
+    return tmp_path
+
+
+def test_stub_fails_with_a_hint_not_a_crash(tmp_path):
+    """The released stub imports; its self-check scores 0 and says to replace NotImplementedError."""
+    nb = nbformat.read(REPO / "assignments" / "source" / "brightness" / "brightness.ipynb", as_version=4)
+    lines, skipping = [], False
+    for line in zoo.module_cell(nb).source.split("\n")[1:]:  # what nbgrader's ClearSolutions does
+        if "### BEGIN SOLUTION" in line:
+            indent = line[:len(line) - len(line.lstrip())]
+            lines += [indent + stub for stub in config.CODE_STUB.split("\n")]
+            skipping = True
+        elif "### END SOLUTION" in line:
+            skipping = False
+        elif not skipping:
+            lines.append(line)
+    (tmp_path / "brightness_node.py").write_text("\n".join(lines))
+    result = harness.execute("brightness", "values", 1, workdir=tmp_path)
+    assert result.points == 0
+    assert "replace `raise NotImplementedError()`" in "\n".join(result.verdict_lines())
+
+
+def _brightness_mistakes():
+    from zoo import brightness as brightness_zoo
+
+    return {k: v for k, v in brightness_zoo.entries("").items() if v.get("level") == "check"}
+
+
+@pytest.mark.parametrize("student", sorted(_brightness_mistakes()))
+def test_brightness_typical_mistake_gets_its_score_and_reason(tmp_path, student):
+    """Typical brightness mistakes, run through the checks directly: expected points and reason."""
+    entry = _brightness_mistakes()[student]
+    workdir = _module_dir(tmp_path, "brightness", entry["edits"])
+    texts = []
+    for check in ("values", "node"):
+        if entry[check] is None:
+            continue  # the entry is about the other check
+        result = harness.execute("brightness", check, 11, workdir=workdir)
+        texts.extend(result.verdict_lines())
+        expected = entry[check]
+        if isinstance(expected, tuple):
+            assert expected[0] - 1e-6 <= result.points <= expected[1] + 1e-6, result.verdict_lines()
+        else:
+            assert result.points == pytest.approx(expected), result.verdict_lines()
+    assert entry["reason"] in "\n".join(texts)
+
+
+CATDOG_MISTAKES = {
+    "bgr_swapped": ([("            crops[name] = cv2.warpPerspective(frame_bgr, H, (width, height))",
+                      "            crops[name] = cv2.cvtColor(cv2.warpPerspective(frame_bgr, H, (width, height)), "
+                      "cv2.COLOR_BGR2RGB)")], "red and blue are swapped"),
+    "mirrored": ([("target = np.float32([[0, 0], [width - 1, 0], [width - 1, height - 1], [0, height - 1]])",
+                   "target = np.float32([[width - 1, 0], [0, 0], [0, height - 1], [width - 1, height - 1]])")],
+                 "mirrored left-right"),
+    "corner_order": ([("CORNER_OF_MARKER = (2, 3, 0, 1)", "CORNER_OF_MARKER = (0, 1, 2, 3)")], "similarity"),
+    "size_swapped": ([("(width, height))\n", "(height, width))\n")], "size is (width, height)"),
+}
+
+
+@pytest.mark.parametrize("mistake", sorted(CATDOG_MISTAKES))
+def test_catdog_typical_mistake_loses_points_with_its_reason(tmp_path, mistake):
+    """Typical warp mistakes score below full on easy scenes, and the verdict names the mistake."""
+    edits, reason = CATDOG_MISTAKES[mistake]
+    result = harness.execute("catdog_warp", "easy", 3, workdir=_module_dir(tmp_path, "catdog_warp", edits))
+    assert result.points < result.max_points
+    assert reason in "\n".join(result.verdict_lines())
+
+
+def test_catdog_reference_passes_easy_scenes(tmp_path):
+    """The reference crop_pictures gets every point on easy scenes (the checks can be passed)."""
+    result = harness.execute("catdog_warp", "easy", 3, workdir=_module_dir(tmp_path, "catdog_warp"))
+    assert result.points == result.max_points, result.verdict_lines()
+
+
+# ---------------------------------------------------------------------------------------------
+# End to end, with the real nbgrader CLI and gradebook
+
+
+@pytest.fixture(scope="module")
+def course(tmp_path_factory):
+    course = tmp_path_factory.mktemp("course")
+    grading.release(course, ASSIGNMENTS)
+    for assignment in ASSIGNMENTS:
+        zoo.submit(course, "reference", assignment)
+    results = grading.grade(course, workers=2, progress=False)
+    return course, {r.assignment: r for r in results}
+
+
+@pytest.mark.slow
+@pytest.mark.timeout(900)
+def test_release_has_stubs_and_no_solutions_or_hidden_tests(course):
+    """release/ holds the notebooks with stubs: no solution code, no hidden tests."""
+    root, _ = course
+    for assignment in ASSIGNMENTS:
+        text = (root / "release" / assignment / f"{assignment}.ipynb").read_text()
+        assert "BEGIN SOLUTION" not in text and "HIDDEN TESTS" not in text and "checks.grade(" not in text
+        assert "NotImplementedError" in text
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("assignment", ASSIGNMENTS)
+def test_reference_solutions_get_full_marks(course, assignment):
+    """release -> reference solution in the student notebook -> grade: every point."""
+    _, results = course
+    result = results[assignment]
+    assert result.status == "graded", result.reason
+    assert result.score == result.max_score > 0, result.cells
+
+
+@pytest.mark.slow
+def test_feedback_shows_crops_beside_expected(course):
+    """Feedback: an index per student, and the warp notebook's page shows both crops."""
+    from autograder import feedback
+
+    root, _ = course
+    pages = feedback.write_feedback(root)
+    assert root / "feedback" / "reference" / "index.html" in pages
+    page = (root / "feedback" / "reference" / "catdog_warp" / "catdog_warp.html").read_text()
+    assert "yours" in page and "expected" in page and "data:image/png;base64" in page
+    assert "reproduce with AUTOGRADER_SEED=" in page
+    assert not (root / "feedback" / "reference" / "brightness" / "autograder.log").exists()

@@ -1,0 +1,150 @@
+"""Does the autograder grade a zoo of submissions right, in parallel, and survive them all?
+
+One module-scoped grading run (2 workers) is shared by the tests: release the brightness
+assignment into a fresh course directory, hand in the zoo (tests/zoo/brightness.py: the
+reference solution, typical mistakes and hostile submissions), grade, and check each grade,
+its reason, the submitted files, leftover processes, and a second (cached) run.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import sys
+import time
+from pathlib import Path
+
+import nbformat
+import psutil
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import zoo  # noqa: E402
+from zoo import brightness as brightness_zoo  # noqa: E402
+
+# The shared grading run (about 15 submissions, 2 workers) happens in the first test's set-up.
+pytestmark = [pytest.mark.slow, pytest.mark.timeout(1500)]
+
+
+def _hashes(folder: Path) -> dict[str, str]:
+    return {str(p.relative_to(folder)): hashlib.sha256(p.read_bytes()).hexdigest()
+            for p in sorted(folder.rglob("*")) if p.is_file()}
+
+
+@pytest.fixture(scope="module")
+def graded(tmp_path_factory):
+    from autograder import grading
+
+    course = tmp_path_factory.mktemp("zoo_course")
+    grading.release(course, ["brightness"])
+    entries = {k: v for k, v in brightness_zoo.entries(str(course)).items() if v.get("level") != "check"}
+    for student, entry in entries.items():
+        zoo.submit(course, student, "brightness", entry["edits"])
+    before = _hashes(course / "submitted")
+    started = time.monotonic()
+    results = grading.grade(course, workers=2, progress=False)
+    seconds = time.monotonic() - started
+    yield {"course": course, "entries": entries, "results": {r.student: r for r in results},
+           "before": before, "seconds": seconds}
+
+
+def _outputs(course: Path, student: str) -> str:
+    nb = nbformat.read(course / "autograded" / student / "brightness" / "brightness.ipynb", as_version=4)
+    texts = []
+    for cell in nb.cells:
+        for output in cell.get("outputs", []):
+            texts.append(output.get("text", "") or str(output.get("data", {}).get("text/plain", "")))
+            texts.extend(output.get("traceback", []))
+    return "\n".join(texts)
+
+
+def _check_scores(result) -> dict[str, float]:
+    return {cell["cell"].removeprefix("check_"): cell["auto_score"] for cell in result.cells}
+
+
+def _matches(expected, actual) -> bool:
+    if expected is None:
+        return True
+    if isinstance(expected, tuple):
+        return expected[0] - 1e-6 <= actual <= expected[1] + 1e-6
+    return abs(actual - expected) < 1e-6
+
+
+@pytest.mark.parametrize("student", [k for k, v in brightness_zoo.entries("").items() if v.get("level") != "check"])
+def test_zoo_entry_gets_its_expected_score_and_reason(graded, student):
+    """Each zoo submission gets its expected points per check, and its notebook says why."""
+    result = graded["results"][student]
+    entry = graded["entries"][student]
+    if entry.get("failed"):
+        assert result.status == "failed" and result.score == 0
+        assert entry["reason"] in result.reason.lower()
+        return
+    assert result.status == "graded", result.reason
+    scores = _check_scores(result)
+    for check in ("values", "node"):
+        assert _matches(entry[check], scores[check]), (check, scores, _outputs(graded["course"], student)[-3000:])
+    assert entry["reason"] in _outputs(graded["course"], student)
+
+
+def test_reference_solution_gets_full_marks(graded):
+    """The reference solution, graded next to hostile submissions, gets every point."""
+    result = graded["results"]["full"]
+    assert (result.score, result.max_score) == (11, 11)
+
+
+def test_hostile_submission_is_contained(graded):
+    """No network, no course directory, no gradebook, and its leftovers do not survive grading."""
+    text = _outputs(graded["course"], "hostile")
+    assert "NETWORK: blocked" in text
+    assert "COURSE: hidden" in text
+    assert "GRADEBOOK: denied" in text or "GRADEBOOK: not found" in text
+    assert "BACKGROUND: started" in text
+    leftovers = [p.info for p in psutil.process_iter(["pid", "cmdline", "uids"])
+                 if p.info["cmdline"] and ("sleep" in p.info["cmdline"][0] and "1234" in p.info["cmdline"])]
+    assert leftovers == []
+
+
+def test_no_process_of_a_grading_uid_survives(graded):
+    """Every process that ran as a worker's uid (61000+) is gone once grading returns."""
+    from autograder import grading
+
+    alive = [p.info for p in psutil.process_iter(["pid", "cmdline", "uids"])
+             if p.info["uids"] and p.info["uids"].real >= grading.KERNEL_UID_BASE]
+    assert alive == []
+
+
+def test_submitted_files_are_byte_identical(graded):
+    """Grading reads the submissions and never writes them."""
+    assert _hashes(graded["course"] / "submitted") == graded["before"]
+
+
+def test_grades_csv_lists_every_submission(graded):
+    """grades.csv has one row per submission with student_id, assignment, score and max_score."""
+    import csv
+
+    with open(graded["course"] / "grades.csv") as handle:
+        rows = list(csv.DictReader(handle))
+    assert {r["student_id"] for r in rows} == set(graded["entries"])
+    assert all(r["assignment"] == "brightness" and r["max_score"] == "11" for r in rows)
+    assert {r["student_id"]: float(r["score"]) for r in rows} == {s: r.score for s, r in graded["results"].items()}
+
+
+def test_second_run_reuses_unchanged_grades(graded):
+    """A second grade run grades nothing again and reports the same scores."""
+    from autograder import grading
+
+    started = time.monotonic()
+    again = grading.grade(graded["course"], workers=2, progress=False)
+    assert all(r.from_cache for r in again)
+    assert {r.student: r.status for r in again} == {s: r.status for s, r in graded["results"].items()}
+    assert {r.student: r.score for r in again} == {s: r.score for s, r in graded["results"].items()}
+
+
+def test_gradebook_holds_the_scores(graded):
+    """The course's SQLite gradebook (nbgrader's API) has each submission's score."""
+    from nbgrader.api import Gradebook
+
+    with Gradebook(f"sqlite:///{graded['course'] / 'gradebook.db'}") as gb:
+        for student, result in graded["results"].items():
+            assert gb.find_submission("brightness", student).score == pytest.approx(result.score)

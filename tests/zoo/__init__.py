@@ -1,0 +1,59 @@
+"""The zoo: submissions made from the reference solution by replacing pieces of it.
+
+``submit(course, student, assignment, edits)`` takes the released notebook, puts the reference
+solution (from the source notebook, solution markers removed) into its solution cells, applies
+``edits`` (old text -> new text in the student's module cell, or whole-notebook functions) and
+writes it to COURSE_DIR/submitted/<student>/<assignment>/<assignment>.ipynb, as nbgrader's
+collect step would.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import nbformat
+
+
+def solution_source(text: str) -> str:
+    """A solution cell as a student who solved it would hand it in: the markers removed."""
+    return "\n".join(line for line in text.split("\n")
+                     if "### BEGIN SOLUTION" not in line and "### END SOLUTION" not in line)
+
+
+def filled_notebook(course: Path, assignment: str) -> nbformat.NotebookNode:
+    """The released notebook with the reference solution in its solution cells."""
+    release = nbformat.read(course / "release" / assignment / f"{assignment}.ipynb", as_version=4)
+    source = nbformat.read(course / "source" / assignment / f"{assignment}.ipynb", as_version=4)
+    solutions = {c.metadata["nbgrader"]["grade_id"]: c.source for c in source.cells
+                 if c.metadata.get("nbgrader", {}).get("solution")}
+    for cell in release.cells:
+        meta = cell.metadata.get("nbgrader", {})
+        if meta.get("solution"):
+            cell.source = solution_source(solutions[meta["grade_id"]])
+    return release
+
+
+def module_cell(nb: nbformat.NotebookNode) -> nbformat.NotebookNode:
+    """The solution cell that writes the student's module (%%writefile)."""
+    for cell in nb.cells:
+        if cell.cell_type == "code" and cell.source.startswith("%%writefile"):
+            return cell
+    raise LookupError("no %%writefile cell in the notebook")
+
+
+def submit(course: Path, student: str, assignment: str, edits=()) -> Path:
+    """Write a zoo submission; each edit is (old, new) applied to the module cell, or a function nb -> None."""
+    nb = filled_notebook(course, assignment)
+    for edit in edits:
+        if callable(edit):
+            edit(nb)
+            continue
+        old, new = edit
+        cell = module_cell(nb)
+        if old not in cell.source:
+            raise ValueError(f"zoo edit for {student}: {old!r} is not in the reference module")
+        cell.source = cell.source.replace(old, new, 1)
+    target = Path(course) / "submitted" / student / assignment / f"{assignment}.ipynb"
+    target.parent.mkdir(parents=True, exist_ok=True)
+    nbformat.write(nb, target)
+    return target
