@@ -10,6 +10,10 @@ UV     := $(VENV)/bin/uv
 UV_VERSION := 0.13.8
 LAB_PORT ?= 8888
 PYTEST_ARGS ?=
+# Most tests wait on discovery, timers and child processes, so more workers than cores pay off;
+# each worker reserves a ROS domain of its own (conftest.py). --dist loadfile keeps a file's
+# shared fixtures (a colcon build, a JupyterLab server, a grading run) on one worker.
+TEST_WORKERS ?= 4
 # Where ROS 2 comes from: pip (the ros-jazzy-* wheels, default), system (/opt/ros/jazzy, sourced
 # first) or conda (an activated RoboStack environment). With system/conda the virtual environment
 # sees the installed rclpy and only the non-ROS packages of environment.txt are installed.
@@ -58,7 +62,7 @@ browser-deps:
 	else echo "chromium is not installed and this user cannot apt-get it: browser tests will be skipped"; fi
 
 test: setup browser-deps
-	$(PY) -m pytest $(PYTEST_ARGS)
+	$(PY) -m pytest -n $(TEST_WORKERS) --dist loadfile $(PYTEST_ARGS)
 
 clean:
 	rm -rf $(VENV) .pytest_cache artifacts
