@@ -31,6 +31,8 @@ import time
 import timeit
 from pathlib import Path
 
+from bench_images import format_time  # the sibling script; benchmarks/ is on sys.path when run
+
 ROOT = Path(__file__).resolve().parents[1]
 READMARKER = ROOT / "assignments" / "reference_ws" / "src" / "readmarker"
 RESULT = "RESULT "
@@ -279,12 +281,6 @@ def main(argv=None) -> int:
     for part, size, what, value, ratio in table:
         print(f"| {part} | {size} | {what} | {value} | {ratio} |")
     return 0
-
-
-def format_time(seconds: float) -> str:
-    if seconds >= 1e-3:
-        return f"{seconds * 1e3:.2f} ms"
-    return f"{seconds * 1e6:.1f} µs"
 
 
 if __name__ == "__main__":
