@@ -244,6 +244,7 @@ class GradeResult:
     seconds: float = 0.0
     isolation: str = ""
     from_cache: bool = False     # True: an earlier run's result (the submission did not change)
+    kernel_uid: int | None = None  # the uid the student's code ran as (root isolation only)
 
 
 def _cell_scores(gradebook: Path, sub: Submission) -> list[dict]:
@@ -290,7 +291,8 @@ def grade_submission(sub: Submission, course: Path, domain_id: int) -> GradeResu
                "JUPYTER_CONFIG_DIR": str(work / "jupyter-config"), "AUTOGRADER_KERNEL_TMP": str(work / "kernel-tmp"),
                "PYTHONPATH": _env_for_tools()["PYTHONPATH"], "HOME": str(work), "PYDEVD_DISABLE_FILE_VALIDATION": "1"}
         if result.isolation == "root":
-            env.update(AUTOGRADER_KERNEL_UID=str(KERNEL_UID_BASE + domain_id), AUTOGRADER_KERNEL_NPROC=str(NPROC))
+            result.kernel_uid = KERNEL_UID_BASE + domain_id
+            env.update(AUTOGRADER_KERNEL_UID=str(result.kernel_uid), AUTOGRADER_KERNEL_NPROC=str(NPROC))
             exposure = interpreter_exposure()
             if exposure:
                 (work / "stage").mkdir()
