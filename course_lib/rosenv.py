@@ -83,7 +83,7 @@ def detect_install() -> RosInstall:
         # Some other prefix (a source build, a colcon overlay): treat it like a sourced install.
         kind = "system"
     distro = os.environ.get("ROS_DISTRO") or (DISTRO if kind == "pip" else None)
-    return RosInstall(kind, rclpy_path, tuple(_unique(p for p in prefixes if _has_ament_index(p))), distro)
+    return RosInstall(kind, rclpy_path, tuple(unique(p for p in prefixes if _has_ament_index(p))), distro)
 
 
 def _pip_wheels_installed() -> bool:
@@ -94,12 +94,9 @@ def _pip_wheels_installed() -> bool:
     return True
 
 
-def _unique(items):
-    seen = []
-    for item in items:
-        if item not in seen:
-            seen.append(item)
-    return seen
+def unique(items) -> list:
+    """The items in their first order, each once (for PATH-like lists)."""
+    return list(dict.fromkeys(items))
 
 
 def ros_environment(domain_id: int | None = None, base: dict[str, str] | None = None,
@@ -124,7 +121,7 @@ def ros_environment(domain_id: int | None = None, base: dict[str, str] | None = 
     env.setdefault("ROS_DOMAIN_ID", "0")
     env["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
     env.pop("ROS_LOCALHOST_ONLY", None)  # deprecated in Jazzy; warns when set
-    prefixes = _unique([str(p) for p in install.prefixes]
+    prefixes = unique([str(p) for p in install.prefixes]
                        + [p for p in env.get("AMENT_PREFIX_PATH", "").split(os.pathsep) if p])
     if prefixes:
         env["AMENT_PREFIX_PATH"] = os.pathsep.join(prefixes)

@@ -562,12 +562,8 @@ def workspace_environment(ws_dir, base: dict[str, str] | None = None,
     for name in _PATH_VARIABLES:
         if name in env:
             # setup.bash leaves a trailing ':' (meaning "the current folder") in some variables.
-            env[name] = os.pathsep.join(_unique(p for p in env[name].split(os.pathsep) if p))
+            env[name] = os.pathsep.join(rosenv.unique(p for p in env[name].split(os.pathsep) if p))
     return env
-
-
-def _unique(items):
-    return list(dict.fromkeys(items))
 
 
 def use_workspace(ws_dir) -> list[str]:
