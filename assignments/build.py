@@ -313,14 +313,12 @@ from rclpy.node import Node
 from rclpy.qos import qos_profile_sensor_data
 from sensor_msgs.msg import CompressedImage, Image
 
-from course_lib import images
+from course_lib import images, scenes
 
-# The board convention (course_lib.scenes): the markers framing each picture, in the order
-# top-left, top-right, bottom-right, bottom-left, and which corner of each marker touches it.
-PICTURES = {"cat": (1, 2, 3, 4), "dog": (5, 6, 7, 8)}
-CORNER_OF_MARKER = (2, 3, 0, 1)
-DETECTOR = cv2.aruco.ArucoDetector(cv2.aruco.getPredefinedDictionary(cv2.aruco.DICT_4X4_50),
-                                   cv2.aruco.DetectorParameters())
+# The board convention lives in course_lib.scenes: scenes.PICTURES (the markers framing each
+# picture, top-left, top-right, bottom-right, bottom-left), scenes.CORNER_OF_MARKER (which corner
+# of each marker touches the picture) and scenes.detector() (DICT_4X4_50).
+DETECTOR = scenes.detector()
 
 
 def crop_pictures(frame_bgr: np.ndarray, size=(320, 240)) -> dict:
@@ -329,11 +327,11 @@ def crop_pictures(frame_bgr: np.ndarray, size=(320, 240)) -> dict:
     corners, ids, _rejected = DETECTOR.detectMarkers(frame_bgr)
     found = {} if ids is None else {int(i): c.reshape(4, 2) for i, c in zip(ids.ravel(), corners)}
     width, height = size
-    target = np.float32([[0, 0], [width - 1, 0], [width - 1, height - 1], [0, height - 1]])
+    target = scenes.crop_corners(size)
     crops = {}
-    for name, markers in PICTURES.items():
+    for name, markers in scenes.PICTURES.items():
         if all(m in found for m in markers):
-            source = np.float32([found[m][c] for m, c in zip(markers, CORNER_OF_MARKER)])
+            source = np.float32([found[m][c] for m, c in zip(markers, scenes.CORNER_OF_MARKER)])
             H = cv2.getPerspectiveTransform(source, target)
             crops[name] = cv2.warpPerspective(frame_bgr, H, (width, height))
     return crops
@@ -347,7 +345,7 @@ class MarkerReader(Node):
         super().__init__("marker_reader")
         ### BEGIN SOLUTION
         self.publishers_ = {name: self.create_publisher(CompressedImage, f"cropped_img/{name}", 10)
-                            for name in PICTURES}
+                            for name in scenes.PICTURES}
         self.subscription = self.create_subscription(Image, "image", self.on_image, qos_profile_sensor_data)
         ### END SOLUTION
 
