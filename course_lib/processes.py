@@ -295,10 +295,15 @@ def _killpg(pgid: int, sig: int) -> None:
 
 
 def _signal_tree(pid: int, sig: int) -> None:
-    """Signal the process group `pid` leads, and `pid` itself in case it left that group."""
+    """Signal the process group `pid` leads, and `pid` itself only if it left that group.
+
+    Signalling a group member twice would deliver SIGINT twice: the second one can land in the
+    node's own clean-up (its finally block) and turn a clean exit into a traceback.
+    """
     _killpg(pid, sig)
     try:
-        os.kill(pid, sig)
+        if os.getpgid(pid) != pid:
+            os.kill(pid, sig)
     except ProcessLookupError:
         pass
 
