@@ -281,10 +281,11 @@ def _supervisor_main(argv: list[str] | None = None) -> int:
     return 0
 
 
-def _group_of(user: str) -> int:
+def _group_of(user: str | int) -> int:
+    """The primary group of a user name; a bare uid (no passwd entry needed) is its own group."""
     import pwd
 
-    return pwd.getpwnam(user).pw_gid
+    return user if isinstance(user, int) else pwd.getpwnam(user).pw_gid
 
 
 def _killpg(pgid: int, sig: int) -> None:
@@ -350,7 +351,8 @@ class Limits:
             combine it with ``user`` when the caller runs as root.
         file_size_mb: largest file the child may write (RLIMIT_FSIZE); SIGXFSZ beyond it.
         open_files: open file descriptors (RLIMIT_NOFILE).
-        user: run the child as this user (for example "nobody"); needs a caller running as root.
+        user: run the child as this user (for example "nobody"), or as this numeric uid (and gid),
+            which needs no passwd entry; needs a caller running as root.
             The child gets a fresh HOME/ROS_HOME it owns, since ROS writes logs there.
         grace_seconds: time between SIGINT and SIGKILL when the wall time runs out.
     """
@@ -361,7 +363,7 @@ class Limits:
     max_processes: int | None = None
     file_size_mb: int | None = None
     open_files: int | None = None
-    user: str | None = None
+    user: str | int | None = None
     grace_seconds: float = 2.0
 
     def __post_init__(self):
@@ -853,20 +855,24 @@ def _start_error(event: dict, command: list[str], cwd: str | None, user: str | N
     return OSError(number, f"Cannot run {command!r}: {event.get('message')}")
 
 
-def _home_for(user: str) -> Path:
+def _home_for(user: str | int) -> Path:
     """A fresh home directory owned by `user`, for a child that runs as that user."""
     import pwd
 
-    try:
-        entry = pwd.getpwnam(user)
-    except KeyError:
-        raise ValueError(f"Limits.user {user!r} does not exist on this machine; use an existing "
-                         f"unprivileged account such as 'nobody'") from None
-    if os.geteuid() != 0 and entry.pw_uid != os.geteuid():
+    if isinstance(user, int):
+        uid = gid = user
+    else:
+        try:
+            entry = pwd.getpwnam(user)
+        except KeyError:
+            raise ValueError(f"Limits.user {user!r} does not exist on this machine; use an existing "
+                             f"unprivileged account such as 'nobody'") from None
+        uid, gid = entry.pw_uid, entry.pw_gid
+    if os.geteuid() != 0 and uid != os.geteuid():
         raise PermissionError(f"Limits.user={user!r} needs the caller to run as root; "
                               "leave user=None when not running as root")
     home = Path(tempfile.mkdtemp(prefix="course_lib-home-"))
-    os.chown(home, entry.pw_uid, entry.pw_gid)
+    os.chown(home, uid, gid)
     return home
 
 

@@ -347,6 +347,20 @@ def test_child_runs_as_the_limits_user_with_a_process_limit():
     assert "fork" in process.log.lower() or "resource temporarily unavailable" in process.log.lower(), process.log
 
 
+@needs_root
+def test_child_runs_as_a_bare_uid_without_a_passwd_entry():
+    """Limits.user may be a number with no account behind it: the child gets that uid and gid."""
+    import pwd
+
+    uid = 61999
+    with pytest.raises(KeyError):
+        pwd.getpwuid(uid)
+    process = NodeProcess(["sh", "-c", "id -u; id -g; touch \"$HOME/written\" && echo home-ok"], cwd="/",
+                          limits=Limits(user=uid)).start()
+    process.wait(timeout=30)
+    assert process.log.split() == [str(uid), str(uid), "home-ok"], process.log
+
+
 def test_wait_for_output_sees_a_line_and_reports_an_early_exit():
     with processes.NodeProcess([sys.executable, "-c", "import time; print('ready', flush=True); time.sleep(30)"],
                                name="printer").start() as proc:
