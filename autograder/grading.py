@@ -11,16 +11,25 @@ One submission is graded like this (:func:`grade_submission`, run by a worker th
    machine; DDS traffic stays in it), a private /dev/shm (Fast DDS shared memory), and the course
    directory and the repository's assignments/ and tests/ hidden under empty tmpfs mounts.
 3. nbgrader starts the kernel through autograder.kernel, which drops to a uid of this worker
-   (61000 + its ROS domain id) with RLIMIT_NPROC; each check in the notebook bounds its own time
-   (harness) and runs the student's code in processes of its own.
-4. The trusted grader reads the per-cell scores from the private gradebook, copies the
+   (61000 + its ROS domain id) with RLIMIT_NPROC, in a subfolder of its own. The notebook's
+   hidden test cells only say that the grader runs them (AUTOGRADER_CHECKS_OUTSIDE=1): a check
+   run in the student's kernel could be faked by the student's code (patch checks.grade and
+   every test cell "passes").
+4. The hidden checks run after the notebook, in a fresh sandbox of the same kind, as processes
+   of the grader (``python -m autograder.harness outside``, root), against the module the
+   notebook wrote; the student's code they start runs as the worker's uid, with the same limits.
+   Their points replace nbgrader's scores of those cells, and their verdicts (seed, what passed
+   and failed, pictures) replace the cells' outputs in the autograded notebook.
+5. The trusted grader reads the other cells' scores from the private gradebook, copies the
    autograded notebook to COURSE_DIR/autograded/, and records the scores in the course
    gradebook with nbgrader's Gradebook API.
 
-Not root: steps 2-3 fall back to ``unshare --user --map-root-user --net --mount`` when
+Not root: steps 2-4 fall back to ``unshare --user --map-root-user --net --mount`` when
 unprivileged user namespaces are allowed (network and mounts isolated, but one uid for all
-workers: RLIMIT_NPROC is then shared by the workers), else to no namespaces at all (no network
-isolation; the run says so on stderr and in grades.csv's ``isolation`` column).
+workers: RLIMIT_NPROC is then shared by the workers, and the student's processes run as the
+same user as the checks, which a determined student could tamper with), else to no
+namespaces at all (no network isolation; the run says so on stderr and in grades.csv's
+``isolation`` column).
 """
 
 from __future__ import annotations
@@ -39,7 +48,7 @@ import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
-from autograder import config
+from autograder import config, harness, kernel
 
 REPO = Path(__file__).resolve().parent.parent
 REPO_SOURCE = REPO / "assignments" / "source"
@@ -287,12 +296,14 @@ def grade_submission(sub: Submission, course: Path, domain_id: int) -> GradeResu
             folder.mkdir(exist_ok=True)
             os.chmod(folder, 0o711)
         env = {"COURSE_LIB_GRADING": "1", "COURSE_LIB_UNDER_TEST": None, "AUTOGRADER_SEED": None,
+               harness.OUTSIDE_ENV: "1",
                "JUPYTER_PATH": str(work / "jupyter"), "JUPYTER_RUNTIME_DIR": str(work / "runtime"),
                "JUPYTER_CONFIG_DIR": str(work / "jupyter-config"), "AUTOGRADER_KERNEL_TMP": str(work / "kernel-tmp"),
                "PYTHONPATH": _env_for_tools()["PYTHONPATH"], "HOME": str(work), "PYDEVD_DISABLE_FILE_VALIDATION": "1"}
         if result.isolation == "root":
             result.kernel_uid = KERNEL_UID_BASE + domain_id
             env.update(AUTOGRADER_KERNEL_UID=str(result.kernel_uid), AUTOGRADER_KERNEL_NPROC=str(NPROC))
+            env.update({harness.STUDENT_UID_ENV: str(result.kernel_uid), harness.STUDENT_NPROC_ENV: str(NPROC)})
             exposure = interpreter_exposure()
             if exposure:
                 (work / "stage").mkdir()
@@ -325,6 +336,11 @@ def grade_submission(sub: Submission, course: Path, domain_id: int) -> GradeResu
         if result.status == "failed":
             result.reason = _explain_failure(log, proc) + "\n" + result.reason + "\n" + \
                 "\n".join(log.strip().splitlines()[-15:])
+        if result.status != "failed":
+            # As root the kernel ran in a subfolder of its own uid (autograder.kernel), where the
+            # notebook wrote the student's module.
+            workdir = autograded / kernel.WORK_SUBDIR if result.kernel_uid is not None else autograded
+            _grade_outside(sub, result, work, autograded, workdir, domain_id, env, hide)
         if any(c["auto_score"] is None for c in result.cells):
             result.reason += " (some cells need manual grading)"
         target = course / "autograded" / sub.student / sub.assignment
@@ -342,6 +358,74 @@ def grade_submission(sub: Submission, course: Path, domain_id: int) -> GradeResu
     result.score = round(sum(c["auto_score"] or 0 for c in result.cells), 3) if result.status != "failed" else 0.0
     result.seconds = round(time.monotonic() - started, 1)
     return result
+
+
+def _grade_outside(sub: Submission, result: GradeResult, work: Path, autograded: Path, workdir: Path,
+                   domain_id: int, env: dict, hide: list[Path]) -> None:
+    """Run the hidden checks of the graded cells in processes of the grader, not in the student's
+    kernel, against the module the notebook wrote in `workdir`; their points replace the cells'
+    scores and their verdicts replace the outputs of the cells of the notebooks in `autograded`
+    (harness.grade only said "graded outside").
+
+    The check runs as root in a fresh sandbox (network and mount namespaces); the student's
+    processes it starts run as the worker's uid, so they cannot touch the check or its results.
+    """
+    from course_lib import processes
+
+    try:
+        checks = harness.checks_of(sub.assignment)
+    except ModuleNotFoundError:  # an assignment of the instructor's own, graded by nbgrader alone
+        return
+    names = [c["cell"].removeprefix("check_") for c in result.cells
+             if c["cell"].startswith("check_") and c["cell"].removeprefix("check_") in checks]
+    if not names:
+        return
+    out = work / "checks"
+    out.mkdir(mode=0o700)
+    command = [sys.executable, "-m", "autograder.harness", "outside", sub.assignment, *names,
+               "--workdir", str(workdir), "--out", str(out)]
+    wall = sum(checks[name].timeout + 30 for name in names)
+    limits = processes.Limits(wall_seconds=wall, grace_seconds=5.0)
+    proc = processes.NodeProcess(sandbox_command(command, hide), name=f"checks {sub.key}", domain_id=domain_id,
+                                 env={**env, harness.SEED_ENV: None}, cwd=out, limits=limits)
+    proc.start()
+    try:
+        proc.wait(wall + 30)
+    except TimeoutError:
+        pass
+    finally:
+        proc.stop(timeout=5)
+    verdicts = {}
+    for name in names:
+        try:
+            verdicts[name] = harness.Result(**json.loads((out / f"{name}.json").read_text()))
+        except (OSError, ValueError, TypeError):
+            verdicts[name] = harness.Result(sub.assignment, name, 0.0, checks[name].points, 0,
+                                            error=f"The grader could not run this check ({proc.describe_exit()}):\n"
+                                                  f"{proc.log_tail(8)}")
+    for cell in result.cells:
+        name = cell["cell"].removeprefix("check_")
+        if cell["cell"].startswith("check_") and name in verdicts:
+            cell["auto_score"] = min(verdicts[name].points, cell["max_score"])
+    _write_verdicts(autograded, verdicts)
+
+
+def _write_verdicts(folder: Path, verdicts: dict) -> None:
+    """Replace the outputs of the graded cells of the notebooks in `folder` by the verdicts."""
+    import nbformat
+
+    for path in sorted(folder.glob("*.ipynb")):
+        nb = nbformat.read(path, as_version=4)
+        for cell in nb.cells:
+            name = cell.get("metadata", {}).get("nbgrader", {}).get("grade_id", "").removeprefix("check_")
+            if cell.cell_type != "code" or name not in verdicts:
+                continue
+            verdict = verdicts[name]
+            cell.outputs = [nbformat.v4.new_output("stream", name="stdout", text=harness.verdict_text(verdict, True))]
+            html = harness.images_html(verdict)
+            if html:
+                cell.outputs.append(nbformat.v4.new_output("display_data", data={"text/html": html}))
+        nbformat.write(nb, path)
 
 
 def _explain_failure(log: str, proc) -> str:

@@ -20,10 +20,16 @@ Where things run:
   ROS, a ROS_DOMAIN_ID reserved for the check. A student process that loops, crashes or exits
   costs the points of that check and nothing else.
 
+At grading the course's grader (autograder.grading) runs the hidden checks itself, outside the
+student's kernel (``python -m autograder.harness outside``): :func:`grade` in the notebook only
+says so. As root the check stays root and the student's processes run as the grader's worker
+uid (AUTOGRADER_STUDENT_UID), so the student's code can neither fake a check's result nor read
+its seed (passed in the environment, not on the command line).
+
 Seeds: a self-check uses fixed seeds (the same frames every time, so a student can debug);
-:func:`grade` draws a fresh seed at grading time (or takes AUTOGRADER_SEED to reproduce a grade)
-and prints it, so that the feedback records it. Expected answers are computed from the seed in
-the check process; nothing the student's process can read holds them.
+grading draws a fresh seed per check (or takes AUTOGRADER_SEED to reproduce a grade) and
+the verdict prints it, so that the feedback records it. Expected answers are computed from the
+seed in the check process; nothing the student's process can read holds them.
 
 Points: the check's items each pass or fail; the check earns ``points × passed weight / total
 weight``. The value of the test cell is that number, which nbgrader 0.9 takes as partial credit
@@ -168,24 +174,49 @@ def selfcheck(assignment: str, name: str) -> float | None:
     return run_check(assignment, name, SELFCHECK_SEED)
 
 
+#: Set by the course's grader (autograder.grading) for the notebook run: the hidden tests do not
+#: run in the student's kernel, where the student's code could fake their result; the grader
+#: runs them afterwards in processes of its own (see :func:`grade_outside`) and writes the
+#: verdicts into the graded notebook.
+OUTSIDE_ENV = "AUTOGRADER_CHECKS_OUTSIDE"
+
+
 def grade(assignment: str, name: str) -> float:
     """Run a check with a fresh seed (AUTOGRADER_SEED to reproduce one), print the seed and the
-    verdict, return the points earned (the test cell's value is the partial credit)."""
+    verdict, return the points earned (the test cell's value is the partial credit).
+
+    Under the course's grader (AUTOGRADER_CHECKS_OUTSIDE=1) it only says so and returns 0: the
+    grader runs the check itself and replaces this cell's output and score.
+    """
+    if os.environ.get(OUTSIDE_ENV) == "1":
+        print(f"[graded] {get_check(assignment, name).description}\n"
+              "  The autograder runs this check outside the notebook; its verdict replaces this text.")
+        return 0.0
+    return run_check(assignment, name, fresh_seed(), graded=True)
+
+
+def fresh_seed() -> int:
+    """A seed drawn now, or AUTOGRADER_SEED when set (to reproduce a grade)."""
     seed = os.environ.get("AUTOGRADER_SEED")
-    seed = int(seed) if seed else secrets.randbelow(2**31)
-    return run_check(assignment, name, seed, graded=True)
+    return int(seed) if seed else secrets.randbelow(2**31)
 
 
 def run_check(assignment: str, name: str, seed: int, graded: bool = False, workdir=None) -> float:
     """Run one check in a separate process, print its verdict, display its pictures, return points."""
     result = execute(assignment, name, seed, workdir=workdir)
-    header = f"[{'graded' if graded else 'self-check'} · seed {seed}] {get_check(assignment, name).description}"
-    print(header)
-    print("\n".join(result.verdict_lines()))
-    if graded:
-        print(f"  (reproduce with AUTOGRADER_SEED={seed})")
+    print(verdict_text(result, graded))
     _display_images(result)
     return round(result.points, 3)
+
+
+def verdict_text(result: Result, graded: bool) -> str:
+    """What a check cell shows: the seed, the check's description, and what passed and failed."""
+    header = (f"[{'graded' if graded else 'self-check'} · seed {result.seed}] "
+              f"{get_check(result.assignment, result.name).description}")
+    lines = [header, *result.verdict_lines()]
+    if graded:
+        lines.append(f"  (reproduce with AUTOGRADER_SEED={result.seed})")
+    return "\n".join(lines)
 
 
 def execute(assignment: str, name: str, seed: int, workdir=None) -> Result:
@@ -196,11 +227,15 @@ def execute(assignment: str, name: str, seed: int, workdir=None) -> Result:
     workdir = Path(workdir or os.getcwd()).resolve()
     out = Path(tempfile.mkdtemp(prefix="autograder-check-"))
     started = time.monotonic()
+    # The seed goes in the environment, which other uids cannot read (a command line they can).
+    # The working directory is the check's own: a student's file next to the notebook (json.py,
+    # numpy.py) must not shadow a module the checker imports.
     command = [sys.executable, "-m", "autograder.harness", "run", assignment, name,
-               "--seed", str(seed), "--workdir", str(workdir), "--out", str(out)]
+               "--workdir", str(workdir), "--out", str(out)]
     limits = processes.Limits(wall_seconds=spec.timeout + 10, grace_seconds=2.0)
-    proc = processes.NodeProcess(command, name=f"autograder-check-{name}", cwd=workdir, limits=limits,
-                                 env={"PYTHONPATH": _pythonpath(), "FASTRTPS_DEFAULT_PROFILES_FILE": str(FASTDDS_PROFILE)})
+    proc = processes.NodeProcess(command, name=f"autograder-check-{name}", cwd=out, limits=limits,
+                                 env={"PYTHONPATH": _pythonpath(), SEED_ENV: str(seed),
+                                      "FASTRTPS_DEFAULT_PROFILES_FILE": str(FASTDDS_PROFILE)})
     try:
         proc.start()
         try:
@@ -234,21 +269,26 @@ def _pythonpath() -> str:
     return os.pathsep.join([root] + rest)
 
 
+def images_html(result: Result) -> str:
+    """The check's pictures as one HTML block ("" when it has none)."""
+    cells = "".join(
+        f"<figure style='display:inline-block;margin:4px'><img src='data:image/png;base64,{image['png']}'/>"
+        f"<figcaption style='font-size:small'>{_escape(image['label'])}</figcaption></figure>"
+        for image in result.images if "png" in image)
+    return f"<div class='autograder-images'>{cells}</div>" if cells else ""
+
+
 def _display_images(result: Result) -> None:
-    if not result.images:
+    html = images_html(result)
+    if not html:
         return
     try:
         from IPython import get_ipython
         from IPython.display import HTML, display
     except ImportError:
         return
-    if get_ipython() is None:
-        return
-    cells = "".join(
-        f"<figure style='display:inline-block;margin:4px'><img src='data:image/png;base64,{image['png']}'/>"
-        f"<figcaption style='font-size:small'>{_escape(image['label'])}</figcaption></figure>"
-        for image in result.images if "png" in image)
-    display(HTML(f"<div class='autograder-images'>{cells}</div>"))
+    if get_ipython() is not None:
+        display(HTML(html))
 
 
 def _escape(text: str) -> str:
@@ -366,39 +406,60 @@ class Context:
             One Outcome per call. Calls that did not run because the process died or ran out of
             time get an Outcome whose error says so.
         """
-        from course_lib import processes
-
-        self.require_module()
         job = Path(tempfile.mkdtemp(prefix="autograder-call-"))
         try:
             _write_calls(job, calls)
             timeout = min(timeout or self.remaining(), self.remaining())
-            limits = processes.Limits(wall_seconds=IMPORT_TIMEOUT + timeout, memory_mb=STUDENT_MEMORY_MB,
-                                      file_size_mb=STUDENT_FILE_MB, grace_seconds=1.0)
-            command = [sys.executable, "-m", "autograder.student", "call", self.module, function, str(job)]
-            proc = processes.NodeProcess(command, name=f"student-{function}", cwd=self.workdir, limits=limits,
-                                         domain_id=self.domain_id, env=_student_env())
-            proc.start()
-            try:
-                imported = _wait_for_file(job / "imported", IMPORT_TIMEOUT, proc)
-                if not imported and proc.running():
-                    (self.workdir / IMPORT_HANG_MARK).touch()
-                    raise StudentError(f"importing {self.module} did not finish within {IMPORT_TIMEOUT:g} s: "
-                                       "remove code that runs forever at import (loops, spin()) from the "
-                                       "top level of the module; put it in main()")
-                if imported:
-                    try:
-                        proc.wait(timeout)
-                    except TimeoutError:
-                        pass
-            finally:
-                proc.stop(timeout=1)
-            if not (job / "imported").exists():
-                raise StudentError(f"{self.module} could not be imported ({proc.describe_exit()}):\n"
-                                   f"{_tail(proc.log, 6)}")
+            proc = self._run_student("call", function, job, timeout)
             return _read_outcomes(job, len(calls), proc, timeout)
         finally:
             shutil.rmtree(job, ignore_errors=True)
+
+    def endpoints(self, class_name: str, timeout: float = 20.0) -> dict:
+        """Construct the student's node class (not spun) in a student process and return the QoS of
+        its publishers and subscriptions: {"publishers"|"subscriptions": [{"topic", "type",
+        "depth", "history", "reliability", "durability"}]}. Raises StudentError when it fails."""
+        job = Path(tempfile.mkdtemp(prefix="autograder-endpoints-"))
+        try:
+            timeout = min(timeout, self.remaining())
+            proc = self._run_student("endpoints", class_name, job, timeout)
+            try:
+                return json.loads((job / "endpoints.json").read_text())
+            except (OSError, ValueError):
+                raise StudentError(f"{class_name}() could not be constructed ({proc.describe_exit()}):\n"
+                                   f"{_tail(proc.log, 6)}") from None
+        finally:
+            shutil.rmtree(job, ignore_errors=True)
+
+    def _run_student(self, command: str, target: str, job: Path, timeout: float):
+        """Run ``python -m autograder.student COMMAND MODULE TARGET JOB`` to its end (or `timeout`
+        seconds after the import); raise StudentError when the module does not import."""
+        from course_lib import processes
+
+        self.require_module()
+        _give_to_student(job)
+        proc = processes.NodeProcess([sys.executable, "-m", "autograder.student", command, self.module, target, str(job)],
+                                     name=f"student-{target}", cwd=self.workdir, domain_id=self.domain_id,
+                                     limits=_student_limits(IMPORT_TIMEOUT + timeout), env=_student_env())
+        proc.start()
+        try:
+            imported = _wait_for_file(job / "imported", IMPORT_TIMEOUT, proc)
+            if not imported and proc.running():
+                _mark(self.workdir / IMPORT_HANG_MARK)
+                raise StudentError(f"importing {self.module} did not finish within {IMPORT_TIMEOUT:g} s: "
+                                   "remove code that runs forever at import (loops, spin()) from the "
+                                   "top level of the module; put it in main()")
+            if imported:
+                try:
+                    proc.wait(timeout)
+                except TimeoutError:
+                    pass
+        finally:
+            proc.stop(timeout=1)
+        if not (job / "imported").exists():
+            raise StudentError(f"{self.module} could not be imported ({proc.describe_exit()}):\n"
+                               f"{_tail(proc.log, 6)}")
+        return proc
 
     def start_node(self, *ros_args: str, entry: str = "main"):
         """Start the student's node (``<module>:main``) in this check's ROS domain; stopped at the end.
@@ -409,8 +470,7 @@ class Context:
         from course_lib import processes
 
         self.require_module()
-        limits = processes.Limits(wall_seconds=self.remaining() + 5, memory_mb=STUDENT_MEMORY_MB,
-                                  file_size_mb=STUDENT_FILE_MB, grace_seconds=1.0)
+        limits = _student_limits(self.remaining() + 5)
         return processes.python_node(f"{self.module}:{entry}", *ros_args, name=f"student-{self.module}-{entry}",
                                      cwd=self.workdir, domain_id=self.domain_id, limits=limits, env=_student_env())
 
@@ -452,8 +512,49 @@ MODULES = {"brightness": "brightness_node", "pubsub": "pubsub_nodes", "catdog_wa
 
 
 def _student_env() -> dict:
-    return {"PYTHONPATH": _pythonpath(), "AUTOGRADER_SEED": None, "PYTHONDONTWRITEBYTECODE": "1",
-            "FASTRTPS_DEFAULT_PROFILES_FILE": str(FASTDDS_PROFILE)}
+    return {"PYTHONPATH": _pythonpath(), "AUTOGRADER_SEED": None, SEED_ENV: None, STUDENT_UID_ENV: None,
+            "PYTHONDONTWRITEBYTECODE": "1", "FASTRTPS_DEFAULT_PROFILES_FILE": str(FASTDDS_PROFILE)}
+
+
+#: Set by the grader (as root) for the checks it runs: the uid (and its RLIMIT_NPROC) that the
+#: student's processes run as, while the check itself stays root. The student's code can then
+#: neither read nor signal nor trace the check, nor write its results.
+STUDENT_UID_ENV = "AUTOGRADER_STUDENT_UID"
+STUDENT_NPROC_ENV = "AUTOGRADER_STUDENT_NPROC"
+
+#: How execute() hands the seed to the check process.
+SEED_ENV = "AUTOGRADER_CHECK_SEED"
+
+
+def _mark(path: Path) -> None:
+    """Create an empty file in the student's folder, never through a symlink planted there (the
+    check may run as root)."""
+    try:
+        os.close(os.open(path, os.O_WRONLY | os.O_CREAT | os.O_NOFOLLOW, 0o644))
+    except OSError:
+        pass
+
+
+def _student_uid() -> int | None:
+    uid = os.environ.get(STUDENT_UID_ENV)
+    return int(uid) if uid and os.geteuid() == 0 else None
+
+
+def _student_limits(wall_seconds: float):
+    """Bounds of a student process: time, memory, file size, and the grader's uid when given."""
+    from course_lib import processes
+
+    uid = _student_uid()
+    nproc = int(os.environ.get(STUDENT_NPROC_ENV, "384")) if uid is not None else None
+    return processes.Limits(wall_seconds=wall_seconds, memory_mb=STUDENT_MEMORY_MB, file_size_mb=STUDENT_FILE_MB,
+                            user=uid, max_processes=nproc, grace_seconds=1.0)
+
+
+def _give_to_student(path: Path) -> None:
+    """Let the student's uid (if any) write the results of its calls into `path`."""
+    uid = _student_uid()
+    if uid is not None:
+        os.chown(path, uid, uid)
 
 
 def clip(text: str, limit: int = 1500) -> str:
@@ -546,6 +647,8 @@ class RosProbe:
                                       enable_rosout=False, start_parameter_services=False)
         self.executor = SingleThreadedExecutor(context=self.context)
         self.executor.add_node(self.node)
+        if _student_uid() is not None:
+            _share_shared_memory()
 
     def spin_until(self, condition, timeout: float) -> bool:
         """Process callbacks until condition() is true or `timeout` seconds pass; returns condition()."""
@@ -580,6 +683,24 @@ class RosProbe:
         self.close()
 
 
+def _share_shared_memory() -> None:
+    """Let the student's uid use this (root) process's Fast DDS shared-memory files.
+
+    Fast DDS creates its segments, ports and port mutexes 0644, so a node of another uid can
+    neither deliver into a root participant's port nor release buffers in its segment: root and
+    student nodes would not even discover each other. The grader's /dev/shm is a private tmpfs of
+    the submission's sandbox, so opening this process's files to "others" opens them to that
+    student's processes only.
+    """
+    me = os.geteuid()
+    for path in Path("/dev/shm").glob("*fastrtps_*"):
+        try:
+            if path.stat().st_uid == me:
+                os.chmod(path, 0o666)
+        except OSError:  # another participant's file went away meanwhile
+            pass
+
+
 def run_in_this_process(assignment: str, name: str, seed: int, workdir: Path, out: Path) -> Result:
     """Run a check here (the check process) and return its Result."""
     spec = get_check(assignment, name)
@@ -608,15 +729,30 @@ def main(argv=None) -> int:
     run = sub.add_parser("run")
     run.add_argument("assignment")
     run.add_argument("check")
-    run.add_argument("--seed", type=int, default=SELFCHECK_SEED)
+    run.add_argument("--seed", type=int, default=None, help=f"default: ${SEED_ENV}, else {SELFCHECK_SEED}")
     run.add_argument("--workdir", default=".")
     run.add_argument("--out", required=True)
+    outside = sub.add_parser("outside", help="run the hidden checks of a graded notebook's module (the grader)")
+    outside.add_argument("assignment")
+    outside.add_argument("checks", nargs="+")
+    outside.add_argument("--workdir", required=True)
+    outside.add_argument("--out", required=True)
     args = parser.parse_args(argv)
     out = Path(args.out)
-    result = run_in_this_process(args.assignment, args.check, args.seed, Path(args.workdir).resolve(), out)
-    (out / "result.json.tmp").write_text(json.dumps(dataclasses.asdict(result)))
-    os.replace(out / "result.json.tmp", out / "result.json")
+    if args.command == "outside":
+        for name in args.checks:
+            _write_json(out / f"{name}.json", dataclasses.asdict(execute(args.assignment, name, fresh_seed(),
+                                                                          workdir=args.workdir)))
+        return 0
+    seed = args.seed if args.seed is not None else int(os.environ.get(SEED_ENV, SELFCHECK_SEED))
+    result = run_in_this_process(args.assignment, args.check, seed, Path(args.workdir).resolve(), out)
+    _write_json(out / "result.json", dataclasses.asdict(result))
     return 0
+
+
+def _write_json(path: Path, data) -> None:
+    path.with_suffix(".tmp").write_text(json.dumps(data))
+    os.replace(path.with_suffix(".tmp"), path)
 
 
 if __name__ == "__main__":

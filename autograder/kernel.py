@@ -4,7 +4,12 @@ The grader installs a kernelspec whose argv runs this module instead of ipykerne
 When the grader runs as root it sets AUTOGRADER_KERNEL_UID, and this launcher (still root):
 
 - copies the connection file (jupyter_client writes it 0600 for root) to a private directory,
-- gives the kernel's working directory (the notebook's autograded copy) to that uid,
+- copies the notebook's folder (the autograded copy) into a subfolder, WORK_SUBDIR, that it
+  gives to that uid, and makes it the kernel's working directory. The folder itself stays
+  root's: nbgrader (root) writes the graded notebook there after the run, and a student who
+  could write in that folder could replace the notebook by a symlink that root then writes
+  through. Modules the notebook writes (%%writefile) land in WORK_SUBDIR, where the grader's
+  checks find them,
 - sets RLIMIT_NPROC (the kernel enforces it for non-root users only: a fork bomb stops there),
 - drops to the uid with no supplementary groups, and execs ipykernel.
 
@@ -20,6 +25,9 @@ import resource
 import shutil
 import sys
 import tempfile
+
+#: The kernel's working directory, inside the notebook's folder (see the module docstring).
+WORK_SUBDIR = ".autograder-cwd"
 
 
 def _give(path: str, uid: int) -> None:
@@ -42,8 +50,16 @@ def main(argv=None) -> int:
             os.mkdir(os.path.join(private, name))
         _give(private, uid)
         os.chmod(private, 0o700)
-        _give(os.getcwd(), uid)
-        os.chmod(os.getcwd(), 0o700)
+        work = os.path.join(os.getcwd(), WORK_SUBDIR)
+        if os.path.islink(work) or os.path.isfile(work):  # handed in under that name: not ours
+            os.unlink(work)
+        elif os.path.isdir(work):
+            shutil.rmtree(work)
+        shutil.copytree(os.getcwd(), work, symlinks=True, ignore=shutil.ignore_patterns(WORK_SUBDIR))
+        _give(work, uid)
+        os.chmod(work, 0o700)
+        os.chmod(os.getcwd(), 0o711)
+        os.chdir(work)
         nproc = int(os.environ.get("AUTOGRADER_KERNEL_NPROC", "512"))
         resource.setrlimit(resource.RLIMIT_NPROC, (nproc, nproc))
         os.environ.update(HOME=os.path.join(private, "home"), TMPDIR=os.path.join(private, "tmp"),

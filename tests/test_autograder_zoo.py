@@ -100,6 +100,8 @@ def test_hostile_submission_is_contained(graded):
     assert "COURSE: hidden" in text
     assert "GRADEBOOK: denied" in text or "GRADEBOOK: not found" in text
     assert "BACKGROUND: started" in text
+    if os.geteuid() == 0:  # the kernel's uid owns only its working folder, not the notebook's
+        assert "SYMLINK: denied" in text
     leftovers = [p.info for p in psutil.process_iter(["pid", "cmdline", "uids"])
                  if p.info["cmdline"] and ("sleep" in p.info["cmdline"][0] and "1234" in p.info["cmdline"])]
     assert leftovers == []

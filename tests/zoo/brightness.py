@@ -37,6 +37,11 @@ try:
         print("GRADEBOOK: not found")
 except OSError as error:
     print("GRADEBOOK: denied", type(error).__name__)
+try:  # root writes the graded notebook into this folder afterwards: it must not follow a planted link
+    os.symlink("/etc/hostname", pathlib.Path.cwd().parent / "brightness-link.ipynb")
+    print("SYMLINK: planted")
+except OSError as error:
+    print("SYMLINK: denied", type(error).__name__)
 # Left running on purpose: sleeps, and floods /brightness with zeros in nearby ROS domains.
 flood = """
 import os, time, rclpy
@@ -74,6 +79,24 @@ def hostile(course_dir: str):
     return edit
 
 
+CHEAT = """
+# Fakes the hidden tests from inside the kernel: every check "earns" its full points.
+import autograder.harness as harness_module
+def full_points(assignment, name, *args, **kwargs):
+    return harness_module.get_check(assignment, name).points
+harness_module.grade = full_points
+harness_module.run_check = full_points
+checks.grade = lambda name: full_points("brightness", name)
+print("CHEAT: installed")
+"""
+
+
+def cheater(nb):
+    """Wrong answers, and a cell that patches the grading functions the hidden tests call."""
+    index = next(i for i, c in enumerate(nb.cells) if "importlib.reload(" in c.source)
+    nb.cells.insert(index + 1, nbformat.v4.new_code_cell(CHEAT))
+
+
 def entries(course_dir: str) -> dict[str, dict]:
     """student id -> {"edits", "values", "node", "reason"}: expected points per check (a number, a
     (low, high) range when fresh seeds decide how many items fail, or None: not asserted) and a
@@ -95,6 +118,8 @@ def entries(course_dir: str) -> dict[str, dict]:
         "python_loop": dict(level="check", edits=[(SUM, "total = 0\n    for value in image.reshape(-1):\n        total += int(value)\n"
                                          "    return total // image.size")], values=None, node=5.25,
                             reason="too slow"),
+        # Points come from the grader's own run of the checks, not from what the kernel reports.
+        "cheater": dict(edits=[(SUM, "return 0"), cheater], values=0, node=None, reason="returned 0, expected"),
         "import_loop": dict(edits=[(IMPORTS, IMPORTS + "while True:\n    pass\n")], values=0, node=0,
                             reason="did not finish within"),
         "callback_loop": dict(edits=[(CALLBACK, "        while True:\n            pass")], values=4, node=None,
