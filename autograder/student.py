@@ -1,4 +1,9 @@
-"""Runs a student's function in a process of its own: ``python -m autograder.student call MODULE FUNCTION JOB``.
+"""Runs a student's code in a process of its own, for a check (autograder.harness.Context).
+
+``python -m autograder.student call MODULE FUNCTION JOB`` calls a function;
+``python -m autograder.student endpoints MODULE CLASS JOB`` constructs a node class and reports
+the QoS of its publishers and subscriptions (what DDS discovery does not tell another process,
+such as the queue depth).
 
 The check that starts it (harness.Context.call) wrote JOB/calls.json and JOB/inputs.npz. This
 process imports the student's module from its working directory, touches JOB/imported, then for
@@ -70,12 +75,39 @@ def call(module: str, function: str, job: Path) -> int:
     return 0
 
 
+def endpoints(module: str, class_name: str, job: Path) -> int:
+    """Construct node class `class_name` without arguments (not spun) and write JOB/endpoints.json:
+    {"publishers"|"subscriptions": [{"topic", "type", "depth", "history", "reliability", "durability"}]}."""
+    import rclpy
+
+    sys.path.insert(0, os.getcwd())
+    mod = importlib.import_module(module)
+    (job / "imported").touch()
+    rclpy.init()
+    try:
+        node = getattr(mod, class_name)()
+        report = {}
+        for kind, endpoints_of_kind in (("publishers", node.publishers), ("subscriptions", node.subscriptions)):
+            report[kind] = [{"topic": e.topic_name, "type": f"{e.msg_type.__module__}.{e.msg_type.__name__}",
+                             "depth": e.qos_profile.depth, "history": e.qos_profile.history.name,
+                             "reliability": e.qos_profile.reliability.name,
+                             "durability": e.qos_profile.durability.name}
+                            for e in endpoints_of_kind if not e.topic_name.startswith(("/rosout", "/parameter_events"))]
+        node.destroy_node()
+    finally:
+        rclpy.try_shutdown()
+    (job / "endpoints.json").write_text(json.dumps(report))
+    return 0
+
+
 def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else argv
-    if len(argv) != 4 or argv[0] != "call":
-        print("usage: python -m autograder.student call MODULE FUNCTION JOB_DIR", file=sys.stderr)
+    commands = {"call": call, "endpoints": endpoints}
+    if len(argv) != 4 or argv[0] not in commands:
+        print("usage: python -m autograder.student call MODULE FUNCTION JOB_DIR\n"
+              "       python -m autograder.student endpoints MODULE CLASS JOB_DIR", file=sys.stderr)
         return 2
-    return call(argv[1], argv[2], Path(argv[3]))
+    return commands[argv[0]](argv[1], argv[2], Path(argv[3]))
 
 
 if __name__ == "__main__":

@@ -153,8 +153,34 @@ def test_catdog_reference_passes_easy_scenes(tmp_path):
     assert result.points == result.max_points, result.verdict_lines()
 
 
+PUBSUB_MISTAKES = {
+    # mistake: (edits of the reference module, the check it costs, a phrase of the verdict)
+    "wrong_topic": ([('TOPIC = "ros_tutorial_msg"', 'TOPIC = "ros_tutorial"')], "publisher",
+                    "nothing arrived on /ros_tutorial_msg"),
+    "queue_depth_10": ([("QUEUE_DEPTH = 100", "QUEUE_DEPTH = 10")], "subscriber", "queue depth of 100"),
+    "best_effort": ([("self.create_publisher(Header, TOPIC, QUEUE_DEPTH)",
+                      "self.create_publisher(Header, TOPIC, rclpy.qos.qos_profile_sensor_data)")], "publisher",
+                    "publisher queue depth 5"),
+    "one_hertz": ([("create_timer(0.1,", "create_timer(1.0,")], "publisher", "cannot measure a 10 Hz rate"),
+    "counter_stuck": ([("        self.count += 1\n", "")], "publisher", "add one per message"),
+}
+
+
+@pytest.mark.parametrize("mistake", sorted(PUBSUB_MISTAKES))
+def test_pubsub_typical_mistake_loses_points_with_its_reason(tmp_path, mistake):
+    """Typical publisher/subscriber mistakes score below full, and the verdict names the mistake."""
+    edits, check, reason = PUBSUB_MISTAKES[mistake]
+    result = harness.execute("pubsub", check, 5, workdir=_module_dir(tmp_path, "pubsub", edits))
+    assert result.points < result.max_points, result.verdict_lines()
+    assert reason in "\n".join(result.verdict_lines())
+
+
 # ---------------------------------------------------------------------------------------------
 # End to end, with the real nbgrader CLI and gradebook
+
+
+#: Typical mistakes that also go through the whole pipeline (nbgrader, grader, feedback page).
+FULL_RUN_MISTAKES = {"catdog_warp": CATDOG_MISTAKES["mirrored"], "pubsub": PUBSUB_MISTAKES["wrong_topic"][::2]}
 
 
 @pytest.fixture(scope="module")
@@ -163,8 +189,18 @@ def course(tmp_path_factory):
     grading.release(course, ASSIGNMENTS)
     for assignment in ASSIGNMENTS:
         zoo.submit(course, "reference", assignment)
+    for assignment, (edits, _reason) in FULL_RUN_MISTAKES.items():
+        zoo.submit(course, "mistaken", assignment, edits)
     results = grading.grade(course, workers=2, progress=False)
-    return course, {r.assignment: r for r in results}
+    return course, {(r.student, r.assignment): r for r in results}
+
+
+@pytest.fixture(scope="module")
+def feedback_pages(course):
+    from autograder import feedback
+
+    root, _ = course
+    return root, feedback.write_feedback(root)
 
 
 @pytest.mark.slow
@@ -183,18 +219,28 @@ def test_release_has_stubs_and_no_solutions_or_hidden_tests(course):
 def test_reference_solutions_get_full_marks(course, assignment):
     """release -> reference solution in the student notebook -> grade: every point."""
     _, results = course
-    result = results[assignment]
+    result = results["reference", assignment]
     assert result.status == "graded", result.reason
     assert result.score == result.max_score > 0, result.cells
 
 
 @pytest.mark.slow
-def test_feedback_shows_crops_beside_expected(course):
-    """Feedback: an index per student, and the warp notebook's page shows both crops."""
-    from autograder import feedback
+@pytest.mark.parametrize("assignment", sorted(FULL_RUN_MISTAKES))
+def test_typical_mistake_is_graded_down_with_its_reason_in_the_feedback(feedback_pages, course, assignment):
+    """A typical mistake, handed in as a notebook, loses points, and its feedback page says why."""
+    _, results = course
+    root, _pages = feedback_pages
+    result = results["mistaken", assignment]
+    assert result.status == "graded" and 0 < result.score < result.max_score, (result.score, result.cells)
+    page = (root / "feedback" / "mistaken" / assignment / f"{assignment}.html").read_text()
+    reason = FULL_RUN_MISTAKES[assignment][1]
+    assert reason in page.replace("&#39;", "'").replace("&quot;", '"')
 
-    root, _ = course
-    pages = feedback.write_feedback(root)
+
+@pytest.mark.slow
+def test_feedback_shows_crops_beside_expected(feedback_pages):
+    """Feedback: an index per student, and the warp notebook's page shows both crops."""
+    root, pages = feedback_pages
     assert root / "feedback" / "reference" / "index.html" in pages
     page = (root / "feedback" / "reference" / "catdog_warp" / "catdog_warp.html").read_text()
     assert "yours" in page and "expected" in page and "data:image/png;base64" in page

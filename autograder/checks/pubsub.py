@@ -26,6 +26,7 @@ TOPIC = "/ros_tutorial_msg"
 RATE_HZ = 10.0
 #: Relative tolerance of the measured rate (from the message stamps).
 RATE_TOLERANCE = 0.15
+QUEUE_DEPTH = 100
 HEARD = re.compile(r"I heard: (-?\d+)")
 
 
@@ -41,6 +42,24 @@ def grade(name: str):
 
 def _stamp_seconds(stamp) -> float:
     return stamp.sec + stamp.nanosec * 1e-9
+
+
+def _queue_depth(ctx, class_name: str, kind: str) -> None:
+    """One item: the node's endpoint on the topic keeps the last QUEUE_DEPTH messages. A running
+    node's depth is not visible to other processes (DDS discovery does not carry it), so the
+    class is constructed in a student process of its own and asked."""
+    try:
+        found = [e for e in ctx.endpoints(class_name)[kind] if e["topic"] == TOPIC]
+    except harness.StudentError as error:
+        ctx.item(False, f"queue depth: {error}")
+        return
+    if not found:
+        ctx.item(False, f"queue depth: {class_name}() has no {kind[:-1]} on {TOPIC}")
+        return
+    depth, history = found[0]["depth"], found[0]["history"]
+    ok = depth == QUEUE_DEPTH and history == "KEEP_LAST"
+    ctx.item(ok, f"{kind[:-1]} queue depth {depth} ({history})" + ("" if ok else
+             f"; the contract asks for a queue depth of {QUEUE_DEPTH}: pass {QUEUE_DEPTH} as the QoS argument"))
 
 
 def _wait_node(ctx, probe, proc, name: str) -> bool:
@@ -62,6 +81,7 @@ def publisher(ctx: harness.Context) -> None:
     """CounterPublisher: std_msgs/Header on ros_tutorial_msg at 10 Hz, counter +1 per message, increasing stamps."""
     from std_msgs.msg import Header
 
+    _queue_depth(ctx, "CounterPublisher", "publishers")
     proc = ctx.start_node(entry="main_publisher")
     try:
         with ctx.probe() as probe:
@@ -110,6 +130,7 @@ def subscriber(ctx: harness.Context) -> None:
     """CounterSubscriber: node counter_subscriber hears every message on ros_tutorial_msg and logs 'I heard: N'."""
     from std_msgs.msg import Header
 
+    _queue_depth(ctx, "CounterSubscriber", "subscriptions")
     first = int(ctx.rng.integers(100, 10000))
     sent = list(range(first, first + 20))
     proc = ctx.start_node(entry="main_subscriber")
