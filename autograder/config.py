@@ -37,13 +37,20 @@ def apply(c, root: str | Path | None = None) -> None:
         c.CourseDirectory.root = str(root)
     c.CourseDirectory.db_url = f"sqlite:///{Path(root).resolve() / 'gradebook.db'}" if root else ""
     c.ClearSolutions.code_stub = {"python": CODE_STUB}
-    c.Execute.timeout = TEST_CELL_TIMEOUT
-    c.Execute.timeout_func = cell_timeout
-    c.Execute.interrupt_on_timeout = True
+    apply_student(c)
     # A student who deleted a test cell gets it back (and its points are graded), not a crash.
     c.OverwriteCells.add_missing_cells = True
     # Students' notebooks may print a lot; the feedback keeps the start of each output.
     c.LimitOutput.max_lines = 400
+
+
+def apply_student(c) -> None:
+    """The settings a student's nbgrader needs (the Validate button runs the whole notebook): the
+    course's cell timeouts. nbgrader's default, 30 s for every cell, would cut a node check that
+    grading lets run (a CellTimeoutError the student never gets at grading)."""
+    c.Execute.timeout = TEST_CELL_TIMEOUT
+    c.Execute.timeout_func = cell_timeout
+    c.Execute.interrupt_on_timeout = True
 
 
 CONFIG_TEMPLATE = '''\
