@@ -6,7 +6,6 @@ checker's own small notebooks, which prove that the checker passes a good notebo
 one that raises. Screenshots go to artifacts/browser/<notebook>.png.
 """
 
-import contextlib
 import json
 import shutil
 from pathlib import Path
@@ -14,8 +13,8 @@ from pathlib import Path
 import nbformat
 import pytest
 
-from browser_support import (NOTEBOOK, ChromiumUnavailable, click_toolbar_button, launched_chromium,
-                             open_notebook, run_notebook, running_jupyterlab, toolbar_labels)
+from browser_support import (NOTEBOOK, click_toolbar_button, open_notebook, run_notebook, running_jupyterlab,
+                             toolbar_labels)
 
 ROOT = Path(__file__).resolve().parents[1]
 NOTEBOOKS = ROOT / "notebooks"
@@ -47,17 +46,6 @@ def write_notebook(path: Path, sources: list[str]) -> None:
 
 def code_cell_count(path: Path) -> int:
     return sum(cell["cell_type"] == "code" for cell in json.loads(path.read_text())["cells"])
-
-
-@pytest.fixture(scope="module")
-def browser(tmp_path_factory):
-    """A headless Chromium context with a fresh profile; skips the module when Chromium is unavailable."""
-    with contextlib.ExitStack() as stack:
-        try:
-            context = stack.enter_context(launched_chromium(tmp_path_factory.mktemp("chromium-profile")))
-        except ChromiumUnavailable as why:
-            pytest.skip(f"browser tests need Chromium: {why}")
-        yield context
 
 
 @pytest.fixture(scope="module")

@@ -1,0 +1,135 @@
+"""nbgrader in JupyterLab for the released brightness assignment: the Validate button and the
+Assignments panel, used as a student uses them.
+
+The brightness assignment is released into a fresh course directory and into a scratch exchange
+(the real nbgrader CLI, as the instructor runs it). Two students work on the released notebook,
+each in a folder of their own under the lab's root (the notebook writes brightness_node.py next
+to itself): ``correct/`` holds the reference solution, ``incorrect/`` the reference with
+``average_brightness`` returning 0. Each presses Validate; nbgrader saves the notebook, runs it
+top to bottom on the server and answers with a dialog, whose text the tests read. Screenshots go
+to artifacts/browser/validate_<student>.png and assignment_list.png.
+"""
+
+import re
+import shutil
+import sys
+from pathlib import Path
+
+import pytest
+
+from browser_support import open_assignment_list, open_notebook, running_jupyterlab, validate, wait_for_assignment
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import zoo  # noqa: E402
+from zoo import brightness as brightness_zoo  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[1]
+SCREENSHOTS = ROOT / "artifacts" / "browser"
+ASSIGNMENT = "brightness"
+# Validate runs the whole notebook on the server: ~30 s on an idle 2-core machine (the node
+# check alone ~20 s), several times that when the machine is busy.
+VALIDATE_TIMEOUT = 300
+
+STUDENTS = {
+    "correct": [],
+    "incorrect": [(brightness_zoo.SUM, "return 0")],
+}
+
+# The student's nbgrader settings, as the repository's nbgrader_config.py gives them to `make lab`
+# (nbgrader's lab handlers read nbgrader_config.py from the server's working directory, here the
+# lab's root, never from a course directory), plus a scratch exchange for the Assignments panel.
+STUDENT_NBGRADER_CONFIG = (ROOT / "nbgrader_config.py").read_text() + """
+c.Exchange.root = {exchange!r}
+c.Exchange.cache = {cache!r}
+"""
+
+pytestmark = pytest.mark.browser
+
+
+@pytest.fixture(scope="module")
+def course(tmp_path_factory):
+    """A course directory with brightness released, to release/brightness/ and to an exchange in exchange/."""
+    from autograder import grading
+
+    course = tmp_path_factory.mktemp("validate-course")
+    grading.release(course, [ASSIGNMENT])
+    grading.run_nbgrader(["release_assignment", ASSIGNMENT, f"--Exchange.root={course / 'exchange'}"], course)
+    return course
+
+
+@pytest.fixture(scope="module")
+def lab(course, tmp_path_factory):
+    """JupyterLab on a student's root: <student>/brightness.ipynb for each of STUDENTS, nbgrader_config.py."""
+    root = tmp_path_factory.mktemp("validate-lab-root")
+    for student, edits in STUDENTS.items():
+        # The zoo makes the submission (released notebook, reference solution, edits) in the
+        # course's submitted/ folder; the student's working copy is that notebook.
+        submitted = zoo.submit(course, student, ASSIGNMENT, edits)
+        (root / student).mkdir()
+        shutil.copy(submitted, root / student / f"{ASSIGNMENT}.ipynb")
+    cache = tmp_path_factory.mktemp("nbgrader-cache")
+    (root / "nbgrader_config.py").write_text(
+        STUDENT_NBGRADER_CONFIG.format(exchange=str(course / "exchange"), cache=str(cache)))
+    with running_jupyterlab(root, tmp_path_factory.mktemp("validate-lab-state")) as server:
+        print(f"\nJupyterLab answered after {server.startup_seconds:.1f} s")
+        yield server
+
+
+def validate_in_lab(browser, lab, student):
+    """Open the student's notebook, press Validate, close it again; return the Validation."""
+    path = f"{student}/{ASSIGNMENT}.ipynb"
+    page = open_notebook(browser, lab, path)
+    try:
+        result = validate(page, VALIDATE_TIMEOUT, SCREENSHOTS / f"validate_{student}.png")
+    finally:
+        lab.shut_down_kernels_of(path)
+        page.close()
+    print(f"\n{path}: Validate answered after {result.seconds:.1f} s: {result.title}\n{result.text}")
+    return result
+
+
+def said(result, lab) -> str:
+    return f"the Validate dialog said:\n{result.title}\n{result.text}\n(server log: {lab.log_path})"
+
+
+@pytest.mark.timeout(VALIDATE_TIMEOUT + 300)
+def test_validate_says_success_for_the_reference_solution(browser, lab):
+    result = validate_in_lab(browser, lab, "correct")
+    verdict = (result.title, result.outcome, result.error)
+    assert verdict == ("Validation Results", "success", False), said(result, lab)
+    assert result.text == "Success! Your notebook passes all the tests.", said(result, lab)
+    # nbgrader ran the notebook in the student's folder: that is where the module was written.
+    assert (lab.root_dir / "correct" / "brightness_node.py").is_file()
+    assert not (lab.root_dir / "brightness_node.py").exists()
+
+
+@pytest.mark.timeout(VALIDATE_TIMEOUT + 300)
+def test_validate_fails_a_wrong_average_and_shows_the_failing_checks(browser, lab):
+    result = validate_in_lab(browser, lab, "incorrect")
+    verdict = (result.title, result.outcome, result.error)
+    assert verdict == ("Validation Results", "failed", True), said(result, lab)
+    # Every failed cell is shown by its source; the node publishes average_brightness's 0 as well.
+    failed = re.findall(r"The following cell failed:\s*#[^\n]*\nchecks\.selfcheck\('(\w+)'\)", result.text)
+    assert failed == ["values", "node"], said(result, lab)
+    # A wrong number is partial credit, not a crash or a timeout: each check ran and scored its cell.
+    assert result.text.count("Partial credit; passed some but not all of the tests") == 2, said(result, lab)
+    assert "Traceback" not in result.text and "CellTimeoutError" not in result.text, said(result, lab)
+
+
+@pytest.mark.timeout(300)
+def test_assignments_panel_lists_the_released_assignment_and_fetches_it(browser, lab, course):
+    from autograder.config import COURSE_ID
+
+    page = open_assignment_list(browser, lab)
+    try:
+        assert wait_for_assignment(page, "released", ASSIGNMENT, 60) == f"{ASSIGNMENT} | {COURSE_ID} | Fetch"
+        page.locator("#released_assignments_list > .list_item", has_text=ASSIGNMENT).get_by_role(
+            "button", name="Fetch").click()
+        assert wait_for_assignment(page, "fetched", ASSIGNMENT, 60) == f"{ASSIGNMENT} | {COURSE_ID} | Submit"
+        SCREENSHOTS.mkdir(parents=True, exist_ok=True)
+        page.screenshot(path=str(SCREENSHOTS / "assignment_list.png"))
+    finally:
+        page.close()
+    fetched = lab.root_dir / ASSIGNMENT / f"{ASSIGNMENT}.ipynb"
+    assert fetched.read_bytes() == (course / "release" / ASSIGNMENT / f"{ASSIGNMENT}.ipynb").read_bytes()
