@@ -188,7 +188,9 @@ _SANDBOX_SCRIPT = r'''
 set -e
 ip link set lo up
 mount --make-rprivate /
-mount -t tmpfs -o size=2g,mode=1777 autograder-shm /dev/shm
+# No sticky bit: Fast DDS replaces a dead participant's shared-memory port by unlinking it, and
+# the student's uid must be able to do so for ports a (root) check process left behind.
+mount -t tmpfs -o size=2g,mode=0777 autograder-shm /dev/shm
 if [ -n "$AUTOGRADER_EXPOSE" ]; then
   # The interpreter lives under a directory the kernel's uid cannot enter (a pyenv under /root):
   # hide that directory under a tmpfs and put the interpreter's prefix back at the same path.
@@ -387,7 +389,8 @@ def _grade_outside(sub: Submission, result: GradeResult, work: Path, autograded:
     wall = sum(checks[name].timeout + 30 for name in names)
     limits = processes.Limits(wall_seconds=wall, grace_seconds=5.0)
     proc = processes.NodeProcess(sandbox_command(command, hide), name=f"checks {sub.key}", domain_id=domain_id,
-                                 env={**env, harness.SEED_ENV: None}, cwd=out, limits=limits)
+                                 env={**env, harness.SEED_ENV: None, "AUTOGRADER_SEED": os.environ.get("AUTOGRADER_SEED")},
+                                 cwd=out, limits=limits)
     proc.start()
     try:
         proc.wait(wall + 30)
