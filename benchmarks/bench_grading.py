@@ -1,0 +1,73 @@
+"""How long the autograder takes per submission, and what a second worker buys, in one run.
+
+Not a test: the times depend on the machine and on what else runs, so this prints them instead
+of asserting them. It releases the three assignments into a scratch course, hands in the
+reference solution of each for --students students, then grades the whole class twice with the
+real nbgrader CLI: once with one worker and once (everything graded again) with --workers.
+
+    .venv/bin/python benchmarks/bench_grading.py [--students 2] [--workers 2]
+
+Per assignment it prints the mean seconds per submission (nbgrader's notebook run plus the
+grader's own run of the hidden checks, as grades.csv reports them); then the wall time of each
+run and the ratio, which is the speed-up of the extra workers on this machine.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import statistics
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "tests"))
+
+import zoo  # noqa: E402 (tests/zoo builds submissions from the reference solutions)
+from autograder import grading  # noqa: E402
+
+ASSIGNMENTS = ["brightness", "pubsub", "catdog_warp"]
+
+
+def timed_grade(course: Path, workers: int) -> tuple[float, list]:
+    started = time.monotonic()
+    results = grading.grade(course, workers=workers, force=True, progress=False)
+    return time.monotonic() - started, results
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--students", type=int, default=2, help="reference submissions per assignment")
+    parser.add_argument("--workers", type=int, default=2, help="workers of the second run")
+    args = parser.parse_args(argv)
+    with tempfile.TemporaryDirectory(prefix="bench-grading-") as scratch:
+        course = Path(scratch) / "course"
+        grading.release(course, ASSIGNMENTS)
+        for index in range(args.students):
+            for assignment in ASSIGNMENTS:
+                zoo.submit(course, f"student{index}", assignment)
+        runs = {workers: timed_grade(course, workers) for workers in (1, args.workers)}
+    print(f"{platform.node()}: {os.cpu_count()} CPUs, isolation {grading.isolation()}, "
+          f"{args.students} reference submissions per assignment\n")
+    print(f"{'assignment':<14}{'s/submission (1 worker)':>26}{f's/submission ({args.workers} workers)':>28}"
+          f"{'scores':>14}")
+    for assignment in ASSIGNMENTS:
+        cells = []
+        for workers in (1, args.workers):
+            seconds = [r.seconds for r in runs[workers][1] if r.assignment == assignment]
+            cells.append(f"{statistics.mean(seconds):.1f}")
+        scores = {f"{r.score:g}/{r.max_score:g}" for _, results in runs.values() for r in results
+                  if r.assignment == assignment}
+        print(f"{assignment:<14}{cells[0]:>26}{cells[1]:>28}{','.join(sorted(scores)):>14}")
+    one, many = runs[1][0], runs[args.workers][0]
+    count = len(runs[1][1])
+    print(f"\n{count} submissions: {one:.0f} s with 1 worker, {many:.0f} s with {args.workers} workers: "
+          f"speed-up {one / many:.2f}x")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
