@@ -229,6 +229,23 @@ def interpreter_exposure() -> dict:
     return {}
 
 
+def _run_sandboxed(command: list[str], hide: list[Path], name: str, domain_id: int, env: dict, cwd: Path, limits):
+    """Run a command in the sandbox (sandbox_command) to its end or its wall time; return the
+    stopped course_lib.processes.NodeProcess (its log, returncode, describe_exit())."""
+    from course_lib import processes
+
+    proc = processes.NodeProcess(sandbox_command(command, hide), name=name, domain_id=domain_id, env=env, cwd=cwd,
+                                 limits=limits)
+    proc.start()
+    try:
+        proc.wait(limits.wall_seconds + 30)
+    except TimeoutError:
+        pass
+    finally:
+        proc.stop(timeout=5)
+    return proc
+
+
 def _private_copy(source: Path, target: Path) -> None:
     """Copy a directory tree readable by root only (other workers' uids cannot read it)."""
     shutil.copytree(source, target, ignore=shutil.ignore_patterns(".ipynb_checkpoints"))
@@ -315,15 +332,7 @@ def grade_submission(sub: Submission, course: Path, domain_id: int) -> GradeResu
         hide = [course, REPO / "assignments", REPO / "tests"]
         limits = processes.Limits(wall_seconds=NOTEBOOK_TIMEOUT, memory_mb=MEMORY_MB, file_size_mb=FILE_MB,
                                   grace_seconds=5.0)
-        proc = processes.NodeProcess(sandbox_command(command, hide), name=f"autograde {sub.key}", domain_id=domain_id,
-                                     env=env, cwd=root, limits=limits)
-        proc.start()
-        try:
-            proc.wait(NOTEBOOK_TIMEOUT + 30)
-        except TimeoutError:
-            pass
-        finally:
-            proc.stop(timeout=5)
+        proc = _run_sandboxed(command, hide, f"autograde {sub.key}", domain_id, env, root, limits)
         log = proc.log
         autograded = root / "autograded" / sub.student / sub.assignment
         try:
@@ -378,8 +387,7 @@ def _grade_outside(sub: Submission, result: GradeResult, work: Path, autograded:
         checks = harness.checks_of(sub.assignment)
     except ModuleNotFoundError:  # an assignment of the instructor's own, graded by nbgrader alone
         return
-    names = [c["cell"].removeprefix("check_") for c in result.cells
-             if c["cell"].startswith("check_") and c["cell"].removeprefix("check_") in checks]
+    names = [name for name in (_check_of(c["cell"]) for c in result.cells) if name in checks]
     if not names:
         return
     out = work / "checks"
@@ -387,17 +395,9 @@ def _grade_outside(sub: Submission, result: GradeResult, work: Path, autograded:
     command = [sys.executable, "-m", "autograder.harness", "outside", sub.assignment, *names,
                "--workdir", str(workdir), "--out", str(out)]
     wall = sum(checks[name].timeout + 30 for name in names)
-    limits = processes.Limits(wall_seconds=wall, grace_seconds=5.0)
-    proc = processes.NodeProcess(sandbox_command(command, hide), name=f"checks {sub.key}", domain_id=domain_id,
-                                 env={**env, harness.SEED_ENV: None, "AUTOGRADER_SEED": os.environ.get("AUTOGRADER_SEED")},
-                                 cwd=out, limits=limits)
-    proc.start()
-    try:
-        proc.wait(wall + 30)
-    except TimeoutError:
-        pass
-    finally:
-        proc.stop(timeout=5)
+    env = {**env, harness.SEED_ENV: None, "AUTOGRADER_SEED": os.environ.get("AUTOGRADER_SEED")}
+    proc = _run_sandboxed(command, hide, f"checks {sub.key}", domain_id, env, out,
+                          processes.Limits(wall_seconds=wall, grace_seconds=5.0))
     verdicts = {}
     for name in names:
         try:
@@ -407,10 +407,14 @@ def _grade_outside(sub: Submission, result: GradeResult, work: Path, autograded:
                                             error=f"The grader could not run this check ({proc.describe_exit()}):\n"
                                                   f"{proc.log_tail(8)}")
     for cell in result.cells:
-        name = cell["cell"].removeprefix("check_")
-        if cell["cell"].startswith("check_") and name in verdicts:
-            cell["auto_score"] = min(verdicts[name].points, cell["max_score"])
+        if _check_of(cell["cell"]) in verdicts:
+            cell["auto_score"] = min(verdicts[_check_of(cell["cell"])].points, cell["max_score"])
     _write_verdicts(autograded, verdicts)
+
+
+def _check_of(grade_id: str) -> str | None:
+    """The check a graded cell runs: grade id "check_<name>" (assignments/build.py names them so)."""
+    return grade_id.removeprefix("check_") if grade_id.startswith("check_") else None
 
 
 def _write_verdicts(folder: Path, verdicts: dict) -> None:
@@ -420,7 +424,7 @@ def _write_verdicts(folder: Path, verdicts: dict) -> None:
     for path in sorted(folder.glob("*.ipynb")):
         nb = nbformat.read(path, as_version=4)
         for cell in nb.cells:
-            name = cell.get("metadata", {}).get("nbgrader", {}).get("grade_id", "").removeprefix("check_")
+            name = _check_of(cell.get("metadata", {}).get("nbgrader", {}).get("grade_id", ""))
             if cell.cell_type != "code" or name not in verdicts:
                 continue
             verdict = verdicts[name]

@@ -45,12 +45,18 @@ def _plain(value):
     return tuple(value) if isinstance(value, list) else value
 
 
-def call(module: str, function: str, job: Path) -> int:
-    import numpy as np
-
+def _import_student(module: str, job: Path):
+    """Import the student's module from the working directory; JOB/imported tells the check it did."""
     sys.path.insert(0, os.getcwd())
     mod = importlib.import_module(module)
     (job / "imported").touch()
+    return mod
+
+
+def call(module: str, function: str, job: Path) -> int:
+    import numpy as np
+
+    mod = _import_student(module, job)
     target = getattr(mod, function, None)
     calls = json.loads((job / "calls.json").read_text())
     inputs = np.load(job / "inputs.npz", allow_pickle=False)
@@ -80,9 +86,7 @@ def endpoints(module: str, class_name: str, job: Path) -> int:
     {"publishers"|"subscriptions": [{"topic", "type", "depth", "history", "reliability", "durability"}]}."""
     import rclpy
 
-    sys.path.insert(0, os.getcwd())
-    mod = importlib.import_module(module)
-    (job / "imported").touch()
+    mod = _import_student(module, job)
     rclpy.init()
     try:
         node = getattr(mod, class_name)()
