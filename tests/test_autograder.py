@@ -221,14 +221,7 @@ def test_reference_solutions_get_full_marks(course, assignment):
     root, results = course
     result = results["reference", assignment]
     assert result.status == "graded", result.reason
-    assert result.score == result.max_score > 0, _verdicts(root, "reference", assignment)
-
-
-def _verdicts(root: Path, student: str, assignment: str) -> str:
-    """The graded cells' outputs of an autograded notebook (what the grader wrote there)."""
-    nb = nbformat.read(root / "autograded" / student / assignment / f"{assignment}.ipynb", as_version=4)
-    return "\n".join(output.get("text", "") for cell in nb.cells if cell.get("outputs")
-                     and cell.metadata.get("nbgrader", {}).get("grade") for output in cell.outputs)
+    assert result.score == result.max_score > 0, zoo.graded_outputs(root, "reference", assignment)
 
 
 @pytest.mark.slow
@@ -238,7 +231,7 @@ def test_typical_mistake_is_graded_down_with_its_reason_in_the_feedback(feedback
     _, results = course
     root, _pages = feedback_pages
     result = results["mistaken", assignment]
-    assert result.status == "graded" and 0 < result.score < result.max_score, _verdicts(root, "mistaken", assignment)
+    assert result.status == "graded" and 0 < result.score < result.max_score, zoo.graded_outputs(root, "mistaken", assignment)
     page = (root / "feedback" / "mistaken" / assignment / f"{assignment}.html").read_text()
     reason = FULL_RUN_MISTAKES[assignment][1]
     assert reason in page.replace("&#39;", "'").replace("&quot;", '"')

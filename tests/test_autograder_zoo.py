@@ -14,7 +14,6 @@ import sys
 import time
 from pathlib import Path
 
-import nbformat
 import psutil
 import pytest
 
@@ -50,13 +49,7 @@ def graded(tmp_path_factory):
 
 
 def _outputs(course: Path, student: str) -> str:
-    nb = nbformat.read(course / "autograded" / student / "brightness" / "brightness.ipynb", as_version=4)
-    texts = []
-    for cell in nb.cells:
-        for output in cell.get("outputs", []):
-            texts.append(output.get("text", "") or str(output.get("data", {}).get("text/plain", "")))
-            texts.extend(output.get("traceback", []))
-    return "\n".join(texts)
+    return zoo.graded_outputs(course, student, "brightness")
 
 
 def _check_scores(result) -> dict[str, float]:

@@ -57,3 +57,14 @@ def submit(course: Path, student: str, assignment: str, edits=()) -> Path:
     target.parent.mkdir(parents=True, exist_ok=True)
     nbformat.write(nb, target)
     return target
+
+
+def graded_outputs(course: Path, student: str, assignment: str) -> str:
+    """The text the autograded notebook shows: every cell's output, tracebacks and the grader's verdicts."""
+    nb = nbformat.read(Path(course) / "autograded" / student / assignment / f"{assignment}.ipynb", as_version=4)
+    texts = []
+    for cell in nb.cells:
+        for output in cell.get("outputs", []):
+            texts.append(output.get("text", "") or str(output.get("data", {}).get("text/plain", "")))
+            texts.extend(output.get("traceback", []))
+    return "\n".join(texts)
