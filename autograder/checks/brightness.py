@@ -176,18 +176,11 @@ def _node_died(ctx, node) -> bool:
 @check(points=7, timeout=90)
 def node(ctx: harness.Context) -> None:
     """BrightnessNode: name my_node, /image -> /brightness with sensor-data QoS, bgr8 and mono8, 30 Hz at 1080p, remappable."""
-    from course_lib import images
-    from rclpy.qos import qos_profile_sensor_data
-    from sensor_msgs.msg import Image
-    from std_msgs.msg import UInt8
-
     reference_answers = _reference_throughput(ctx)
     node = ctx.start_node()
     try:
         with ctx.probe() as probe:
-            replies: list[int] = []
-            publisher = probe.node.create_publisher(Image, "/image", qos_profile_sensor_data)
-            probe.node.create_subscription(UInt8, "/brightness", lambda m: replies.append(m.data), qos_profile_sensor_data)
+            publisher, replies = _frames_and_replies(probe, "/image", "/brightness")
             appeared = probe.spin_until(lambda: NODE_NAME in _node_names(probe) or not node.running(), 25.0)
             if _node_died(ctx, node):
                 return
@@ -231,21 +224,28 @@ def _burst(ctx, probe, publisher, replies: list) -> int:
     return len(replies)
 
 
-def _reference_throughput(ctx) -> int:
-    """How many throughput frames the grader's own numpy node answers here and now (the yardstick)."""
-    from course_lib import processes
+def _frames_and_replies(probe, image_topic: str, brightness_topic: str):
+    """The probe's side of a brightness node: a sensor-data Image publisher on image_topic, and the
+    list that the UInt8 values arriving on brightness_topic are appended to."""
     from rclpy.qos import qos_profile_sensor_data
     from sensor_msgs.msg import Image
     from std_msgs.msg import UInt8
+
+    replies: list[int] = []
+    publisher = probe.node.create_publisher(Image, image_topic, qos_profile_sensor_data)
+    probe.node.create_subscription(UInt8, brightness_topic, lambda m: replies.append(m.data), qos_profile_sensor_data)
+    return publisher, replies
+
+
+def _reference_throughput(ctx) -> int:
+    """How many throughput frames the grader's own numpy node answers here and now (the yardstick)."""
+    from course_lib import processes
 
     reference = processes.python_node("autograder.checks.brightness:reference_main", name="brightness-reference",
                                       domain_id=ctx.domain_id, env=harness._student_env())
     try:
         with ctx.probe() as probe:
-            replies: list[int] = []
-            publisher = probe.node.create_publisher(Image, "/image", qos_profile_sensor_data)
-            probe.node.create_subscription(UInt8, "/brightness", lambda m: replies.append(m.data),
-                                           qos_profile_sensor_data)
+            publisher, replies = _frames_and_replies(probe, "/image", "/brightness")
             if not probe.spin_until(lambda: REFERENCE_NODE_NAME in _node_names(probe), 25.0):
                 return 0
             probe.wait_for_subscriber(publisher, 5.0)
@@ -299,18 +299,12 @@ def _throughput(ctx, probe, publisher, replies, reference_answers: int) -> None:
 
 def _remapped(ctx) -> None:
     from course_lib import images
-    from rclpy.qos import qos_profile_sensor_data
-    from sensor_msgs.msg import Image
-    from std_msgs.msg import UInt8
 
     node = ctx.start_node("--ros-args", "-r", "__node:=renamed_by_grader", "-r", "/image:=/grader/image",
                           "-r", "/brightness:=/grader/brightness")
     try:
         with ctx.probe() as probe:
-            replies: list[int] = []
-            publisher = probe.node.create_publisher(Image, "/grader/image", qos_profile_sensor_data)
-            probe.node.create_subscription(UInt8, "/grader/brightness", lambda m: replies.append(m.data),
-                                           qos_profile_sensor_data)
+            publisher, replies = _frames_and_replies(probe, "/grader/image", "/grader/brightness")
             if not probe.spin_until(lambda: "renamed_by_grader" in _node_names(probe) or not node.running(), 20.0) \
                     or not node.running():
                 ctx.item(False, "with --ros-args -r __node:=renamed_by_grader no node of that name appeared: "
