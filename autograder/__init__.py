@@ -5,8 +5,11 @@
   time (``checks.grade("values")``): one piece of code for both.
 - ``autograder.harness``: what a check is (points, timeout, one-line description) and how it
   runs: in a separate process, with the student's code in yet another process.
-- ``python -m autograder release|grade|feedback COURSE_DIR``: the instructor's commands
-  (``autograder.course``, ``autograder.grading``, ``autograder.feedback``).
+- ``python -m autograder roster|release|collect|grade|feedback|export COURSE_DIR``: the
+  instructor's commands (``autograder.roster``, ``autograder.grading``, ``autograder.collect``,
+  ``autograder.feedback``, ``autograder.export``); ``autograder.gradebook`` writes the grades into
+  nbgrader's gradebook as nbgrader's autograde would, ``autograder.late`` holds due dates and late
+  penalties, ``autograder.guard`` makes nbgrader's own autograde refuse outside the grader.
 """
 
 __all__ = ["harness", "checks"]
