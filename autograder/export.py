@@ -34,8 +34,11 @@ class CourseCsvExport(CsvExportPlugin):
         dest = Path(self.to or FILE_NAME)
         if (self.student or self.assignment) and dest.name == FILE_NAME:
             only = ", ".join(str(x) for x in [*self.assignment, *self.student])
-            raise ValueError(f"An export of {only} only would replace {dest} (every student and assignment) with "
-                             f"fewer rows: give it a file of its own, e.g. --to {dest.with_name('grades-partial.csv')}")
+            message = (f"An export of {only} only would replace {dest} (every student and assignment) with fewer "
+                       f"rows: give it a file of its own, e.g. --to {dest.with_name('grades-partial.csv')}")
+            if hasattr(self.parent, "fail"):  # nbgrader's export command: its error line and exit status
+                self.parent.fail(message)
+            raise ValueError(message)
         rows = rows_of(gradebook, [str(x) for x in self.assignment], [str(x) for x in self.student])
         self.log.info("Exporting %d grades to %s", len(rows), dest)
         temporary = dest.with_name(f".{dest.name}.{os.getpid()}.tmp")

@@ -68,3 +68,15 @@ def test_filtered_export_does_not_replace_grades_csv(course):
     with gradebook.open_gradebook(course) as gb:
         plugin.export(gb)
     assert {r["assignment"] for r in _rows(course / "a-only.csv")} == {"a"}
+
+
+def test_nbgrader_export_of_one_assignment_is_refused_with_its_error_line(course):
+    """`nbgrader export --assignment a` in the course directory: an error line, exit status 1."""
+    import subprocess
+    import sys
+
+    before = export.export(course).read_text()
+    done = subprocess.run([sys.executable, "-m", "nbgrader", "export", "--assignment", "a"], cwd=course,
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 1 and "[ExportApp | ERROR] An export of a only" in done.stderr + done.stdout
+    assert "Traceback" not in done.stderr and (course / "grades.csv").read_text() == before
