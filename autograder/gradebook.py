@@ -55,7 +55,8 @@ def submitted_timestamp(folder: Path):
                          "in it (e.g. 2025-03-14 23:59:00 UTC) or delete it") from None
 
 
-def record(course: Path, student: str, assignment: str, scores: dict, timestamp, config) -> float:
+def record(course: Path, student: str, assignment: str, scores: dict, timestamp, config,
+           earlier: bool = False) -> float:
     """Write a graded submission into the course gradebook and assign its late penalty.
 
     Args:
@@ -63,6 +64,9 @@ def record(course: Path, student: str, assignment: str, scores: dict, timestamp,
             that could not be run earns nothing), None means it needs manual grading.
         timestamp: the submission time (naive UTC datetime) or None.
         config: the course's nbgrader configuration (autograder.config.load), for the late penalty.
+        earlier: the scores are an earlier run's (nothing was graded again): when the gradebook has
+            the submission, only its time and late penalty are updated, so the formgrader's manual
+            grading (scores, cells marked as reviewed) stays as the instructor left it.
 
     Returns:
         The assignment's maximum score.
@@ -79,13 +83,16 @@ def record(course: Path, student: str, assignment: str, scores: dict, timestamp,
             # objects to the session; an autoflush meanwhile only raises SQLAlchemy warnings.
             with gb.db.no_autoflush:
                 submission = gb.add_submission(assignment, student)
+            earlier = False
         submission.timestamp = timestamp
         for notebook in submission.notebooks:
             for grade in notebook.grades:
+                max_score += grade.max_score
+                if earlier:
+                    continue
                 grade.auto_score = scores.get((notebook.name, grade.name), 0.0)
                 # nbgrader's SaveAutoGrades rule
                 grade.needs_manual_grade = grade.manual_score is not None or grade.auto_score is None
-                max_score += grade.max_score
         gb.db.commit()
         notebooks = [notebook.name for notebook in submission.notebooks]
     for notebook in notebooks:

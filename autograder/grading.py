@@ -530,13 +530,15 @@ def _store(course: Path, result: GradeResult, course_config) -> None:
 
 
 def _record(course: Path, result: GradeResult, course_config) -> None:
-    """The result's scores, the submission time and the late penalty, in the course gradebook."""
+    """The result's scores, the submission time and the late penalty, in the course gradebook (a
+    result from an earlier run: the time and penalty only, when the gradebook has its scores)."""
     scores = {} if result.status == "failed" else {(c["notebook"], c["cell"]): c["auto_score"] for c in result.cells}
     try:
         timestamp = gradebook.submitted_timestamp(course / "submitted" / result.student / result.assignment)
     except ValueError:  # intake.check failed the submission for it, with the fix
         timestamp = None
-    result.max_score = gradebook.record(course, result.student, result.assignment, scores, timestamp, course_config)
+    result.max_score = gradebook.record(course, result.student, result.assignment, scores, timestamp, course_config,
+                                        earlier=result.from_cache)
 
 
 def _cached(course: Path, sub: Submission) -> GradeResult | None:

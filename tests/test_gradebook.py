@@ -102,6 +102,23 @@ def test_regrade_keeps_manual_scores_and_recomputes_the_penalty(course):
         assert not gb.find_submission("hw", "alice").late_submission_penalty
 
 
+def test_earlier_result_keeps_the_instructors_review_and_updates_the_penalty(course):
+    """Writing an earlier run's result again (nothing re-graded) leaves a cell the instructor
+    reviewed in the formgrader as reviewed, and recomputes the penalty for a moved due date."""
+    _record(course)
+    with gradebook.open_gradebook(course) as gb:
+        grade = gb.find_grade("check_a", "hw", "hw", "alice")
+        grade.manual_score, grade.needs_manual_grade = 4.0, False  # what the formgrader's save does
+        gb.db.commit()
+        gb.update_or_create_assignment("hw", duedate="2025-03-16 12:00:00 UTC")
+    timestamp = gradebook.submitted_timestamp(course / "submitted" / "alice" / "hw")
+    gradebook.record(course, "alice", "hw", SCORES, timestamp, config.load(course), earlier=True)
+    with gradebook.open_gradebook(course) as gb:
+        grade = gb.find_grade("check_a", "hw", "hw", "alice")
+        assert (grade.manual_score, grade.needs_manual_grade) == (4.0, False)
+        assert not gb.find_submission("hw", "alice").late_submission_penalty
+
+
 def test_unreadable_timestamp_names_the_file_and_the_fix(course):
     """A timestamp.txt without a date gives an error that names the file and what to write."""
     folder = course / "submitted" / "alice" / "hw"
