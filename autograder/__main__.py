@@ -1,4 +1,4 @@
-"""python -m autograder release|grade|feedback COURSE_DIR: the instructor's commands."""
+"""python -m autograder release|grade|feedback COURSE_DIR, record-answers: the instructor's commands."""
 
 from __future__ import annotations
 
@@ -21,8 +21,17 @@ def main(argv=None) -> int:
     fee = sub.add_parser("feedback", help="write per-student HTML feedback to COURSE_DIR/feedback/")
     fee.add_argument("course_dir", type=Path)
     fee.add_argument("--assignment", help="only this assignment")
+    rec = sub.add_parser("record-answers", help="record the self-checks' answers from the grader's answer keys "
+                         "(after changing a check's inputs or an answer key)")
+    rec.add_argument("assignments", nargs="*", help="default: every assignment with an answer key")
     args = parser.parse_args(argv)
 
+    if args.command == "record-answers":
+        from autograder import record
+
+        for path in record.record_answers(args.assignments or None):
+            print(path)
+        return 0
     from autograder import grading
 
     if args.command == "release":

@@ -34,6 +34,7 @@ from pathlib import Path
 from bench_images import format_time  # the sibling script; benchmarks/ is on sys.path when run
 
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))  # the grader's answer key (autograder/) runs from the repository, uninstalled
 READMARKER = ROOT / "assignments" / "reference_ws" / "src" / "readmarker"
 RESULT = "RESULT "
 WARMUP = 6.0  # seconds for the processes to start and discover each other before the window
@@ -42,10 +43,10 @@ WARMUP = 6.0  # seconds for the processes to start and discover each other befor
 # ---- the roles run as processes ------------------------------------------------------------
 
 def average_brightness(image):
-    """The brightness assignment's definition, as the grader computes it."""
-    from autograder.checks.brightness import expected_brightness
+    """The brightness assignment's definition, as the grader computes it (its answer key)."""
+    from autograder.answers.brightness import average_brightness as answer
 
-    return expected_brightness(image)
+    return answer(image)
 
 
 def python_loop_brightness(data) -> int:

@@ -1,6 +1,6 @@
 """What a graded check is, and how it runs: the same code for the self-check and the autograder.
 
-A check is a function in ``autograder/checks/<assignment>.py`` decorated with :func:`check`,
+A check is a function in ``course_lib/checks/<assignment>.py`` decorated with :func:`check`,
 which gives it its points and its time limit; its docstring's first line says what it checks::
 
     @check(points=4, timeout=40)
@@ -12,7 +12,7 @@ which gives it its points and its time limit; its docstring's first line says wh
 Where things run:
 
 - the notebook kernel only starts the check and prints its verdict (:func:`run_check`): the check
-  runs in a process of its own (``python -m autograder.harness run ...``) with a wall-time bound,
+  runs in a process of its own (``python -m course_lib.checks.harness run ...``) with a wall-time bound,
   so nothing a check does can hang or crash the kernel, and nothing the kernel's state holds
   (a node the student left spinning, a patched module) changes the check;
 - the student's code runs in a third process, started by the check (:meth:`Context.call` for
@@ -21,15 +21,19 @@ Where things run:
   costs the points of that check and nothing else.
 
 At grading the course's grader (autograder.grading) runs the hidden checks itself, outside the
-student's kernel (``python -m autograder.harness outside``): :func:`grade` in the notebook only
+student's kernel (``python -m course_lib.checks.harness outside``): :func:`grade` in the notebook only
 says so. As root the check stays root and the student's processes run as the grader's worker
 uid (AUTOGRADER_STUDENT_UID), so the student's code can neither fake a check's result nor read
 its seed (passed in the environment, not on the command line).
 
 Seeds: a self-check uses fixed seeds (the same frames every time, so a student can debug);
 grading draws a fresh seed per check (or takes AUTOGRADER_SEED to reproduce a grade) and
-the verdict prints it, so that the feedback records it. Expected answers are computed from the
-seed in the check process; nothing the student's process can read holds them.
+the verdict prints it, so that the feedback records it.
+
+Expected answers (:meth:`Context.expected`, course_lib.checks.answers): graded, from the grader's
+answer key (``autograder.answers``, instructor side only); in a self-check, the answers that key
+gave for the self-check's inputs, recorded as data. Nothing a student can import or read holds
+a reference solution, and nothing the student's process can read holds a graded answer.
 
 Points: the check's items each pass or fail; the check earns ``points × passed weight / total
 weight``. The value of the test cell is that number, which nbgrader 0.9 takes as partial credit
@@ -51,6 +55,8 @@ import tempfile
 import time
 import traceback
 from pathlib import Path
+
+from course_lib.checks import answers
 
 #: Seconds a student's module gets to import (rclpy alone needs one or two on a busy machine).
 IMPORT_TIMEOUT = 25.0
@@ -99,7 +105,7 @@ _REGISTRY: dict[str, dict[str, Check]] = {}
 
 
 def check(points: float, timeout: float):
-    """Register a check function of an ``autograder.checks`` module (see the module docstring)."""
+    """Register a check function of a ``course_lib.checks`` module (see the module docstring)."""
     def register(function):
         assignment = function.__module__.rsplit(".", 1)[-1]
         doc = (function.__doc__ or "").strip().splitlines()
@@ -113,7 +119,7 @@ def check(points: float, timeout: float):
 
 def checks_of(assignment: str) -> dict[str, Check]:
     """The checks of an assignment, in the order they are defined (imports the checks module)."""
-    importlib.import_module(f"autograder.checks.{assignment}")
+    importlib.import_module(f"course_lib.checks.{assignment}")
     return dict(_REGISTRY.get(assignment, {}))
 
 
@@ -203,7 +209,7 @@ def fresh_seed() -> int:
 
 def run_check(assignment: str, name: str, seed: int, graded: bool = False, workdir=None) -> float:
     """Run one check in a separate process, print its verdict, display its pictures, return points."""
-    result = execute(assignment, name, seed, workdir=workdir)
+    result = execute(assignment, name, seed, workdir=workdir, mode="graded" if graded else "selfcheck")
     print(verdict_text(result, graded))
     _display_images(result)
     return round(result.points, 3)
@@ -219,8 +225,13 @@ def verdict_text(result: Result, graded: bool) -> str:
     return "\n".join(lines)
 
 
-def execute(assignment: str, name: str, seed: int, workdir=None) -> Result:
-    """Run a check in its own process and return its Result (0 points when it failed to finish)."""
+def execute(assignment: str, name: str, seed: int, workdir=None, mode: str = "selfcheck") -> Result:
+    """Run a check in its own process and return its Result (0 points when it failed to finish).
+
+    `mode` says where its expected answers come from (course_lib.checks.answers): "selfcheck"
+    (recorded answers; only the self-check seed's inputs are recorded), "graded" (the grader's
+    answer key) or "record" (graded, and the answers written to $AUTOGRADER_RECORD_TO).
+    """
     from course_lib import processes
 
     spec = get_check(assignment, name)
@@ -230,11 +241,11 @@ def execute(assignment: str, name: str, seed: int, workdir=None) -> Result:
     # The seed goes in the environment, which other uids cannot read (a command line they can).
     # The working directory is the check's own: a student's file next to the notebook (json.py,
     # numpy.py) must not shadow a module the checker imports.
-    command = [sys.executable, "-m", "autograder.harness", "run", assignment, name,
+    command = [sys.executable, "-m", "course_lib.checks.harness", "run", assignment, name,
                "--workdir", str(workdir), "--out", str(out)]
     limits = processes.Limits(wall_seconds=spec.timeout + 10, grace_seconds=2.0)
     proc = processes.NodeProcess(command, name=f"autograder-check-{name}", cwd=out, limits=limits,
-                                 env={"PYTHONPATH": _pythonpath(), SEED_ENV: str(seed),
+                                 env={"PYTHONPATH": _pythonpath(), SEED_ENV: str(seed), answers.MODE_ENV: mode,
                                       "FASTRTPS_DEFAULT_PROFILES_FILE": str(FASTDDS_PROFILE)})
     try:
         proc.start()
@@ -263,8 +274,9 @@ def execute(assignment: str, name: str, seed: int, workdir=None) -> Result:
 
 
 def _pythonpath() -> str:
-    """The directory holding the autograder package, first on the path of child processes."""
-    root = str(Path(__file__).resolve().parent.parent)
+    """The directory holding course_lib (in a course checkout also the autograder), first on the
+    path of child processes."""
+    root = str(Path(__file__).resolve().parents[2])
     rest = [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p and p != root]
     return os.pathsep.join([root] + rest)
 
@@ -345,6 +357,7 @@ class Context:
         self.images: list[dict] = []
         self._reservation = None
         self._started = time.monotonic()
+        self._answers = answers.AnswerKey(spec.assignment)
 
     # -- recording -----------------------------------------------------------------------------
 
@@ -352,6 +365,16 @@ class Context:
         """Record one checked claim; `message` says what was found (and the fix when it failed)."""
         self.items.append({"ok": bool(ok), "message": clip(message), "weight": float(weight)})
         return bool(ok)
+
+    def precondition(self, ok: bool, message: str) -> bool:
+        """Record a claim that later items depend on but that earns nothing by itself (a node that
+        starts, then fails at its job, must not score): shown like an item, weight 0."""
+        return self.item(ok, message, weight=0.0)
+
+    def expected(self, question: str, *args):
+        """The right answer of the contract's function `question` for these arguments (see
+        course_lib.checks.answers: the grader's key when graded, recorded answers in a self-check)."""
+        return self._answers.expected(question, *args)
 
     def note(self, text: str) -> None:
         """Record an informative line (no points)."""
@@ -432,13 +455,13 @@ class Context:
             shutil.rmtree(job, ignore_errors=True)
 
     def _run_student(self, command: str, target: str, job: Path, timeout: float):
-        """Run ``python -m autograder.student COMMAND MODULE TARGET JOB`` to its end (or `timeout`
+        """Run ``python -m course_lib.checks.student COMMAND MODULE TARGET JOB`` to its end (or `timeout`
         seconds after the import); raise StudentError when the module does not import."""
         from course_lib import processes
 
         self.require_module()
         _give_to_student(job)
-        proc = processes.NodeProcess([sys.executable, "-m", "autograder.student", command, self.module, target, str(job)],
+        proc = processes.NodeProcess([sys.executable, "-m", "course_lib.checks.student", command, self.module, target, str(job)],
                                      name=f"student-{target}", cwd=self.workdir, domain_id=self.domain_id,
                                      limits=_student_limits(IMPORT_TIMEOUT + timeout), env=_student_env())
         proc.start()
@@ -513,6 +536,7 @@ MODULES = {"brightness": "brightness_node", "pubsub": "pubsub_nodes", "catdog_wa
 
 def _student_env() -> dict:
     return {"PYTHONPATH": _pythonpath(), "AUTOGRADER_SEED": None, SEED_ENV: None, STUDENT_UID_ENV: None,
+            answers.MODE_ENV: None, answers.RECORD_ENV: None,
             "PYTHONDONTWRITEBYTECODE": "1", "FASTRTPS_DEFAULT_PROFILES_FILE": str(FASTDDS_PROFILE)}
 
 
@@ -724,7 +748,7 @@ def run_in_this_process(assignment: str, name: str, seed: int, workdir: Path, ou
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m autograder.harness", description="Run one graded check.")
+    parser = argparse.ArgumentParser(prog="python -m course_lib.checks.harness", description="Run one graded check.")
     sub = parser.add_subparsers(dest="command", required=True)
     run = sub.add_parser("run")
     run.add_argument("assignment")
@@ -742,7 +766,7 @@ def main(argv=None) -> int:
     if args.command == "outside":
         for name in args.checks:
             _write_json(out / f"{name}.json", dataclasses.asdict(execute(args.assignment, name, fresh_seed(),
-                                                                          workdir=args.workdir)))
+                                                                          workdir=args.workdir, mode="graded")))
         return 0
     seed = args.seed if args.seed is not None else int(os.environ.get(SEED_ENV, SELFCHECK_SEED))
     result = run_in_this_process(args.assignment, args.check, seed, Path(args.workdir).resolve(), out)
@@ -757,6 +781,6 @@ def _write_json(path: Path, data) -> None:
 
 if __name__ == "__main__":
     # Run through the imported module, so that the checks register where they are looked up.
-    from autograder.harness import main as _main
+    from course_lib.checks.harness import main as _main
 
     sys.exit(_main())
