@@ -457,8 +457,10 @@ class NodeProcess:
         limits: resource bounds (see Limits); None for none.
         on_output: called as ``on_output(stream, data)`` with each piece of the child's output
             as it arrives, stream being "stdout" or "stderr" (from a thread of its own; the
-            log keeps everything as well). With it the child's stdout and stderr are separate
-            pipes, so their order in the log is only as exact as their arrival.
+            log keeps everything as well). By the time returncode is known, on_output has had
+            all of it (so on_output must not wait for this process). With it the child's stdout
+            and stderr are separate pipes, so their order in the log is only as exact as their
+            arrival.
 
     Attributes:
         pid: the child's process id (it also leads the child's process group) once started.
@@ -484,6 +486,7 @@ class NodeProcess:
         self.cwd = None if cwd is None else os.fspath(cwd)
         self.limits = limits or Limits()
         self._on_output = on_output
+        self._relay: threading.Thread | None = None
         base = dict(os.environ)
         for key, value in (env or {}).items():
             if value is None:
@@ -561,8 +564,9 @@ class NodeProcess:
                 if echo_write is not None:
                     os.close(echo_write)
             if echo_read is not None:
-                threading.Thread(target=_relay_echo, args=(echo_read, self._on_output),
-                                 name=f"course_lib-output-{self.name}", daemon=True).start()
+                self._relay = threading.Thread(target=_relay_echo, args=(echo_read, self._on_output),
+                                               name=f"course_lib-output-{self.name}", daemon=True)
+                self._relay.start()
             with _RUNNING_LOCK:
                 _RUNNING.add(self)
             event = self._next_event(START_TIMEOUT)
@@ -787,6 +791,8 @@ class NodeProcess:
             while (event := self._next_event(0)) is not None:
                 if event.get("event") == "exited":
                     final = event
+            if self._relay is not None and self._relay is not threading.current_thread():
+                self._relay.join(timeout=5.0)  # the supervisor has exited: its last frames are in the pipe
             if final is not None:
                 self._returncode = final["returncode"]
                 self.exit_reason = final["reason"]
