@@ -289,6 +289,27 @@ class Node(Action):
         context.nodes.append(NodeToStart(command, environment, label, output, name, namespace, self.file, self.line))
 
 
+def run_launch_file(path, arguments: dict | None = None, environment: dict | None = None) -> LaunchContext:
+    """Run a launch file's actions, as ``ros2 launch`` does before its processes start.
+
+    Args:
+        path: the launch file.
+        arguments: {name: value} as given on the command line (``name:=value``).
+        environment: the environment to start from (os.environ when None; never changed).
+
+    Returns:
+        The context: ``nodes`` to start, ``configurations``, ``warnings``.
+
+    Raises:
+        LaunchFileError: the file cannot run as written (the message has its line).
+    """
+    path = Path(os.path.abspath(path))
+    context = LaunchContext(environment=environment, current_file=path)
+    IncludeLaunchDescription(path=[str(path)], arguments=[([name], [value]) for name, value in (arguments or {}).items()],
+                             file=path, line=0, from_command_line=True).run(context)
+    return context
+
+
 # --- namespaces (launch_ros's rules) -----------------------------------------------------------
 
 def prefix_namespace(base: str | None, namespace: str | None) -> str | None:

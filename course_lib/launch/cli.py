@@ -11,6 +11,7 @@ import argparse
 import os
 import signal
 import sys
+from pathlib import Path
 
 from course_lib.launch import actions, parser, substitutions
 from course_lib.launch.entities import LaunchFileError
@@ -61,7 +62,7 @@ def parse_launch_arguments(texts: list[str]) -> dict[str, str]:
 def print_arguments(path) -> None:
     """``ros2 launch -s``: the file's arguments, with descriptions and defaults, as ros2launch prints them."""
     description = parser.load_description(path)
-    declared = actions.declared_arguments(description, None, os.path.abspath(path))
+    declared = actions.declared_arguments(description, None, Path(os.path.abspath(path)))
     print("Arguments (pass arguments as '<name>:=<value>'):")
     for argument, _passed, conditional in declared:
         text = f"\n    '{argument.name}':{'*' if conditional else ''}\n        "

@@ -208,10 +208,11 @@ def _construct_mapping(loader: _LineLoader, node: yaml.MappingNode):
 _LineLoader.add_constructor("tag:yaml.org,2002:map", _construct_mapping)
 
 
-def _yaml_entity(kind: str, value, file: Path, line: int) -> Entity:
-    """An entity from the value of a YAML tag: a mapping of attributes, or a list of children."""
+def _yaml_entity(kind: str, value, file: Path, line: int, *, tag_line: bool = False) -> Entity:
+    """An entity from the value of a YAML tag: a mapping of attributes, or a list of children.
+    Its line is the mapping's own, or with tag_line the given one (the line of ``- node:``)."""
     if isinstance(value, dict):
-        return Entity(kind, file, getattr(value, "line", line), dict(value), None, typed=True,
+        return Entity(kind, file, line if tag_line else getattr(value, "line", line), dict(value), None, typed=True,
                       attribute_lines=getattr(value, "key_lines", {}))
     if isinstance(value, list):
         return Entity(kind, file, line, {}, value, typed=True)
@@ -228,7 +229,7 @@ def _yaml_child(item, file: Path, line: int) -> Entity:
         raise LaunchFileError("each tag in a list must be a mapping with one key, the tag name "
                               f"(like - node: {{pkg: ..., exec: ...}}), not {item!r}", file, where)
     (kind, value), = item.items()
-    return _yaml_entity(kind, value, file, item.key_lines.get(kind, line) if hasattr(item, "key_lines") else line)
+    return _yaml_entity(kind, value, file, getattr(item, "key_lines", {}).get(kind, line), tag_line=True)
 
 
 def load_yaml(path: Path, text: str) -> Entity:

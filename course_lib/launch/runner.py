@@ -33,7 +33,7 @@ from pathlib import Path
 from typing import Callable
 
 from course_lib import processes
-from course_lib.launch.actions import IncludeLaunchDescription, LaunchContext, NodeToStart
+from course_lib.launch.actions import LaunchContext, NodeToStart, run_launch_file
 
 #: Seconds between SIGINT and SIGKILL when a launch stops (the real tool's sigterm_timeout).
 STOP_TIMEOUT = 5.0
@@ -171,10 +171,7 @@ class Launch:
         Raises:
             LaunchFileError: the file cannot run as written (the message has its line).
         """
-        context = LaunchContext(current_file=self.path)
-        IncludeLaunchDescription(path=[str(self.path)], arguments=[([name], [value]) for name, value
-                                                                   in self.arguments.items()],
-                                 file=self.path, line=0, from_command_line=True).run(context)
+        context = run_launch_file(self.path, self.arguments)
         self._context, self._nodes = context, context.nodes
         for logger, message in context.warnings:
             self.warning(logger, message)
