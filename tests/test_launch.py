@@ -1,8 +1,8 @@
 """course_lib.launch with real processes: ros2 launch brings up the graph a launch file describes.
 
-The package course_demo lives in a temporary prefix with an ament index marker: two small rclpy
-nodes (chatter_a, chatter_b) and a few shell executables, its launch files and a parameter
-file in share/. `ros2 launch` is run as `python -m course_lib.launch` (what the ros2 command
+The package course_demo lives in a temporary prefix with an ament index marker (launch_demo.py):
+two small rclpy nodes (chatter_a, chatter_b) and a few shell executables, its launch files and a
+parameter file in share/. `ros2 launch` is run as `python -m course_lib.launch` (what the ros2 command
 calls); the graph is read with course_lib.graph and the parameters through the nodes' own
 parameter services. Leftover processes are found by the prefix's path, which is in the command
 line of every process a launch starts (nodes and their supervisors).
@@ -20,44 +20,7 @@ import psutil
 import pytest
 
 from course_lib import graph, launch, rosenv, session, workspace
-
-NODE = '''
-import os
-import sys
-
-import rclpy
-from rclpy.executors import ExternalShutdownException
-from rclpy.node import Node
-from std_msgs.msg import String
-
-
-class Chatter(Node):
-    """Publish on chatter, listen on heard; takes whatever parameters it is given."""
-
-    def __init__(self):
-        super().__init__(os.path.basename(sys.argv[0]), automatically_declare_parameters_from_overrides=True)
-        self.publisher = self.create_publisher(String, "chatter", 10)
-        self.subscription = self.create_subscription(String, "heard", lambda msg: None, 10)
-        print(f"COURSE_GREETING={os.environ.get('COURSE_GREETING')}", flush=True)
-        self.get_logger().info("started")
-
-
-def main():
-    rclpy.init()
-    node = None
-    try:
-        node = Chatter()
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
-
-
-main()
-'''
+from launch_demo import CHATTER_NODE, make_prefix
 
 EVERY_TAG = """\
 <launch>
@@ -115,29 +78,19 @@ SLEEPERS = """\
 @pytest.fixture(scope="module")
 def prefix(tmp_path_factory):
     """The prefix of package course_demo, on AMENT_PREFIX_PATH for this module."""
-    prefix = tmp_path_factory.mktemp("course_demo_prefix")
-    index = prefix / "share" / "ament_index" / "resource_index" / "packages"
-    index.mkdir(parents=True)
-    (index / "course_demo").write_text("")
-    share, lib = prefix / "share" / "course_demo", prefix / "lib" / "course_demo"
-    (share / "launch").mkdir(parents=True)
-    (share / "config").mkdir()
-    lib.mkdir(parents=True)
-    (share / "launch" / "every_tag.launch.xml").write_text(EVERY_TAG)
-    (share / "launch" / "listener.launch.yaml").write_text(LISTENER)
-    (share / "launch" / "endings.launch.xml").write_text(ENDINGS)
-    (share / "launch" / "sleepers.launch.xml").write_text(SLEEPERS)
-    (share / "config" / "params.yaml").write_text("/**:\n  ros__parameters:\n    gain: 2\n    rate: 1\n")
-    executables = {
-        "chatter_a": f"#!{sys.executable}\n{NODE}",
-        "chatter_b": f"#!{sys.executable}\n{NODE}",
+    prefix = make_prefix(tmp_path_factory.mktemp("course_demo_prefix"), "course_demo", {
+        "chatter_a": CHATTER_NODE,
+        "chatter_b": CHATTER_NODE,
         "crasher": "#!/bin/sh\necho to stdout\necho to stderr >&2\nexit 1\n",
         "quitter": "#!/bin/sh\nsleep 0.5\nexit 0\n",
         "sleeper": "#!/bin/sh\ntrap 'echo bye; exit 0' INT\necho sleeping\nwhile :; do sleep 0.1; done\n",
-    }
-    for name, text in executables.items():
-        (lib / name).write_text(text)
-        (lib / name).chmod(0o755)
+    }, {
+        "launch/every_tag.launch.xml": EVERY_TAG,
+        "launch/listener.launch.yaml": LISTENER,
+        "launch/endings.launch.xml": ENDINGS,
+        "launch/sleepers.launch.xml": SLEEPERS,
+        "config/params.yaml": "/**:\n  ros__parameters:\n    gain: 2\n    rate: 1\n",
+    })
     saved = os.environ.get("AMENT_PREFIX_PATH", "")
     os.environ["AMENT_PREFIX_PATH"] = f"{prefix}{os.pathsep}{saved}"
     yield prefix
@@ -254,6 +207,9 @@ def test_processes_that_end_are_reported_and_then_the_launch_ends(prefix, ros_do
     assert (f"[ERROR] [{name}]: process has died [pid {pid}, exit code 1, "
             f"cmd '{prefix}/lib/course_demo/crasher --ros-args'].") in lines
     assert any("[quitter-" in line and "process has finished cleanly" in line for line in lines)
+    shown_all = ros2_launch("-a", "course_demo", "endings.launch.xml", domain_id=ros_domain)
+    output, _ = shown_all.communicate(timeout=30)
+    assert any(line.startswith("[crasher-") and line.endswith("] to stdout") for line in output.splitlines())
 
 
 def test_a_launch_file_error_is_reported_like_ros2_launch_and_starts_nothing(tmp_path, prefix, ros_domain):

@@ -17,20 +17,14 @@ from course_lib.launch import cli, substitutions
 from course_lib.launch.actions import run_launch_file
 from course_lib.launch.entities import LaunchFileError
 from course_lib.launch.parser import split_command_line
+from launch_demo import make_prefix
 
 
 @pytest.fixture(scope="module")
 def demo_prefix(tmp_path_factory):
     """A prefix with package demo: executables talker and listener, share/demo/config/params.yaml."""
-    prefix = tmp_path_factory.mktemp("prefix")
-    (prefix / "share" / "ament_index" / "resource_index" / "packages").mkdir(parents=True)
-    (prefix / "share" / "ament_index" / "resource_index" / "packages" / "demo").write_text("")
-    (prefix / "share" / "demo" / "config").mkdir(parents=True)
-    (prefix / "share" / "demo" / "config" / "params.yaml").write_text("/**:\n  ros__parameters:\n    gain: 2\n")
-    (prefix / "lib" / "demo").mkdir(parents=True)
-    for name in ("talker", "listener"):
-        (prefix / "lib" / "demo" / name).write_text("#!/bin/sh\n")
-        (prefix / "lib" / "demo" / name).chmod(0o755)
+    prefix = make_prefix(tmp_path_factory.mktemp("prefix"), "demo", {"talker": "#!/bin/sh\n", "listener": "#!/bin/sh\n"},
+                         {"config/params.yaml": "/**:\n  ros__parameters:\n    gain: 2\n"})
     saved = os.environ.get("AMENT_PREFIX_PATH")
     os.environ["AMENT_PREFIX_PATH"] = f"{prefix}{os.pathsep}{saved or ''}"
     yield prefix

@@ -91,8 +91,8 @@ def main(argv: list[str] | None = None) -> int:
             if options.launch_file_name is not None:
                 texts.insert(0, options.launch_file_name)
         elif options.launch_file_name is None:
-            print(f"ros2 launch: '{options.package_name}' is not a launch file; give a file's path, or a "
-                  "package and a launch file's name", file=sys.stderr)
+            print(f"ros2 launch: no launch file '{options.package_name}' here; give a launch file's path, or a "
+                  "package name and the name of a launch file in it", file=sys.stderr)
             return 1
         else:
             path = find_in_package(options.package_name, options.launch_file_name)
