@@ -10,11 +10,11 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-#: An rclpy node named after its executable: it publishes on chatter, listens on heard,
-#: declares whatever parameters it is given, prints COURSE_GREETING from its environment to
-#: stdout and logs "started" (to stderr, like every ROS log line).
-CHATTER_NODE = f'''#!{sys.executable}
-import os
+#: An rclpy node (a module with main(), as setup.py's entry points want) named after its
+#: executable: it publishes "Hello World: N" on chatter at 10 Hz, listens on heard, declares
+#: whatever parameters it is given, prints COURSE_GREETING from its environment to stdout and
+#: logs "started" (to stderr, like every ROS log line).
+CHATTER_SOURCE = """import os
 import sys
 
 import rclpy
@@ -26,14 +26,20 @@ from std_msgs.msg import String
 class Chatter(Node):
     def __init__(self):
         super().__init__(os.path.basename(sys.argv[0]), automatically_declare_parameters_from_overrides=True)
-        self.publisher = self.create_publisher(String, "chatter", 10)
-        self.subscription = self.create_subscription(String, "heard", lambda msg: None, 10)
-        print(f"COURSE_GREETING={{os.environ.get('COURSE_GREETING')}}", flush=True)
-        self.get_logger().info("started")
+        self.count = 0
+        self.publisher = self.create_publisher(String, 'chatter', 10)
+        self.subscription = self.create_subscription(String, 'heard', lambda msg: None, 10)
+        self.timer = self.create_timer(0.1, self.talk)
+        print(f"COURSE_GREETING={os.environ.get('COURSE_GREETING')}", flush=True)
+        self.get_logger().info('started')
+
+    def talk(self):
+        self.count += 1
+        self.publisher.publish(String(data=f'Hello World: {self.count}'))
 
 
-def main():
-    rclpy.init()
+def main(args=None):
+    rclpy.init(args=args)
     node = None
     try:
         node = Chatter()
@@ -46,8 +52,12 @@ def main():
         rclpy.try_shutdown()
 
 
-main()
-'''
+if __name__ == '__main__':
+    main()
+"""
+
+#: The same node as an executable script of this interpreter (what lib/<package>/ holds).
+CHATTER_NODE = f"#!{sys.executable}\n{CHATTER_SOURCE}"
 
 
 def make_prefix(prefix: Path, package: str, executables: dict[str, str], share: dict[str, str]) -> Path:

@@ -20,7 +20,7 @@ import psutil
 import pytest
 
 from course_lib import graph, launch, rosenv, session, workspace
-from launch_demo import CHATTER_NODE, make_prefix
+from launch_demo import CHATTER_NODE, CHATTER_SOURCE, make_prefix
 
 EVERY_TAG = """\
 <launch>
@@ -278,44 +278,9 @@ def test_a_kernel_that_ends_takes_its_launches_with_it(prefix, ending):
 
 # --- a real colcon-built package ---------------------------------------------------------------
 
-TALKER = '''import rclpy
-from rclpy.executors import ExternalShutdownException
-from rclpy.node import Node
-from std_msgs.msg import String
-
-
-class Talker(Node):
-    """Publish 'Hello World: N' on chatter at the rate its parameter asks."""
-
-    def __init__(self):
-        super().__init__('talker')
-        self.rate = self.declare_parameter('rate', 1.0).value
-        self.count = 0
-        self.publisher = self.create_publisher(String, 'chatter', 10)
-        self.timer = self.create_timer(1.0 / self.rate, self.talk)
-
-    def talk(self):
-        self.count += 1
-        self.publisher.publish(String(data=f'Hello World: {self.count}'))
-
-
-def main(args=None):
-    rclpy.init(args=args)
-    node = None
-    try:
-        node = Talker()
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
-'''
-
 TALK_XML = """<launch>
   <arg name="rate" default="2.0"/>
-  <node pkg="launch_tutorial" exec="talker" name="talker" namespace="tutorial">
+  <node pkg="launch_tutorial" exec="talker" namespace="tutorial">
     <param name="rate" value="$(var rate)"/>
     <remap from="chatter" to="talk"/>
   </node>
@@ -327,7 +292,6 @@ TALK_YAML = """launch:
 - node:
     pkg: launch_tutorial
     exec: talker
-    name: talker
     namespace: tutorial
     param: [{name: rate, value: $(var rate)}]
     remap: [{from: chatter, to: talk}]
@@ -336,11 +300,11 @@ TALK_YAML = """launch:
 
 @pytest.fixture(scope="module")
 def tutorial_ws(tmp_path_factory):
-    """An ament_python package with a talker and the same launch file as XML and YAML, installed
-    to share/launch_tutorial/launch by setup.py, built once with the real colcon."""
+    """An ament_python package with a talker (launch_demo's node) and the same launch file as XML
+    and YAML, installed to share/launch_tutorial/launch by setup.py, built once with the real colcon."""
     ws = tmp_path_factory.mktemp("launch_ws")
     package = workspace.create_package(ws, "launch_tutorial", dependencies=["rclpy", "std_msgs"], node_name="talker")
-    (package / "launch_tutorial" / "talker.py").write_text(TALKER)
+    (package / "launch_tutorial" / "talker.py").write_text(CHATTER_SOURCE)
     (package / "launch").mkdir()
     (package / "launch" / "talk.launch.xml").write_text(TALK_XML)
     (package / "launch" / "talk.launch.yaml").write_text(TALK_YAML)

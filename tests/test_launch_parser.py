@@ -403,6 +403,7 @@ class FakeContext:
     ("$(var nothing 'a default')", "a default"),
     ("$(env NOTHING '')", ""),
     ("$(env NOTHING $(var robot))", "r1"),
+    ("$(var robot $(var missing))", "r1"),  # a default is only performed when needed
     ('$(var "$(var robot)_missing" "x $(var robot)")', "x r1"),
     (r"\$(var robot) is text", "$(var robot) is text"),
     (r"$(var a\(b\) c\))", "c)"),

@@ -30,6 +30,13 @@ SUPPORTED = {
 NOT_SUPPORTED = ("eval", "command", "anon", "not", "and", "or", "any", "all", "equals", "not-equals",
                  "if", "file-content", "find-exec", "exec-in-pkg", "param", "launch_log_dir", "log_dir")
 
+#: What a missing launch configuration or environment variable is told, with the fix.
+_MISSING = {
+    "var": ("launch configuration '{name}' does not exist: declare it with <arg name=\"{name}\" default=\"...\"/> "
+            "(or <let>) before it is used, or pass {name}:=VALUE"),
+    "env": "environment variable '{name}' does not exist: set it, or give a default: $(env {name} DEFAULT)",
+}
+
 _IDENTIFIER = re.compile(r"[A-Za-z][A-Za-z0-9_-]*")
 _ESCAPED = re.compile(r"\\(.)")
 
@@ -57,27 +64,19 @@ class Substitution:
         Raises:
             LaunchFileError: an argument or variable that does not exist, a missing package.
         """
-        values = [perform(arg, context) for arg in self.args]
-        if self.name == "var":
-            if values[0] in context.configurations:
-                return context.configurations[values[0]]
-            if len(values) == 2:
-                return values[1]
-            raise self.error(f"launch configuration '{values[0]}' does not exist: declare it with "
-                             f"<arg name=\"{values[0]}\" default=\"...\"/> (or <let>) before it is used, "
-                             f"or pass {values[0]}:=VALUE")
-        if self.name == "env":
-            if values[0] in context.environment:
-                return context.environment[values[0]]
-            if len(values) == 2:
-                return values[1]
-            raise self.error(f"environment variable '{values[0]}' does not exist: set it, or give a "
-                             f"default: $(env {values[0]} DEFAULT)")
+        first = perform(self.args[0], context) if self.args else None
+        if self.name in ("var", "env"):
+            known = context.configurations if self.name == "var" else context.environment
+            if first in known:
+                return known[first]
+            if len(self.args) == 2:  # the default is only performed when it is needed
+                return perform(self.args[1], context)
+            raise self.error(_MISSING[self.name].format(name=first))
         if self.name in ("find-pkg-share", "find-pkg-prefix"):
             from course_lib import ament
 
             try:
-                found = ament.share(values[0]) if self.name == "find-pkg-share" else ament.prefix(values[0])
+                found = ament.share(first) if self.name == "find-pkg-share" else ament.prefix(first)
             except LookupError as error:
                 raise self.error(str(error)) from None
             return str(found)
