@@ -214,7 +214,8 @@ def test_processes_that_end_are_reported_and_then_the_launch_ends(prefix, ros_do
 
 def test_a_launch_file_error_is_reported_like_ros2_launch_and_starts_nothing(tmp_path, prefix, ros_domain):
     path = tmp_path / "bad.launch.xml"
-    path.write_text('<launch>\n  <node pkg="course_demo" exec="sleeper"/>\n  <node pkg="course_demo" exec="nope"/>\n</launch>\n')
+    path.write_text('<launch>\n  <node pkg="course_demo" exec="sleeper"/>\n'
+                    '  <node pkg="course_demo" exec="nope"/>\n</launch>\n')
     process = ros2_launch(str(path), domain_id=ros_domain)
     output, _ = process.communicate(timeout=30)
     assert process.returncode == 1
@@ -311,8 +312,8 @@ def tutorial_ws(tmp_path_factory):
     setup = (package / "setup.py").read_text()
     installed = "('share/' + package_name, ['package.xml']),"
     assert installed in setup
-    (package / "setup.py").write_text(setup.replace(installed, installed + "\n        ('share/' + package_name + "
-                                                    "'/launch', ['launch/talk.launch.xml', 'launch/talk.launch.yaml']),"))
+    launch_files = "('share/' + package_name + '/launch', ['launch/talk.launch.xml', 'launch/talk.launch.yaml']),"
+    (package / "setup.py").write_text(setup.replace(installed, f"{installed}\n        {launch_files}"))
     workspace.build(ws, timeout=600)
     return ws
 

@@ -7,6 +7,7 @@ produce. The package `demo` lives in a temporary prefix with an ament index mark
 
 import os
 import re
+import tempfile
 import textwrap
 from pathlib import Path
 
@@ -23,12 +24,19 @@ from launch_demo import make_prefix
 @pytest.fixture(scope="module")
 def demo_prefix(tmp_path_factory):
     """A prefix with package demo: executables talker and listener, share/demo/config/params.yaml."""
-    prefix = make_prefix(tmp_path_factory.mktemp("prefix"), "demo", {"talker": "#!/bin/sh\n", "listener": "#!/bin/sh\n"},
+    prefix = make_prefix(tmp_path_factory.mktemp("prefix"), "demo",
+                         {"talker": "#!/bin/sh\n", "listener": "#!/bin/sh\n"},
                          {"config/params.yaml": "/**:\n  ros__parameters:\n    gain: 2\n"})
     saved = os.environ.get("AMENT_PREFIX_PATH")
     os.environ["AMENT_PREFIX_PATH"] = f"{prefix}{os.pathsep}{saved or ''}"
     yield prefix
     os.environ["AMENT_PREFIX_PATH"] = saved or ""
+
+
+@pytest.fixture(autouse=True)
+def parameter_files_in_tmp_path(tmp_path, monkeypatch):
+    """The parameter files a launch writes go to the test's own folder."""
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
 
 
 def write(folder: Path, form: str, xml: str, yaml_text: str, name: str = "test") -> Path:
@@ -231,7 +239,8 @@ def test_param_from_a_file_is_passed_as_it_is(tmp_path, demo_prefix, form):
 
 def test_a_missing_parameter_file_is_warned_about_and_skipped(tmp_path, demo_prefix):
     """As launch_ros does: a warning, and the node starts without it."""
-    path = write(tmp_path, "xml", '<launch><node pkg="demo" exec="talker"><param from="nope.yaml"/></node></launch>', "")
+    path = write(tmp_path, "xml", '<launch><node pkg="demo" exec="talker"><param from="nope.yaml"/></node></launch>',
+                 "")
     context = run_launch_file(path)
     assert "--params-file" not in context.nodes[0].command
     assert context.warnings == [("launch_ros.actions.node",
@@ -422,7 +431,8 @@ def test_find_pkg_share_and_prefix_use_the_ament_index(demo_prefix):
 
 @pytest.mark.parametrize("text, message", [
     ("$(var missing)", "launch configuration 'missing' does not exist"),
-    ("$(env COURSE_NOT_SET)", r"environment variable 'COURSE_NOT_SET' does not exist.*\$\(env COURSE_NOT_SET DEFAULT\)"),
+    ("$(env COURSE_NOT_SET)",
+     r"environment variable 'COURSE_NOT_SET' does not exist.*\$\(env COURSE_NOT_SET DEFAULT\)"),
 ])
 def test_missing_values_are_errors_that_name_them(text, message):
     with pytest.raises(LaunchFileError, match=message):
@@ -570,9 +580,11 @@ def test_show_args_of_a_package_file_without_arguments(tmp_path, demo_prefix, ca
 
 
 @pytest.mark.parametrize("argv, message", [
-    (["demo", "missing.launch.xml"], "file 'missing.launch.xml' was not found in the share directory of package 'demo'"),
+    (["demo", "missing.launch.xml"],
+     "file 'missing.launch.xml' was not found in the share directory of package 'demo'"),
     (["nopkg", "x.launch.xml"], "Package 'nopkg' not found"),
-    (["--print", "x.launch.xml"], r"-p/--print is not supported by the course's ros2 launch \(it supports -s/--show-args"),
+    (["--print", "x.launch.xml"],
+     r"-p/--print is not supported by the course's ros2 launch \(it supports -s/--show-args"),
     (["--launch-prefix", "gdb", "x.launch.xml"], "--launch-prefix is not supported"),
     (["FILE", "rate=5"], "malformed launch argument 'rate=5', expected format '<name>:=<value>'"),
 ])

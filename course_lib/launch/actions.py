@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import os
 import re
+import shutil
 import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -52,10 +53,16 @@ class LaunchContext:
         self.configurations, self.environment = self._scopes.pop()
 
     def temp_dir(self) -> Path:
-        """A folder for the parameter files of this launch (removed when the launch ends)."""
+        """A folder for the parameter files of this launch (see remove_files)."""
         if self._temp_dir is None:
             self._temp_dir = Path(tempfile.mkdtemp(prefix="course_lib-launch-"))
         return self._temp_dir
+
+    def remove_files(self) -> None:
+        """Remove the parameter files written for the nodes (once they have read them)."""
+        if self._temp_dir is not None:
+            shutil.rmtree(self._temp_dir, ignore_errors=True)
+            self._temp_dir = None
 
 
 @dataclass
@@ -305,8 +312,13 @@ def run_launch_file(path, arguments: dict | None = None, environment: dict | Non
     """
     path = Path(os.path.abspath(path))
     context = LaunchContext(environment=environment, current_file=path)
-    IncludeLaunchDescription(path=[str(path)], arguments=[([name], [value]) for name, value in (arguments or {}).items()],
-                             file=path, line=0, from_command_line=True).run(context)
+    given = [([name], [value]) for name, value in (arguments or {}).items()]
+    try:
+        IncludeLaunchDescription(path=[str(path)], arguments=given, file=path, line=0,
+                                 from_command_line=True).run(context)
+    except BaseException:
+        context.remove_files()
+        raise
     return context
 
 

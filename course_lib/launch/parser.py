@@ -89,8 +89,8 @@ def _arg(entity: Entity):
 
 
 def _let(entity: Entity):
-    return (SetLaunchConfiguration(name=_text(entity, "name", required=True), value=_text(entity, "value", required=True),
-                                   **_where(entity)),
+    return (SetLaunchConfiguration(name=_text(entity, "name", required=True),
+                                   value=_text(entity, "value", required=True), **_where(entity)),
             f"name, value, {_CONDITION}")
 
 

@@ -23,7 +23,6 @@ import atexit
 import datetime
 import itertools
 import os
-import shutil
 import signal
 import socket
 import threading
@@ -234,8 +233,8 @@ class Launch:
     def _finish(self) -> None:
         with self._lock:
             self._log_file.close()
-        if self._context is not None and self._context._temp_dir is not None:
-            shutil.rmtree(self._context._temp_dir, ignore_errors=True)
+        if self._context is not None:
+            self._context.remove_files()
         self._done.set()
 
     def running(self) -> bool:
