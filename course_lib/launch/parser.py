@@ -113,25 +113,22 @@ def _group(entity: Entity):
             f"scoped, {_CONDITION}, and tags inside it")
 
 
+def _pairs(entity: Entity, kind: str, first: str, second: str) -> list[tuple[list, list]]:
+    """The nested tags of one kind that hold two attributes (``<remap from= to=/>``), in order."""
+    pairs = []
+    for tag in entity.nested(kind):
+        pairs.append((_text(tag, first, required=True), _text(tag, second, required=True)))
+        tag.check_all_read(f"{first}, {second}")
+    return pairs
+
+
 def _include(entity: Entity):
-    arguments = []
-    for argument in entity.nested("arg"):
-        arguments.append((_text(argument, "name", required=True), _text(argument, "value", required=True)))
-        argument.check_all_read("name, value")
-    return (IncludeLaunchDescription(path=_text(entity, "file", required=True), arguments=arguments,
-                                     **_where(entity)),
+    return (IncludeLaunchDescription(path=_text(entity, "file", required=True),
+                                     arguments=_pairs(entity, "arg", "name", "value"), **_where(entity)),
             f"file, {_CONDITION}, nested <arg name= value=>")
 
 
 def _node(entity: Entity):
-    remappings = []
-    for remap in entity.nested("remap"):
-        remappings.append((_text(remap, "from", required=True), _text(remap, "to", required=True)))
-        remap.check_all_read("from, to")
-    environment = []
-    for variable in entity.nested("env"):
-        environment.append((_text(variable, "name", required=True), _text(variable, "value", required=True)))
-        variable.check_all_read("name, value")
     arguments = _text(entity, "args")
     ros_arguments = _text(entity, "ros_args")
     node = Node(package=_text(entity, "pkg"), executable=_text(entity, "exec", required=True),
@@ -139,8 +136,9 @@ def _node(entity: Entity):
                 exec_name=_text(entity, "exec_name"), output=_text(entity, "output"),
                 arguments=[] if arguments is None else split_command_line(arguments),
                 ros_arguments=None if ros_arguments is None else split_command_line(ros_arguments),
-                parameters=_parameters(entity.nested("param")), remappings=remappings,
-                environment=environment, **_where(entity))
+                parameters=_parameters(entity.nested("param")),
+                remappings=_pairs(entity, "remap", "from", "to"),
+                environment=_pairs(entity, "env", "name", "value"), **_where(entity))
     return node, (f"pkg, exec, name, namespace, exec_name, output, args, ros_args, {_CONDITION}, "
                   "nested <param>, <remap>, <env>")
 
