@@ -423,7 +423,8 @@ class Context:
         Args:
             function: the name of a function of the student's module.
             calls: (args, kwargs) per call; args may hold numpy arrays, kwargs plain JSON values.
-            timeout: seconds for all calls together (after the import); default: what is left.
+            timeout: seconds for the import and all calls together; default (and at most): what is
+                left of the check's time, so the check always has time to report.
 
         Returns:
             One Outcome per call. Calls that did not run because the process died or ran out of
@@ -433,8 +434,8 @@ class Context:
         try:
             _write_calls(job, calls)
             timeout = min(timeout or self.remaining(), self.remaining())
-            proc = self._run_student("call", function, job, timeout)
-            return _read_outcomes(job, len(calls), proc, timeout)
+            proc, call_seconds = self._run_student("call", function, job, timeout)
+            return _read_outcomes(job, len(calls), proc, call_seconds)
         finally:
             shutil.rmtree(job, ignore_errors=True)
 
@@ -445,7 +446,7 @@ class Context:
         job = Path(tempfile.mkdtemp(prefix="autograder-endpoints-"))
         try:
             timeout = min(timeout, self.remaining())
-            proc = self._run_student("endpoints", class_name, job, timeout)
+            proc, _seconds = self._run_student("endpoints", class_name, job, timeout)
             try:
                 return json.loads((job / "endpoints.json").read_text())
             except (OSError, ValueError):
@@ -455,26 +456,41 @@ class Context:
             shutil.rmtree(job, ignore_errors=True)
 
     def _run_student(self, command: str, target: str, job: Path, timeout: float):
-        """Run ``python -m course_lib.checks.student COMMAND MODULE TARGET JOB`` to its end (or `timeout`
-        seconds after the import); raise StudentError when the module does not import."""
+        """Run ``python -m course_lib.checks.student COMMAND MODULE TARGET JOB`` to its end, or until
+        `timeout` seconds (import included, never past the check's own time) have passed.
+
+        Returns:
+            (the stopped process, the seconds its calls had after the import).
+
+        Raises:
+            StudentError: the module did not import.
+        """
         from course_lib import processes
 
         self.require_module()
         _give_to_student(job)
+        timeout = min(timeout, self.remaining())
+        deadline = time.monotonic() + timeout
         proc = processes.NodeProcess([sys.executable, "-m", "course_lib.checks.student", command, self.module, target, str(job)],
                                      name=f"student-{target}", cwd=self.workdir, domain_id=self.domain_id,
-                                     limits=_student_limits(IMPORT_TIMEOUT + timeout), env=_student_env())
+                                     limits=_student_limits(timeout + 2), env=_student_env())
         proc.start()
+        import_wait = min(IMPORT_TIMEOUT, timeout)
+        call_seconds = 0.0
         try:
-            imported = _wait_for_file(job / "imported", IMPORT_TIMEOUT, proc)
+            imported = _wait_for_file(job / "imported", import_wait, proc)
             if not imported and proc.running():
+                if import_wait < IMPORT_TIMEOUT:
+                    raise StudentError(f"importing {self.module} did not finish within the {import_wait:.0f} s "
+                                       "this check had left (the machine may be busy; the import itself took long)")
                 _mark(self.workdir / IMPORT_HANG_MARK)
                 raise StudentError(f"importing {self.module} did not finish within {IMPORT_TIMEOUT:g} s: "
                                    "remove code that runs forever at import (loops, spin()) from the "
                                    "top level of the module; put it in main()")
             if imported:
+                call_seconds = max(0.0, deadline - time.monotonic())
                 try:
-                    proc.wait(timeout)
+                    proc.wait(call_seconds)
                 except TimeoutError:
                     pass
         finally:
@@ -482,7 +498,7 @@ class Context:
         if not (job / "imported").exists():
             raise StudentError(f"{self.module} could not be imported ({proc.describe_exit()}):\n"
                                f"{_tail(proc.log, 6)}")
-        return proc
+        return proc, call_seconds
 
     def start_node(self, *ros_args: str, entry: str = "main"):
         """Start the student's node (``<module>:main``) in this check's ROS domain; stopped at the end.
