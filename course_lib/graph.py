@@ -60,7 +60,7 @@ def _graph_node():
 
 
 def wait_for_discovery(minimum: float | None = None, quiet: float = _SETTLE_QUIET,
-                       others: float = 0.0) -> None:
+                       complete_within: float = 0.0) -> None:
     """Wait until discovery has shown the graph to the tool node; later queries do not wait.
 
     The functions of this module call it on the tool node's first use, with the defaults;
@@ -71,28 +71,52 @@ def wait_for_discovery(minimum: float | None = None, quiet: float = _SETTLE_QUIE
         minimum: seconds after the tool node's creation to wait at least (default
             SETTLE_SECONDS).
         quiet: then wait until the graph has not changed for this long.
-        others: while the graph shows no node but the tool node, wait up to this many seconds
-            after its creation for another one (on a busy machine discovery can take seconds).
+        complete_within: also wait, up to this many seconds after the tool node's creation,
+            while the graph shows fewer nodes of other processes than there are other DDS
+            participants on this machine in this domain (each ROS process has one, holding its
+            nodes). On a busy machine some of them take seconds to be discovered.
 
     The wait never lasts longer than 5 s after the tool node's creation.
     """
     global _settled_node
     node = session.tool_node()
     minimum = SETTLE_SECONDS if minimum is None else minimum
-    me = node.get_fully_qualified_name()
+    others_here = _participants_here(node.context.get_domain_id()) - 1 if complete_within else 0
+    ours = 1 + len(session.nodes())  # the nodes of this process share its participant
     last = _snapshot(node)
     quiet_since = time.monotonic()
     while True:
         now = time.monotonic()
         age = now - node.created_at
-        alone = age < others and all(name == me for name in last[0])
-        if age >= _SETTLE_MAX or (age >= minimum and now - quiet_since >= quiet and not alone):
+        missing = age < complete_within and len(last[0]) - ours < others_here
+        if age >= _SETTLE_MAX or (age >= minimum and now - quiet_since >= quiet and not missing):
             break
         time.sleep(_SETTLE_POLL)
         current = _snapshot(node)
         if current != last:
             last, quiet_since = current, time.monotonic()
     _settled_node = node
+
+
+def _participants_here(domain_id: int) -> int:
+    """How many DDS participants run on this machine in a domain.
+
+    Each binds the UDP port 7400 + 250 * domain + 10 + 2 * (its participant id) for discovery
+    traffic (the RTPS standard port mapping), so /proc/net/udp tells. 0 when it cannot.
+    """
+    first = 7410 + 250 * domain_id
+    ports = set()
+    for table in ("/proc/net/udp", "/proc/net/udp6"):
+        try:
+            with open(table) as handle:
+                rows = handle.read().splitlines()[1:]
+        except OSError:
+            continue
+        for row in rows:
+            port = int(row.split()[1].rsplit(":", 1)[1], 16)
+            if first <= port < first + 240 and (port - first) % 2 == 0:
+                ports.add(port)
+    return len(ports)
 
 
 def _snapshot(node):

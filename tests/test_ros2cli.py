@@ -87,6 +87,18 @@ def ros2(*args, env, timeout=60, check=True):
     return done
 
 
+def ros2_together(*commands, env, timeout=60):
+    """Run several independent ros2 commands at the same time (each one mostly waits for
+    discovery); their CompletedProcesses, in order."""
+    started = [subprocess.Popen([str(ROS2), *args], env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                text=True, stdin=subprocess.DEVNULL) for args in commands]
+    done = []
+    for args, process in zip(commands, started):
+        out, err = process.communicate(timeout=timeout)
+        done.append(subprocess.CompletedProcess([str(ROS2), *args], process.returncode, out, err))
+    return done
+
+
 @pytest.fixture(scope="module")
 def live(tmp_path_factory):
     """A talker and a listener in processes of their own, on a reserved domain; yields ros2's env."""
@@ -166,12 +178,11 @@ def test_topic_list(live):
 
 
 def test_topic_echo(live):
-    once = ros2("topic", "echo", "/cli_chatter", "--once", env=live.env).stdout
-    assert re.fullmatch(r"data: hello \d+\n---\n", once), once
-    field = ros2("topic", "echo", "cli_chatter", "std_msgs/msg/String", "--field", "data", "--timeout", "30",
-                 env=live.env).stdout
-    numbers = [int(line.split()[1]) for line in field.split("---\n")[:-1]]
-    assert len(numbers) > 1 and numbers == list(range(numbers[0], numbers[0] + len(numbers))), field
+    once, field = ros2_together(["topic", "echo", "/cli_chatter", "--once"],
+                                ["topic", "echo", "cli_chatter", "std_msgs/msg/String", "--field", "data", "--once"],
+                                env=live.env)
+    assert re.fullmatch(r"data: hello \d+\n---\n", once.stdout), once
+    assert re.fullmatch(r"hello \d+\n---\n", field.stdout), field
 
 
 def test_topic_hz_prints_rates_until_ctrl_c(live):
@@ -194,9 +205,9 @@ def test_topic_hz_prints_rates_until_ctrl_c(live):
 
 
 def test_topic_info(live):
-    short = ros2("topic", "info", "/cli_chatter", env=live.env).stdout
+    short, verbose = (done.stdout for done in ros2_together(["topic", "info", "/cli_chatter"],
+                                                            ["topic", "info", "-v", "/cli_chatter"], env=live.env))
     assert short == "Type: std_msgs/msg/String\nPublisher count: 1\nSubscription count: 1\n"
-    verbose = ros2("topic", "info", "-v", "/cli_chatter", env=live.env).stdout
     assert "\n\nNode name: cli_talker\nNode namespace: /\nTopic type: std_msgs/msg/String\n" in verbose
     assert "Endpoint type: SUBSCRIPTION\n" in verbose and verbose.endswith("\n\n")
 
@@ -222,18 +233,21 @@ def test_param_list(live):
 
 
 def test_param_get(live):
-    assert ros2("param", "get", "/cli_talker", "greeting", env=live.env).stdout == "String value is: hello\n"
-    unset = ros2("param", "get", "/cli_talker", "nope", env=live.env, check=False)
+    found, unset, missing = ros2_together(["param", "get", "/cli_talker", "greeting"],
+                                          ["param", "get", "/cli_talker", "nope"],
+                                          ["param", "get", "/ghost", "rate", "--timeout", "0", "--spin-time", "0.1"],
+                                          env=live.env)
+    assert found.stdout == "String value is: hello\n"
     assert (unset.returncode, unset.stderr) == (1, "Parameter not set\n")
-    missing = ros2("param", "get", "/ghost", "rate", "--timeout", "0", "--spin-time", "0.1", env=live.env,
-                   check=False)
     assert (missing.returncode, missing.stderr) == (1, "Node not found\n")
 
 
 def test_param_set_goes_through_the_nodes_callback(live):
     """Accepted: the node has the value. Rejected: ros2cli's message with the node's reason."""
-    assert ros2("param", "set", "/cli_talker", "rate", "5.0", env=live.env).stdout == "Set parameter successful\n"
-    refused = ros2("param", "set", "/cli_talker", "rate", "-1.0", env=live.env)
+    accepted, refused = ros2_together(["param", "set", "/cli_talker", "rate", "5.0"],
+                                      ["param", "set", "/cli_talker", "rate", "-1.0"], env=live.env)
+    assert accepted.stdout == "Set parameter successful\n" and accepted.returncode == 0
+    assert refused.returncode == 0  # ros2cli too: a refusal is printed, not an error exit
     assert refused.stderr == "Setting parameter failed: rate must be positive\n" and refused.stdout == ""
     assert ros2("param", "get", "/cli_talker", "rate", env=live.env).stdout == "Double value is: 5.0\n"
 
@@ -251,9 +265,8 @@ def test_param_dump_is_a_params_file(live, tmp_path):
     """Dump a node's parameters, start it again with --params-file the dump: it has the value."""
     name = "cli_dumped"
     args = [sys.executable, str(live.script), "talker", "--ros-args", "-r", f"__node:={name}"]
-    with processes.NodeProcess(args, domain_id=live.domain_id) as first:
+    with processes.NodeProcess(args + ["-p", "greeting:=dumped"], domain_id=live.domain_id) as first:
         first.wait_for_node(name, timeout=30)
-        ros2("param", "set", f"/{name}", "greeting", "dumped", env=live.env)
         dump = ros2("param", "dump", f"/{name}", env=live.env).stdout
     assert dump.startswith(f"/{name}:\n  ros__parameters:\n    greeting: dumped\n    limits:\n      low: 1\n")
     path = tmp_path / "dumped.yaml"

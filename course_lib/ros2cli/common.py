@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import argparse
 import sys
-import time
 import typing
 
 #: The end of every "not supported" line.
@@ -17,8 +16,9 @@ DEFAULT_SPIN_TIME = 0.5
 #: Seconds the graph must stay unchanged before a listing verb answers.
 QUIET_SECONDS = 0.2
 
-#: Seconds a listing verb waits for any other node to show while it sees none.
-OTHERS_SECONDS = 3.0
+#: Seconds after its start up to which a listing verb waits for the nodes of the other ROS
+#: processes on this machine (course_lib.graph.wait_for_discovery counts them).
+COMPLETE_SECONDS = 4.0
 
 #: Seconds a verb that names a node or topic waits for discovery to show it, after --spin-time.
 #: It goes on as soon as the name shows. ros2cli waits 1 s (the param verbs' --timeout default),
@@ -108,17 +108,14 @@ def wait_for_whole_graph(spin_time: float) -> None:
     """Before a verb that lists the graph: wait for discovery the way ros2cli without its daemon
     does, spinning ``spin_time`` seconds, and longer where that would answer too early.
 
-    Longer: at least as long as creating this process's own DDS participant took (a busy
-    machine discovers slowly too), until the graph has not changed for a moment, and, while no
-    other node shows at all, up to OTHERS_SECONDS for one.
+    Longer: until the graph has not changed for a moment, and, up to COMPLETE_SECONDS, until
+    the nodes of every other ROS process on this machine show (on a busy machine a new process
+    can take seconds to discover them all).
     """
-    from course_lib import graph, session
+    from course_lib import graph
 
-    began = time.monotonic()
-    session.tool_node()  # creates this process's DDS participant
-    startup = time.monotonic() - began
-    graph.wait_for_discovery(minimum=max(spin_time, startup), quiet=min(QUIET_SECONDS, spin_time),
-                             others=OTHERS_SECONDS)
+    graph.wait_for_discovery(minimum=spin_time, quiet=min(QUIET_SECONDS, spin_time),
+                             complete_within=COMPLETE_SECONDS)
 
 
 def wait_for_named_only() -> None:
