@@ -97,7 +97,7 @@ def _echo_arguments(parser) -> None:
                         help="Set a timeout in seconds for waiting")
 
 
-def _echo(args) -> str | None:
+def _echo(args) -> int | str | None:
     from course_lib import graph
 
     wait_for_named_only()
@@ -105,19 +105,19 @@ def _echo(args) -> str | None:
     if field == []:
         return f"Invalid field value '{args.field}'"
     truncate = None if args.full_length else args.truncate_length
-    printed = []
+    seen = {"messages": 0, "bad field": False}  # counts only: an echo may run for hours
 
     def show(msg):
-        if printed and args.once:
+        if seen["bad field"] or (seen["messages"] and args.once):
             return
         for part in field or ():
             try:
                 msg = getattr(msg, part)
             except AttributeError as error:
                 say(f"Invalid field '{args.field}': {error}", error=True)
-                printed.append(None)
+                seen["bad field"] = True
                 return
-        printed.append(msg)
+        seen["messages"] += 1
         if hasattr(msg, "get_fields_and_field_types"):
             print(graph.format_message(msg, truncate, args.no_arr, args.no_str), end="---\n")
         else:
@@ -126,13 +126,11 @@ def _echo(args) -> str | None:
     qos = qos_from_arguments(args) if qos_overridden(args) else None  # None: what the publishers offer
     try:
         with graph.subscription(args.topic_name, show, args.message_type, args.spin_time + NAMED_TIMEOUT, qos):
-            wait_until(lambda: bool(printed) and (args.once or printed[-1] is None), args.timeout)
+            wait_until(lambda: seen["bad field"] or (args.once and seen["messages"] > 0), args.timeout)
     except TimeoutError:
         say(f"WARNING: topic [{args.topic_name}] does not appear to be published yet")
         return "Could not determine the type for the passed topic"
-    if printed and printed[-1] is None:
-        return 1
-    return None
+    return 1 if seen["bad field"] else None
 
 
 # --- ros2 topic hz -----------------------------------------------------------------------
