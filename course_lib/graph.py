@@ -235,7 +235,7 @@ def message_class(type_name: str):
         return getattr(module, name)
     except AttributeError:
         raise ValueError(f"Package {package} has no {kind} type {name!r}; check the spelling "
-                         f"(graph.topic_list(types=True) shows the types in use)") from None
+                         f"(`ros2 topic list -t` or graph.topic_list(types=True) shows the types in use)") from None
 
 
 def _topic_class(node, topic: str, msg_type, timeout: float | None):
