@@ -4,6 +4,7 @@ Commands:
     doctor            check the ROS 2 environment and run a live pub/sub round trip
     build WS [ARGS]   run the real ``colcon build`` in workspace WS with the right environment
     repair-wheels     make the pip-installed ROS 2 CMake files usable in this environment
+    install-ros2      put the course's `ros2` command into this environment (pip install only)
 """
 
 from __future__ import annotations
@@ -28,6 +29,9 @@ def main(argv: list[str] | None = None) -> int:
     if command == "repair-wheels":
         from course_lib import wheelfix
         return wheelfix.main(rest)
+    if command == "install-ros2":
+        from course_lib.ros2cli import install
+        return install.main(rest)
     print(f"unknown command {command!r}; commands:{USAGE}", file=sys.stderr)
     return 2
 

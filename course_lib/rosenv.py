@@ -142,13 +142,19 @@ def prepare_current_process() -> None:
 
     Only the pip install needs this: the wheels register their packages in sys.prefix's ament
     index, but nothing puts sys.prefix on AMENT_PREFIX_PATH, so ament_index_python (and every
-    tool built on it) finds nothing.
+    tool built on it) finds nothing; and the venv's bin/, where the course's ``ros2`` lives,
+    goes on PATH as activating the venv would put it.
     """
     install = detect_install()
     paths = [p for p in os.environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep) if p]
     missing = [str(p) for p in install.prefixes if str(p) not in paths]
     if missing:
         os.environ["AMENT_PREFIX_PATH"] = os.pathsep.join(paths + missing)
+    bindir = str(Path(sys.executable).parent)
+    if install.kind == "pip" and bindir not in os.environ.get("PATH", "").split(os.pathsep):
+        # The course's `ros2` lives next to this interpreter: `!ros2 ...` in a kernel that was
+        # not started from an activated venv finds it only so.
+        os.environ["PATH"] = os.pathsep.join([bindir] + [p for p in os.environ.get("PATH", "").split(os.pathsep) if p])
     if "ROS_LOCALHOST_ONLY" not in os.environ and "ROS_AUTOMATIC_DISCOVERY_RANGE" not in os.environ:
         os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
         DEFAULTS_APPLIED.add("ROS_AUTOMATIC_DISCOVERY_RANGE")
