@@ -47,8 +47,10 @@ $(VENV)/.setup-done: environment.txt pyproject.toml course_lib/wheelfix.py
 # JupyterLab refuses to run as root unless told; containers and CI often are root.
 ALLOW_ROOT := $(if $(filter 0,$(shell id -u)),--allow-root)
 
+# The server gets the notebook session's ROS variables (Fast DDS set-up for camera frames,
+# discovery range, ament index), so JupyterLab's terminals and `!` commands have them too.
 lab: setup
-	$(VENV)/bin/jupyter lab --no-browser --ip=127.0.0.1 --port=$(LAB_PORT) $(ALLOW_ROOT) \
+	eval "$$($(PY) -m course_lib env)" && exec $(VENV)/bin/jupyter lab --no-browser --ip=127.0.0.1 --port=$(LAB_PORT) $(ALLOW_ROOT) \
 	  --ServerApp.root_dir="$(CURDIR)" --LabApp.default_url=/lab/tree/notebooks
 
 # Browser tests need Debian's chromium. Install it when we may (root with apt); otherwise the
