@@ -507,7 +507,7 @@ MODULES = {"brightness": "brightness_node", "pubsub": "pubsub_nodes", "catdog_wa
 
 def _student_env() -> dict:
     # Fast DDS's set-up for camera frames comes, as for every course process, from
-    # course_lib.rosenv.ros_environment (its shared-memory segments need RLIMIT_FSIZE above 16 MB).
+    # course_lib.rosenv.ros_environment (its shared-memory segments need RLIMIT_FSIZE above 32 MB).
     return {"PYTHONPATH": _pythonpath(), "AUTOGRADER_SEED": None, SEED_ENV: None, STUDENT_UID_ENV: None,
             "PYTHONDONTWRITEBYTECODE": "1"}
 

@@ -34,7 +34,7 @@ SYSTEM_PREFIX = Path("/opt/ros") / DISTRO
 RESERVABLE_DOMAIN_IDS = range(1, 102)
 
 #: The course's Fast DDS profile for camera frames: the default transports (shared memory, then
-#: UDP) with 16 MB shared-memory segments instead of 512 KB. With the defaults a best-effort
+#: UDP) with 32 MB shared-memory segments instead of 512 KB. With the defaults a best-effort
 #: subscriber in another process gets about half of the 640x480 frames and a fifth of the
 #: 1920x1080 ones at 30 Hz; with it, all of them (benchmarks/bench_vision.py measures both).
 FASTDDS_PROFILE = Path(__file__).resolve().with_name("fastdds_large_data.xml")
@@ -42,7 +42,7 @@ FASTDDS_PROFILE = Path(__file__).resolve().with_name("fastdds_large_data.xml")
 #: The variables by which a user picks Fast DDS transports; when one is set the course adds none.
 FASTDDS_USER_SETTINGS = ("FASTRTPS_DEFAULT_PROFILES_FILE", "FASTDDS_BUILTIN_TRANSPORTS")
 
-#: Every ROS process with FASTDDS_PROFILE keeps a 16 MB segment in /dev/shm. Where /dev/shm is
+#: Every ROS process with FASTDDS_PROFILE keeps a 32 MB segment in /dev/shm. Where /dev/shm is
 #: smaller than this (Docker's default is 64 MB), Fast DDS's defaults are kept: with the profile,
 #: the fourth process would print errors and fall back to UDP.
 SHARED_MEMORY_NEEDED_MB = 512
