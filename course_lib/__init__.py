@@ -15,7 +15,7 @@ from course_lib import rosenv as _rosenv
 
 _rosenv.prepare_current_process()
 
-_MODULES = ("camera", "doctor", "graph", "images", "interfaces", "processes", "rosenv", "scenes",
+_MODULES = ("camera", "doctor", "graph", "images", "interfaces", "live", "processes", "rosenv", "scenes",
             "selfcheck", "session", "vision", "wheelfix", "workspace")
 
 
