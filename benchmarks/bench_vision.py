@@ -18,12 +18,12 @@ asserting them. Compare the ratios between rows measured at the same time.
     scenes (in this process), and the MarkerReader node end to end: a publisher sends webcam
     frames as fast as it can, the node crops them, a counter counts frames and cat crops.
 (c) Frame delivery at 640x480 and 1920x1080, 30 Hz: the share of the frames sent that reach a
-    best-effort subscriber in another process, with Fast DDS's defaults and with the course's
-    set-up (course_lib.rosenv.large_data_environment), one after the other in the same run. Two
-    senders: the camera node itself (course_lib.camera.WebcamNode, rendering every frame, so its
-    rate is what the machine can draw) and a 30 Hz timer sending pre-rendered webcam frames.
-    Frames are counted by their header stamps, so the sender's and the receiver's counts cover
-    the same frames.
+    best-effort subscriber in another process, with Fast DDS's defaults, with its LARGE_DATA
+    builtin transports, and with the course's set-up (course_lib.rosenv.large_data_environment),
+    one after the other in the same run. Two senders: the camera node itself
+    (course_lib.camera.WebcamNode, rendering every frame, so its rate is what the machine can
+    draw) and a 30 Hz timer sending pre-rendered webcam frames. Frames are matched by their
+    header stamps, counted from the first one that arrived.
 (a) and (b) run with the course's set-up, as every process course_lib starts.
 """
 
@@ -353,21 +353,24 @@ def main(argv=None) -> int:
     if "c" in args.parts:
         print()
         print(f"(c) frames delivered to a best-effort subscriber in another process, 30 Hz; course set-up: "
-              f"{delivery['setup']}")
+              f"{delivery['setup']}; LARGE_DATA: FASTDDS_BUILTIN_TRANSPORTS={SETUPS['LARGE_DATA']['FASTDDS_BUILTIN_TRANSPORTS']}")
         print()
-        print("| frames | sender | sent (default / course) | default Fast DDS: received | delivered "
-              "| course set-up: received | delivered |")
-        print("|---|---|---:|---:|---:|---:|---:|")
+        print(f"| frames | sender | sent ({' / '.join(SETUPS)}) | "
+              + " | ".join(f"{name}: received of sent" for name in SETUPS) + " |")
+        print("|---|---|---:|" + "---:|" * len(SETUPS))
         for row in delivery["rows"]:
             print("| " + " | ".join(row) + " |")
     return 0
 
 
-#: The two Fast DDS set-ups part (c) compares, as environment changes for the processes. Fast DDS's
-#: defaults are asked for by name (FASTDDS_BUILTIN_TRANSPORTS=DEFAULT), a choice the course keeps.
+#: The Fast DDS set-ups part (c) compares, as environment changes for the processes: the defaults
+#: (asked for by name, a choice the course keeps), the LARGE_DATA builtin transports (TCP for
+#: data, with messages and socket buffers big enough for a 1080p frame), and the course's profile.
 SETUPS = {
-    "default": {"FASTRTPS_DEFAULT_PROFILES_FILE": None, "FASTDDS_BUILTIN_TRANSPORTS": "DEFAULT"},
-    "course": {"FASTRTPS_DEFAULT_PROFILES_FILE": None, "FASTDDS_BUILTIN_TRANSPORTS": None},
+    "default Fast DDS": {"FASTRTPS_DEFAULT_PROFILES_FILE": None, "FASTDDS_BUILTIN_TRANSPORTS": "DEFAULT"},
+    "LARGE_DATA": {"FASTRTPS_DEFAULT_PROFILES_FILE": None,
+                   "FASTDDS_BUILTIN_TRANSPORTS": "LARGE_DATA?max_msg_size=8MB&sockets_size=8MB&non_blocking=true"},
+    "course set-up": {"FASTRTPS_DEFAULT_PROFILES_FILE": None, "FASTDDS_BUILTIN_TRANSPORTS": None},
 }
 
 
@@ -389,7 +392,7 @@ def measure_delivery(seconds, domain_id) -> dict:
             row = [size, label]
             rates = []
             for name, env in SETUPS.items():
-                print(f"(c) delivery at {size}, {sender}, {name} Fast DDS ...", file=sys.stderr)
+                print(f"(c) delivery at {size}, {sender}, {name} ...", file=sys.stderr)
                 results = measure([sender, "receiver"], seconds, domain_id, size=size, frames=2, rate=30.0,
                                   env=env)
                 sent = results[sender]["stamps"]["sent"]
@@ -397,7 +400,8 @@ def measure_delivery(seconds, domain_id) -> dict:
                 rates.append(f"{len(sent) / seconds:.1f}")
                 counted = [stamp for stamp in sent if received and stamp >= min(received)]
                 arrived = sum(stamp in received for stamp in counted)
-                row += [f"{arrived} of {len(counted)}", f"{arrived / len(counted):.0%}" if counted else "none arrived"]
+                row.append(f"{arrived} of {len(counted)} ({arrived / len(counted):.0%})" if counted else
+                           "none arrived")
             rows.append(row[:2] + [" / ".join(rates) + " /s"] + row[2:])
     return {"setup": setup, "rows": rows}
 
