@@ -398,10 +398,9 @@ def measure_delivery(seconds, domain_id) -> dict:
                 sent = results[sender]["stamps"]["sent"]
                 received = set(results["receiver"]["stamps"]["image"])
                 rates.append(f"{len(sent) / seconds:.1f}")
-                counted = [stamp for stamp in sent if received and stamp >= min(received)]
+                counted = [stamp for stamp in sent if stamp >= min(received, default=0)]
                 arrived = sum(stamp in received for stamp in counted)
-                row.append(f"{arrived} of {len(counted)} ({arrived / len(counted):.0%})" if counted else
-                           "none arrived")
+                row.append(f"{arrived} of {len(counted)} ({arrived / len(counted):.0%})" if counted else "none sent")
             rows.append(row[:2] + [" / ".join(rates) + " /s"] + row[2:])
     return {"setup": setup, "rows": rows}
 
