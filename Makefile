@@ -48,12 +48,14 @@ $(VENV)/.setup-done: environment.txt pyproject.toml course_lib/wheelfix.py cours
 # JupyterLab refuses to run as root unless told; containers and CI often are root.
 ALLOW_ROOT := $(if $(filter 0,$(shell id -u)),--allow-root)
 
-# The venv's bin/ goes first on PATH, so that JupyterLab's terminals and `!` cells find its
-# commands (`ros2` on the pip install, python, colcon) as in an activated venv. Terminals run
-# $SHELL without -l: a login shell would read /etc/profile, which sets PATH anew.
+# The server gets the notebook session's ROS variables (Fast DDS set-up for camera frames,
+# discovery range, ament index), so JupyterLab's terminals and `!` commands have them too; the
+# venv's bin/ goes first on PATH, so they find its commands (`ros2` on the pip install, python,
+# colcon) as in an activated venv. Terminals run $SHELL without -l: a login shell would read
+# /etc/profile, which sets PATH anew.
 lab: setup
-	PATH="$(CURDIR)/$(VENV)/bin:$$PATH" VIRTUAL_ENV="$(CURDIR)/$(VENV)" \
-	$(VENV)/bin/jupyter lab --no-browser --ip=127.0.0.1 --port=$(LAB_PORT) $(ALLOW_ROOT) \
+	eval "$$($(PY) -m course_lib env)" && PATH="$(CURDIR)/$(VENV)/bin:$$PATH" VIRTUAL_ENV="$(CURDIR)/$(VENV)" \
+	exec $(VENV)/bin/jupyter lab --no-browser --ip=127.0.0.1 --port=$(LAB_PORT) $(ALLOW_ROOT) \
 	  --ServerApp.root_dir="$(CURDIR)" --LabApp.default_url=/lab/tree/notebooks \
 	  --ServerApp.terminado_settings='{"shell_command": ["'"$${SHELL:-/bin/bash}"'"]}'
 

@@ -71,11 +71,6 @@ STUDENT_FILE_MB = 128
 #: later checks fail at once with the same reason instead of waiting again.
 IMPORT_HANG_MARK = ".autograder-import-hang"
 
-#: Fast DDS profile of check and student processes: a shared-memory transport with 32 MB segments (so a student process needs RLIMIT_FSIZE above that).
-#: With the default transports, best-effort 1920x1080 frames (6 MB, sensor-data QoS) between two
-#: local processes lose most of their UDP fragments: 2-8 of 60 frames arrive. With it, all do.
-FASTDDS_PROFILE = Path(__file__).resolve().parent / "fastdds_large_data.xml"
-
 #: The fixed seed of self-checks (what the student sees when running the notebook).
 SELFCHECK_SEED = 2024
 
@@ -245,8 +240,7 @@ def execute(assignment: str, name: str, seed: int, workdir=None, mode: str = "se
                "--workdir", str(workdir), "--out", str(out)]
     limits = processes.Limits(wall_seconds=spec.timeout + 10, grace_seconds=2.0)
     proc = processes.NodeProcess(command, name=f"autograder-check-{name}", cwd=out, limits=limits,
-                                 env={"PYTHONPATH": _pythonpath(), SEED_ENV: str(seed), answers.MODE_ENV: mode,
-                                      "FASTRTPS_DEFAULT_PROFILES_FILE": str(FASTDDS_PROFILE)})
+                                 env={"PYTHONPATH": _pythonpath(), SEED_ENV: str(seed), answers.MODE_ENV: mode})
     try:
         proc.start()
         try:
@@ -551,9 +545,10 @@ MODULES = {"brightness": "brightness_node", "pubsub": "pubsub_nodes", "catdog_wa
 
 
 def _student_env() -> dict:
+    # Fast DDS's set-up for camera frames comes, as for every course process, from
+    # course_lib.rosenv.ros_environment (its shared-memory segments need RLIMIT_FSIZE above 32 MB).
     return {"PYTHONPATH": _pythonpath(), "AUTOGRADER_SEED": None, SEED_ENV: None, STUDENT_UID_ENV: None,
-            answers.MODE_ENV: None, answers.RECORD_ENV: None,
-            "PYTHONDONTWRITEBYTECODE": "1", "FASTRTPS_DEFAULT_PROFILES_FILE": str(FASTDDS_PROFILE)}
+            answers.MODE_ENV: None, answers.RECORD_ENV: None, "PYTHONDONTWRITEBYTECODE": "1"}
 
 
 #: Set by the grader (as root) for the checks it runs: the uid (and its RLIMIT_NPROC) that the
