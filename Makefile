@@ -30,7 +30,7 @@ endif
 
 setup: $(VENV)/.setup-done
 
-$(VENV)/.setup-done: environment.txt pyproject.toml course_lib/wheelfix.py
+$(VENV)/.setup-done: environment.txt pyproject.toml course_lib/wheelfix.py course_lib/ros2cli/install.py
 	@$(PYTHON) -c 'import sys; v = sys.version_info[:2]; ok = (3, 10) <= v <= (3, 13); \
 	print("Using Python %d.%d from %s" % (v + (sys.executable,))) if ok else \
 	sys.exit("Python %d.%d found, but the ROS 2 Jazzy wheels exist for CPython 3.10-3.13 only. " \
@@ -42,14 +42,22 @@ $(VENV)/.setup-done: environment.txt pyproject.toml course_lib/wheelfix.py
 	@if [ "$(ROS)" != pip ]; then grep -v -E '^(ros-jazzy-|colcon-)' environment.txt > $(REQUIREMENTS); fi
 	$(UV) pip install --quiet --python $(PY) -r $(REQUIREMENTS) -e .
 	$(PY) -m course_lib repair-wheels
+	$(PY) -m course_lib install-ros2
 	@touch $@
 
 # JupyterLab refuses to run as root unless told; containers and CI often are root.
 ALLOW_ROOT := $(if $(filter 0,$(shell id -u)),--allow-root)
 
+# The server gets the notebook session's ROS variables (Fast DDS set-up for camera frames,
+# discovery range, ament index), so JupyterLab's terminals and `!` commands have them too; the
+# venv's bin/ goes first on PATH, so they find its commands (`ros2` on the pip install, python,
+# colcon) as in an activated venv. Terminals run $SHELL without -l: a login shell would read
+# /etc/profile, which sets PATH anew.
 lab: setup
-	$(VENV)/bin/jupyter lab --no-browser --ip=127.0.0.1 --port=$(LAB_PORT) $(ALLOW_ROOT) \
-	  --ServerApp.root_dir="$(CURDIR)" --LabApp.default_url=/lab/tree/notebooks
+	eval "$$($(PY) -m course_lib env)" && PATH="$(CURDIR)/$(VENV)/bin:$$PATH" VIRTUAL_ENV="$(CURDIR)/$(VENV)" \
+	exec $(VENV)/bin/jupyter lab --no-browser --ip=127.0.0.1 --port=$(LAB_PORT) $(ALLOW_ROOT) \
+	  --ServerApp.root_dir="$(CURDIR)" --LabApp.default_url=/lab/tree/notebooks \
+	  --ServerApp.terminado_settings='{"shell_command": ["'"$${SHELL:-/bin/bash}"'"]}'
 
 # Browser tests need Debian's chromium. Install it when we may (root with apt); otherwise the
 # browser tests skip and say why.

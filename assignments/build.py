@@ -51,7 +51,7 @@ def code(text: str, kind: str | None = None, grade_id: str | None = None, points
 
 def test_cell(assignment: str, name: str):
     """The graded cell of one check: the self-check, then the hidden graded run with a fresh seed."""
-    from autograder import harness
+    from course_lib.checks import harness
 
     spec = harness.get_check(assignment, name)
     source = (f"# {spec.description} ({spec.points:g} points)\n"
@@ -70,7 +70,7 @@ import importlib
 import numpy as np
 
 from course_lib import images, rosenv
-from autograder.checks import {assignment} as checks
+from course_lib.checks import {assignment} as checks
 {extra}""", "locked", "setup")
 
 

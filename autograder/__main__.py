@@ -1,4 +1,5 @@
-"""python -m autograder roster|release|collect|grade|feedback|export COURSE_DIR: the instructor's commands."""
+"""python -m autograder roster|release|collect|grade|feedback|export COURSE_DIR, record-answers: the
+instructor's commands."""
 
 from __future__ import annotations
 
@@ -33,6 +34,9 @@ def _parser() -> argparse.ArgumentParser:
     fee.add_argument("--student", help="only this student")
     exp = sub.add_parser("export", help="COURSE_DIR/grades.csv for the LMS: final scores, late penalty applied")
     exp.add_argument("course_dir", type=Path)
+    rec = sub.add_parser("record-answers", help="record the self-checks' answers from the grader's answer keys "
+                         "(after changing a check's inputs or an answer key)")
+    rec.add_argument("assignments", nargs="*", help="default: every assignment with an answer key")
     return parser
 
 
@@ -47,6 +51,12 @@ def main(argv=None) -> int:
 
 
 def _run(parser, args) -> int:
+    if args.command == "record-answers":
+        from autograder import record
+
+        for path in record.record_answers(args.assignments or None):
+            print(path)
+        return 0
     from autograder import grading
 
     if args.command == "roster":

@@ -12,24 +12,12 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from course_lib.checks.validate import apply_student
+
 COURSE_ID = "ros2-jazzy-opencv"
-
-#: Seconds an ordinary (non-graded) cell may run under grading: importing the student's module
-#: imports rclpy, which takes a second or two; anything longer is a loop that must not run at import.
-CELL_TIMEOUT = 30
-
-#: Seconds a graded test cell may run: the longest check plus its start-up. Each check also
-#: bounds itself (harness.Check.timeout); this is the backstop when a kernel stops answering.
-TEST_CELL_TIMEOUT = 150
 
 #: The stub ClearSolutions puts in place of a solution, at the solution's indentation.
 CODE_STUB = "# YOUR CODE HERE\nraise NotImplementedError(\"replace this line with your code\")"
-
-
-def cell_timeout(cell) -> int:
-    """nbclient's timeout_func: graded cells get TEST_CELL_TIMEOUT, all others CELL_TIMEOUT."""
-    meta = cell.get("metadata", {}).get("nbgrader", {})
-    return TEST_CELL_TIMEOUT if meta.get("grade") and not meta.get("solution") else CELL_TIMEOUT
 
 
 def apply(c, root: str | Path | None = None) -> None:
@@ -73,15 +61,6 @@ def quiet_add_submission() -> None:
         return
     warnings.filterwarnings("ignore", message=r"Object of type <Submitted\w+> not in session",
                             category=SAWarning, module=r"nbgrader\.api")
-
-
-def apply_student(c) -> None:
-    """The settings a student's nbgrader needs (the Validate button runs the whole notebook): the
-    course's cell timeouts. nbgrader's default, 30 s for every cell, would cut a node check that
-    grading lets run (a CellTimeoutError the student never gets at grading)."""
-    c.Execute.timeout = TEST_CELL_TIMEOUT
-    c.Execute.timeout_func = cell_timeout
-    c.Execute.interrupt_on_timeout = True
 
 
 #: The line of the course's nbgrader_config.py below which the instructor's settings are kept.

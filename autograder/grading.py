@@ -16,7 +16,7 @@ One submission is graded like this (:func:`grade_submission`, run by a worker th
    run in the student's kernel could be faked by the student's code (patch checks.grade and
    every test cell "passes").
 4. The hidden checks run after the notebook, in a fresh sandbox of the same kind, as processes
-   of the grader (``python -m autograder.harness outside``, root), against the module the
+   of the grader (``python -m course_lib.checks.harness outside``, root), against the module the
    notebook wrote; the student's code they start runs as the worker's uid, with the same limits.
    Their points replace nbgrader's scores of those cells, and their verdicts (seed, what passed
    and failed, pictures) replace the cells' outputs in the autograded notebook.
@@ -53,7 +53,8 @@ import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
-from autograder import config, gradebook, harness, intake, kernel
+from autograder import config, gradebook, intake, kernel
+from course_lib.checks import harness
 
 REPO = Path(__file__).resolve().parent.parent
 REPO_SOURCE = REPO / "assignments" / "source"
@@ -165,9 +166,10 @@ def submission_digest(sub: Submission, course: Path) -> str:
     """Changes when the submission, the assignment's source or the grading code changes."""
     digest = hashlib.sha256()
     _tree_digest([sub.path, course / "source" / sub.assignment], digest)
-    here = Path(__file__).resolve().parent
-    _tree_digest([here / "harness.py", here / "student.py", here / "kernel.py", here / "config.py",
-                  here / "checks" / f"{sub.assignment}.py"], digest)
+    here, checks = Path(__file__).resolve().parent, Path(harness.__file__).resolve().parent
+    code = [here / "kernel.py", here / "config.py", here / "answers" / f"{sub.assignment}.py",
+            checks / "harness.py", checks / "student.py", checks / "answers.py", checks / f"{sub.assignment}.py"]
+    _tree_digest([path for path in code if path.exists()], digest)
     return digest.hexdigest()
 
 
@@ -257,6 +259,23 @@ def _run_sandboxed(command: list[str], hide: list[Path], name: str, domain_id: i
     return proc
 
 
+#: Folders of the repository that a submission's processes never see (empty tmpfs over each):
+#: the reference solutions and the instructor's side (the grader, its answer keys, the tests).
+HIDDEN_FROM_STUDENTS = [REPO / "assignments", REPO / "autograder", REPO / "tests", REPO / "benchmarks"]
+
+
+def stage_grader(work: Path) -> Path:
+    """Copy the autograder package into `work`/grader, readable by root only, and return that
+    folder (first on the sandbox's PYTHONPATH). The sandbox hides the repository's autograder/;
+    the grader's own processes (nbgrader's config, the kernel launcher, the checks' answer keys)
+    import this copy, while the student's uid cannot enter it."""
+    folder = work / "grader"
+    shutil.copytree(Path(__file__).resolve().parent, folder / "autograder",
+                    ignore=shutil.ignore_patterns("__pycache__"))
+    os.chmod(folder, 0o700)
+    return folder
+
+
 def _private_copy(source: Path, target: Path) -> None:
     """Copy a directory tree readable by root only (other workers' uids cannot read it)."""
     shutil.copytree(source, target, ignore=shutil.ignore_patterns(".ipynb_checkpoints"))
@@ -338,11 +357,13 @@ def grade_submission(sub: Submission, course: Path, domain_id: int) -> GradeResu
         for folder in (work / "jupyter", work / "runtime", work / "kernel-tmp"):
             folder.mkdir(exist_ok=True)
             os.chmod(folder, 0o711)
+        grader = stage_grader(work)
         env = {"COURSE_LIB_GRADING": "1", "COURSE_LIB_UNDER_TEST": None, "AUTOGRADER_SEED": None,
                harness.OUTSIDE_ENV: "1",
                "JUPYTER_PATH": str(work / "jupyter"), "JUPYTER_RUNTIME_DIR": str(work / "runtime"),
                "JUPYTER_CONFIG_DIR": str(work / "jupyter-config"), "AUTOGRADER_KERNEL_TMP": str(work / "kernel-tmp"),
-               "PYTHONPATH": _env_for_tools()["PYTHONPATH"], "HOME": str(work), "PYDEVD_DISABLE_FILE_VALIDATION": "1"}
+               "PYTHONPATH": os.pathsep.join([str(grader), _env_for_tools()["PYTHONPATH"]]), "HOME": str(work),
+               "PYDEVD_DISABLE_FILE_VALIDATION": "1"}
         if result.isolation == "root":
             result.kernel_uid = KERNEL_UID_BASE + domain_id
             env.update(AUTOGRADER_KERNEL_UID=str(result.kernel_uid), AUTOGRADER_KERNEL_NPROC=str(NPROC))
@@ -353,7 +374,7 @@ def grade_submission(sub: Submission, course: Path, domain_id: int) -> GradeResu
                 env.update(exposure, AUTOGRADER_STAGE=str(work / "stage"))
         command = [sys.executable, "-m", "nbgrader", "autograde", sub.assignment, "--student", sub.student,
                    "--force", f"--CourseDirectory.root={root}"]
-        hide = [course, REPO / "assignments", REPO / "tests"]
+        hide = [course, *HIDDEN_FROM_STUDENTS]
         limits = processes.Limits(wall_seconds=NOTEBOOK_TIMEOUT, memory_mb=MEMORY_MB, file_size_mb=FILE_MB,
                                   grace_seconds=5.0)
         proc = _run_sandboxed(command, hide, f"autograde {sub.key}", domain_id, env, root, limits)
@@ -410,7 +431,7 @@ def _grade_outside(sub: Submission, result: GradeResult, work: Path, autograded:
         return
     out = work / "checks"
     out.mkdir(mode=0o700)
-    command = [sys.executable, "-m", "autograder.harness", "outside", sub.assignment, *names,
+    command = [sys.executable, "-m", "course_lib.checks.harness", "outside", sub.assignment, *names,
                "--workdir", str(workdir), "--out", str(out)]
     wall = sum(checks[name].timeout + 30 for name in names)
     env = {**env, harness.SEED_ENV: None, "AUTOGRADER_SEED": os.environ.get("AUTOGRADER_SEED")}

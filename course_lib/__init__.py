@@ -15,8 +15,8 @@ from course_lib import rosenv as _rosenv
 
 _rosenv.prepare_current_process()
 
-_MODULES = ("camera", "doctor", "graph", "images", "interfaces", "processes", "rosenv", "scenes",
-            "selfcheck", "session", "vision", "wheelfix", "workspace")
+_MODULES = ("ament", "camera", "doctor", "graph", "images", "interfaces", "launch", "live", "parameters",
+            "processes", "rosenv", "scenes", "selfcheck", "session", "vision", "wheelfix", "workspace")
 
 
 def __getattr__(name):

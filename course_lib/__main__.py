@@ -4,6 +4,9 @@ Commands:
     doctor            check the ROS 2 environment and run a live pub/sub round trip
     build WS [ARGS]   run the real ``colcon build`` in workspace WS with the right environment
     repair-wheels     make the pip-installed ROS 2 CMake files usable in this environment
+    install-ros2      put the course's `ros2` command into this environment (pip install only)
+    env               print the notebook session's ROS variables as shell exports
+                      (eval "$(python -m course_lib env)"; make lab does it for JupyterLab)
 """
 
 from __future__ import annotations
@@ -25,9 +28,15 @@ def main(argv: list[str] | None = None) -> int:
     if command == "build":
         from course_lib import workspace
         return workspace.main_build(rest)
+    if command == "env":
+        from course_lib import rosenv
+        return rosenv.main_env(rest)
     if command == "repair-wheels":
         from course_lib import wheelfix
         return wheelfix.main(rest)
+    if command == "install-ros2":
+        from course_lib.ros2cli import install
+        return install.main(rest)
     print(f"unknown command {command!r}; commands:{USAGE}", file=sys.stderr)
     return 2
 

@@ -39,7 +39,12 @@ def share(package: str) -> Path:
 
 def executables(package: str) -> list[str]:
     """The executables ``ros2 run package`` offers: the executable files in <prefix>/lib/<package>/."""
-    folder = prefix(package) / "lib" / package
+    return executables_in(prefix(package), package)
+
+
+def executables_in(install_prefix, package: str) -> list[str]:
+    """The executable files a package installs below one prefix (``<prefix>/lib/<package>/``)."""
+    folder = Path(install_prefix) / "lib" / package
     if not folder.is_dir():
         return []
     return sorted(p.name for p in folder.iterdir() if p.is_file() and os.access(p, os.X_OK))

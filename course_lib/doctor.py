@@ -142,6 +142,22 @@ def _check_network_settings() -> Check:
     return Check("discovery", True, detail)
 
 
+def _check_large_data() -> Check:
+    """Whether camera frames travel whole between processes (rosenv.large_data_environment)."""
+    profile = os.environ.get("FASTRTPS_DEFAULT_PROFILES_FILE")
+    if profile == str(rosenv.FASTDDS_PROFILE):
+        return Check("camera frames", True, "Fast DDS with the course's shared-memory profile "
+                     f"({rosenv.FASTDDS_PROFILE.name}): full-size frames reach other processes")
+    chosen = [f"{name}={os.environ[name]}" for name in rosenv.FASTDDS_USER_SETTINGS if os.environ.get(name)]
+    if chosen:
+        return Check("camera frames", True, "your own Fast DDS set-up: " + ", ".join(chosen))
+    shm = rosenv.shared_memory_mb()
+    return Check("camera frames", True, f"Fast DDS defaults (/dev/shm has {shm} MB, the course's profile needs "
+                 f"{rosenv.SHARED_MEMORY_NEEDED_MB} MB): most frames of 640x480 and more are lost between processes",
+                 f"give /dev/shm at least {rosenv.SHARED_MEMORY_NEEDED_MB} MB (docker run --shm-size=1g), "
+                 "then restart the kernel", warning=True)
+
+
 def _check_opencv() -> Check:
     try:
         import cv2
@@ -251,7 +267,7 @@ def run(live: bool = True, timeout: float = 15.0) -> Report:
     checks = [_check_python(), _check_install()]
     if checks[-1].ok:
         checks += [_check_messages(), _check_rmw()]
-    checks += [_check_network_settings(), _check_opencv()]
+    checks += [_check_network_settings(), _check_large_data(), _check_opencv()]
     if checks[1].ok:
         checks.append(_check_interface_builds())
         if live:

@@ -1,15 +1,17 @@
 """Look at the running ROS graph from a notebook, the way the ``ros2`` command line does.
 
-The course's pip install of ROS 2 has no ``ros2`` command, so these functions give the same
-answers from Python, through rclpy's graph API and the session's hidden tool node:
+These functions give the answers of the ``ros2`` command line from Python, through rclpy's
+graph API and the session's hidden tool node (on the pip install, the course's own ``ros2``
+command, :mod:`course_lib.ros2cli`, prints them):
 
 ==============================  ==========================================
 ``ros2 node list``              ``graph.node_list()``
 ``ros2 topic list -t``          ``graph.topic_list(types=True)``
 ``ros2 topic echo --once /t``   ``graph.topic_echo("/t")``
-``ros2 topic echo --times 5``   ``graph.topic_echo("/t", count=5)``
+(the first 5 messages)          ``graph.topic_echo("/t", count=5)``
 ``ros2 topic hz /t``            ``graph.topic_hz("/t")``
 ``ros2 topic info -v /t``       ``print(graph.format_topic_info(graph.topic_info("/t")))``
+``ros2 node info /talker``      ``print(graph.format_node_info(graph.node_info("/talker")))``
 ``rqt_graph``                   ``graph.draw_graph()``
 ==============================  ==========================================
 
@@ -21,7 +23,9 @@ query after the tool node starts waits, briefly and boundedly, for the graph to 
 from __future__ import annotations
 
 import array
+import contextlib
 import dataclasses
+import functools
 import importlib
 import math
 import time
@@ -39,7 +43,7 @@ DEFAULT_HIDDEN_TOPICS = ("/rosout", "/parameter_events")
 SETTLE_SECONDS = 2.5
 # After SETTLE_SECONDS the graph must also have stayed the same for _SETTLE_QUIET s (things
 # found late bring more with them), but the wait never lasts longer than _SETTLE_MAX s.
-_SETTLE_POLL = 0.1
+_SETTLE_POLL = 0.05
 _SETTLE_QUIET = 0.3
 _SETTLE_MAX = 5.0
 _settled_node = None
@@ -49,31 +53,75 @@ _settled_node = None
 
 def _graph_node():
     """The session's tool node, after a bounded wait for discovery on its first use."""
-    global _settled_node
     node = session.tool_node()
     if _settled_node is not node:
-        _settle(node)
-        _settled_node = node
+        wait_for_discovery()
     return node
 
 
-def _snapshot(node):
-    return (sorted(node.get_fully_qualified_node_names()),
-            sorted((name, tuple(types)) for name, types in node.get_topic_names_and_types()))
+def wait_for_discovery(minimum: float | None = None, quiet: float = _SETTLE_QUIET,
+                       complete_within: float = 0.0) -> None:
+    """Wait until discovery has shown the graph to the tool node; later queries do not wait.
 
+    The functions of this module call it on the tool node's first use, with the defaults;
+    the ``ros2`` command calls it first with its own (--spin-time, or no wait at all for a
+    verb that waits for the name it is given).
 
-def _settle(node) -> None:
+    Args:
+        minimum: seconds after the tool node's creation to wait at least (default
+            SETTLE_SECONDS).
+        quiet: then wait until the graph has not changed for this long.
+        complete_within: also wait, up to this many seconds after the tool node's creation,
+            while the graph shows fewer nodes of other processes than there are other DDS
+            participants on this machine in this domain (each ROS process has one, holding its
+            nodes). On a busy machine some of them take seconds to be discovered.
+
+    The wait never lasts longer than 5 s after the tool node's creation.
+    """
+    global _settled_node
+    node = session.tool_node()
+    minimum = SETTLE_SECONDS if minimum is None else minimum
+    others_here = _participants_here(node.context.get_domain_id()) - 1 if complete_within else 0
+    ours = 1 + len(session.nodes())  # the nodes of this process share its participant
     last = _snapshot(node)
     quiet_since = time.monotonic()
     while True:
         now = time.monotonic()
         age = now - node.created_at
-        if age >= _SETTLE_MAX or (age >= SETTLE_SECONDS and now - quiet_since >= _SETTLE_QUIET):
-            return
+        missing = age < complete_within and len(last[0]) - ours < others_here
+        if age >= _SETTLE_MAX or (age >= minimum and now - quiet_since >= quiet and not missing):
+            break
         time.sleep(_SETTLE_POLL)
         current = _snapshot(node)
         if current != last:
             last, quiet_since = current, time.monotonic()
+    _settled_node = node
+
+
+def _participants_here(domain_id: int) -> int:
+    """How many DDS participants run on this machine in a domain.
+
+    Each binds the UDP port 7400 + 250 * domain + 10 + 2 * (its participant id) for discovery
+    traffic (the RTPS standard port mapping), so /proc/net/udp tells. 0 when it cannot.
+    """
+    first = 7410 + 250 * domain_id
+    ports = set()
+    for table in ("/proc/net/udp", "/proc/net/udp6"):
+        try:
+            with open(table) as handle:
+                rows = handle.read().splitlines()[1:]
+        except OSError:
+            continue
+        for row in rows:
+            port = int(row.split()[1].rsplit(":", 1)[1], 16)
+            if first <= port < first + 240 and (port - first) % 2 == 0:
+                ports.add(port)
+    return len(ports)
+
+
+def _snapshot(node):
+    return (sorted(node.get_fully_qualified_node_names()),
+            sorted((name, tuple(types)) for name, types in node.get_topic_names_and_types()))
 
 
 def _wait_until(condition, timeout: float) -> bool:
@@ -187,10 +235,10 @@ def message_class(type_name: str):
         return getattr(module, name)
     except AttributeError:
         raise ValueError(f"Package {package} has no {kind} type {name!r}; check the spelling "
-                         f"(graph.topic_list(types=True) shows the types in use)") from None
+                         f"(`ros2 topic list -t` or graph.topic_list(types=True) shows the types in use)") from None
 
 
-def _topic_class(node, topic: str, msg_type, deadline: float):
+def _topic_class(node, topic: str, msg_type, timeout: float | None):
     if msg_type is not None:
         return message_class(msg_type) if isinstance(msg_type, str) else msg_type
     found: list[list[str]] = []
@@ -199,7 +247,7 @@ def _topic_class(node, topic: str, msg_type, deadline: float):
         found[:] = [kinds for name, kinds in node.get_topic_names_and_types() if name == topic]
         return bool(found)
 
-    if not _wait_until(known, max(0.0, deadline - time.monotonic())):
+    if not _wait_until(known, timeout):
         raise TimeoutError(f"Topic {topic} did not appear in the ROS graph: is its publisher "
                            "running, on the same ROS_DOMAIN_ID? graph.topic_list() shows the "
                            "topics there are, or pass msg_type= to subscribe anyway")
@@ -227,6 +275,41 @@ def _matching_qos(node, topic: str, depth: int = 10):
 
 # --- ros2 topic echo --------------------------------------------------------------------
 
+@contextlib.contextmanager
+def subscription(topic: str, callback, msg_type=None, timeout: float | None = 5.0, qos=None,
+                 raw: bool = False):
+    """Call ``callback(msg)`` for each message on a topic while a ``with`` block runs.
+
+    What ``ros2 topic echo`` and ``ros2 topic hz`` do between their start and Ctrl-C: the
+    session's tool node subscribes, and unsubscribes when the block ends.
+
+    Args:
+        topic: the topic name; relative names are resolved like the CLI does.
+        callback: called in the session's background thread with each message (the
+            serialized bytes when ``raw``).
+        msg_type: the message class or type name; None takes it from the graph.
+        timeout: seconds to wait for the topic to appear when msg_type is None; None waits
+            as long as session.wait_for allows (forever in a live session).
+        qos: the subscription's QoS; None chooses one every current publisher can serve.
+        raw: deliver serialized messages (no conversion cost, for rates of large messages).
+
+    Yields:
+        The resolved topic name.
+
+    Raises:
+        TimeoutError: the topic did not appear and no msg_type was given.
+    """
+    node = _graph_node()
+    name = node.resolve_topic_name(topic)
+    cls = _topic_class(node, name, msg_type, timeout)
+    handle = node.create_subscription(cls, name, callback,
+                                      _matching_qos(node, name) if qos is None else qos, raw=raw)
+    try:
+        yield name
+    finally:
+        _unsubscribe(node, handle, name)
+
+
 class EchoTimeout(TimeoutError):
     """Fewer messages than asked for arrived in time; ``messages`` holds those that did."""
 
@@ -236,7 +319,7 @@ class EchoTimeout(TimeoutError):
 
 
 def topic_echo(topic: str, count: int = 1, timeout: float = 5.0, msg_type=None) -> list:
-    """Receive messages from a topic, like ``ros2 topic echo --once`` or ``--times N``.
+    """Receive messages from a topic, like ``ros2 topic echo --once`` (or N of them).
 
     Args:
         topic: the topic name; relative names are resolved like the CLI does ("chatter" is
@@ -257,22 +340,18 @@ def topic_echo(topic: str, count: int = 1, timeout: float = 5.0, msg_type=None) 
     if count < 1:
         raise ValueError(f"count must be at least 1, got {count}")
     deadline = time.monotonic() + timeout
-    node = _graph_node()
-    name = node.resolve_topic_name(topic)
-    cls = _topic_class(node, name, msg_type, deadline)
     received: list = []
 
     def keep(msg):
         if len(received) < count:
             received.append(msg)
 
-    subscription = node.create_subscription(cls, name, keep,
-                                            _matching_qos(node, name, depth=max(10, count)))
-    try:
+    node = _graph_node()
+    name = node.resolve_topic_name(topic)
+    cls = _topic_class(node, name, msg_type, timeout)
+    with subscription(name, keep, cls, qos=_matching_qos(node, name, depth=max(10, count))):
         arrived = _wait_until(lambda: len(received) >= count,
                               max(0.0, deadline - time.monotonic()))
-    finally:
-        _unsubscribe(node, subscription, name)
     if not arrived:
         raise EchoTimeout(f"Received {len(received)} of {count} messages on {name} within "
                           f"{timeout} s: is anyone publishing? graph.topic_info({name!r}) "
@@ -280,48 +359,154 @@ def topic_echo(topic: str, count: int = 1, timeout: float = 5.0, msg_type=None) 
     return received[:count]
 
 
-def message_to_dict(msg, truncate_length: int | None = 128):
+def message_to_dict(msg, truncate_length: int | None = 128, no_arr: bool = False,
+                    no_str: bool = False):
     """A message as plain dicts, lists and numbers (for printing, JSON or comparisons).
+
+    Converts the way ``ros2 topic echo`` does before it prints YAML.
 
     Args:
         msg: a ROS message (nested messages and arrays are converted too).
-        truncate_length: arrays longer than this keep their first elements and end with
-            "..." (ros2 topic echo's default is 128); None keeps everything.
+        truncate_length: arrays and strings longer than this keep their first elements and
+            end with "..." (ros2 topic echo's default is 128); None keeps everything.
+        no_arr: show each array field as its type and length only (echo's ``--no-arr``).
+        no_str: show each string field as its length only (echo's ``--no-str``).
 
     Returns:
         A dict in field order, or the plain value when ``msg`` is not a message.
     """
     if hasattr(msg, "get_fields_and_field_types"):
-        return {field: message_to_dict(getattr(msg, field), truncate_length)
-                for field in msg.get_fields_and_field_types()}
+        return {field: _field_to_plain(getattr(msg, field), slot_type, truncate_length, no_arr, no_str)
+                for field, slot_type in zip(msg.get_fields_and_field_types(), msg.SLOT_TYPES)}
     if isinstance(msg, (bytes, bytearray)):
-        msg = list(msg)
-    if isinstance(msg, np.ndarray):
-        msg = msg.tolist()
-    if isinstance(msg, array.array):
+        text = "".join(chr(byte) for byte in msg[:truncate_length])
+        return text + "..." if truncate_length is not None and len(msg) > truncate_length else text
+    if isinstance(msg, str):
+        if no_str:
+            return f"<string length: <{len(msg)}>>"
+        cut = truncate_length is not None and len(msg) > truncate_length
+        return msg[:truncate_length] + "..." if cut else msg
+    if isinstance(msg, (np.ndarray, array.array)):
         msg = msg.tolist()
     if isinstance(msg, (list, tuple)):
         items = list(msg)
         cut = truncate_length is not None and len(items) > truncate_length
-        items = [message_to_dict(item, truncate_length) for item in
-                 (items[:truncate_length] if cut else items)]
+        items = [message_to_dict(item, truncate_length, no_arr, no_str)
+                 for item in (items[:truncate_length] if cut else items)]
         return items + ["..."] if cut else items
     if isinstance(msg, np.generic):
         return msg.item()
     return msg
 
 
-def format_message(msg, truncate_length: int | None = 128) -> str:
+def _field_to_plain(value, slot_type, truncate_length, no_arr, no_str):
+    from rosidl_parser import definition
+
+    if no_arr and isinstance(slot_type, definition.AbstractNestedType):
+        element = slot_type.value_type
+        element = ("string" if isinstance(element, definition.AbstractString) else
+                   "/".join(element.namespaced_name()) if isinstance(element, definition.NamespacedType)
+                   else getattr(element, "typename", "unknown"))
+        if isinstance(slot_type, definition.Array):
+            return f"<array type: {element}[{slot_type.size}]>"
+        if isinstance(slot_type, definition.BoundedSequence):
+            return f"<sequence type: {element}[{slot_type.maximum_size}], length: {len(value)}>"
+        return f"<sequence type: {element}, length: {len(value)}>"
+    return message_to_dict(value, truncate_length, no_arr, no_str)
+
+
+def format_message(msg, truncate_length: int | None = 128, no_arr: bool = False,
+                   no_str: bool = False) -> str:
     """One message as YAML, the way ``ros2 topic echo`` prints it (without the "---")."""
     import yaml
 
-    return yaml.safe_dump(message_to_dict(msg, truncate_length), sort_keys=False,
+    return yaml.safe_dump(message_to_dict(msg, truncate_length, no_arr, no_str), sort_keys=False,
                           default_flow_style=False, allow_unicode=True, width=1 << 30)
 
 
 def format_messages(messages, truncate_length: int | None = 128) -> str:
     """Messages as ``ros2 topic echo`` prints them: YAML, each followed by a "---" line."""
     return "".join(format_message(msg, truncate_length) + "---\n" for msg in messages)
+
+
+def fill_message(msg, values) -> list:
+    """Set a message's fields from plain values, the way ``ros2 topic pub`` reads its YAML.
+
+    Args:
+        msg: the message to fill; it is changed in place.
+        values: ``{field: value}``; a nested message takes a dict, an array a list. As in
+            ``ros2 topic pub``, ``header: auto`` (a std_msgs/Header) and ``stamp: now`` (a
+            builtin_interfaces/Time) mean "the time of each publish".
+
+    Returns:
+        One setter per field marked auto/now: call each with a builtin_interfaces/Time
+        (``node.get_clock().now().to_msg()``) before publishing.
+
+    Raises:
+        ValueError: a field the message does not have, or a value that does not fit its field
+            (the message names the field and its type).
+    """
+    setters: list = []
+    _fill(msg, values, setters, "")
+    return setters
+
+
+def _type_name(msg) -> str:
+    module = type(msg).__module__.split(".")
+    return f"{module[0]}/{module[1]}/{type(msg).__name__}"
+
+
+def _fill(msg, values, setters: list, path: str) -> None:
+    from rosidl_parser import definition
+
+    fields = msg.get_fields_and_field_types()
+    if not isinstance(values, dict):
+        raise ValueError(f"{path.rstrip('.') or 'The message'} is a {_type_name(msg)} and needs a "
+                         f"dictionary of its fields ({', '.join(fields)}), not {values!r}")
+    slots = dict(zip(fields, msg.SLOT_TYPES))
+    for field, value in values.items():
+        where = path + str(field)
+        if field not in fields:
+            raise ValueError(f"{_type_name(msg)} has no field {field!r}"
+                             f"{' (in ' + path.rstrip('.') + ')' if path else ''}; its fields are: "
+                             f"{', '.join(fields)}")
+        current = getattr(msg, field)
+        slot = slots[field]
+        if hasattr(current, "get_fields_and_field_types"):
+            kind = _type_name(current)
+            if value == "auto" and kind == "std_msgs/msg/Header":
+                setters.append(functools.partial(setattr, current, "stamp"))
+            elif value == "now" and kind == "builtin_interfaces/msg/Time":
+                setters.append(functools.partial(setattr, msg, field))
+            else:
+                _fill(current, value, setters, where + ".")
+            continue
+        if isinstance(slot, definition.AbstractNestedType) and \
+                isinstance(slot.value_type, definition.NamespacedType):
+            element = getattr(importlib.import_module(".".join(slot.value_type.namespaces)),
+                              slot.value_type.name)
+            if not isinstance(value, list):
+                raise ValueError(f"{where} ({fields[field]}) needs a list, not {value!r}")
+            items = []
+            for index, item in enumerate(value):
+                items.append(element())
+                _fill(items[-1], item, setters, f"{where}[{index}].")
+            value = items
+        elif isinstance(current, array.array):
+            value = _converted(lambda: array.array(current.typecode, value), where, fields[field], value)
+        elif isinstance(current, np.ndarray):
+            value = _converted(lambda: np.array(value, dtype=current.dtype), where, fields[field], value)
+        elif not isinstance(current, list) and type(value) is not type(current):
+            value = _converted(lambda: type(current)(value), where, fields[field], value)
+        _converted(lambda: setattr(msg, field, value), where, fields[field], value)
+
+
+def _converted(convert, where: str, field_type: str, value):
+    try:
+        return convert()
+    except (AssertionError, TypeError, ValueError, OverflowError) as error:
+        raise ValueError(f"{where} is a {field_type} and cannot take {value!r}"
+                         f"{': ' + str(error) if str(error) else ''}") from None
 
 
 # --- ros2 topic hz ----------------------------------------------------------------------
@@ -400,19 +585,13 @@ def topic_hz(topic: str, window: int = 10000, duration: float = 2.0, timeout: fl
         ValueError: only one message arrived during the measurement.
     """
     deadline = time.monotonic() + timeout
-    node = _graph_node()
-    name = node.resolve_topic_name(topic)
-    cls = _topic_class(node, name, msg_type, deadline)
     times: list[float] = []
-    subscription = node.create_subscription(cls, name, lambda _: times.append(time.monotonic()),
-                                            _matching_qos(node, name), raw=True)
-    try:
+    with subscription(topic, lambda _: times.append(time.monotonic()), msg_type, timeout,
+                      raw=True) as name:
         if not _wait_until(lambda: bool(times), max(0.0, deadline - time.monotonic())):
             raise TimeoutError(f"No message on {name} within {timeout} s: is anyone "
                                f"publishing? graph.topic_info({name!r}) shows the publishers")
         session.spin_for(duration)
-    finally:
-        _unsubscribe(node, subscription, name)
     return rate_statistics(list(times), window)
 
 
@@ -572,6 +751,69 @@ def format_topic_info(info: TopicInfo, verbose: bool = True) -> str:
     if verbose:
         parts += [format_endpoint(endpoint) for endpoint in info.subscriptions]
     return ("\n\n" if verbose else "\n").join(parts) + "\n"
+
+
+# --- ros2 node info ---------------------------------------------------------------------
+
+@dataclasses.dataclass(frozen=True)
+class NodeInfo:
+    """What ``ros2 node info`` shows about a node: each list holds (name, [types]) pairs."""
+
+    name: str
+    subscribers: list[tuple[str, list[str]]]
+    publishers: list[tuple[str, list[str]]]
+    service_servers: list[tuple[str, list[str]]]
+    service_clients: list[tuple[str, list[str]]]
+    action_servers: list[tuple[str, list[str]]]
+    action_clients: list[tuple[str, list[str]]]
+
+
+def node_info(name: str, include_hidden: bool = False, timeout: float = 2.0) -> NodeInfo:
+    """The topics, services and actions of a node, like ``ros2 node info``.
+
+    Args:
+        name: the node's full name, e.g. "/talker" ("talker" is read as "/talker").
+        include_hidden: also list hidden names (a part starting with "_").
+        timeout: seconds to wait for the node to appear in the graph.
+
+    Raises:
+        ValueError: the node is not in the graph (the message lists the nodes there are).
+    """
+    from rclpy.action import (get_action_client_names_and_types_by_node,
+                              get_action_server_names_and_types_by_node)
+
+    full = name if name.startswith("/") else "/" + name
+    nodes = node_list(all=True, wait_for=[full], timeout=timeout)
+    if full not in nodes:
+        raise ValueError(f"Unable to find node '{full}'; the nodes are {node_list()}")
+    namespace, _, base = full.rpartition("/")
+    namespace = namespace or "/"
+    node = _graph_node()
+
+    def shown(pairs):
+        return [(topic, list(kinds)) for topic, kinds in pairs if include_hidden or not _is_hidden(topic)]
+
+    return NodeInfo(
+        name=full,
+        subscribers=shown(node.get_subscriber_names_and_types_by_node(base, namespace)),
+        publishers=shown(node.get_publisher_names_and_types_by_node(base, namespace)),
+        service_servers=shown(node.get_service_names_and_types_by_node(base, namespace)),
+        service_clients=shown(node.get_client_names_and_types_by_node(base, namespace)),
+        action_servers=shown(get_action_server_names_and_types_by_node(node, base, namespace)),
+        action_clients=shown(get_action_client_names_and_types_by_node(node, base, namespace)))
+
+
+def format_node_info(info: NodeInfo) -> str:
+    """A NodeInfo as ``ros2 node info`` prints it (an empty section leaves an empty line)."""
+    lines = [info.name]
+    for title, pairs in (("Subscribers", info.subscribers), ("Publishers", info.publishers),
+                         ("Service Servers", info.service_servers),
+                         ("Service Clients", info.service_clients),
+                         ("Action Servers", info.action_servers),
+                         ("Action Clients", info.action_clients)):
+        lines.append(f"  {title}:")
+        lines += [f"    {topic}: {', '.join(kinds)}" for topic, kinds in pairs] or [""]
+    return "\n".join(lines) + "\n"
 
 
 # --- rqt_graph --------------------------------------------------------------------------

@@ -45,42 +45,65 @@ def definition_path(name: str) -> Path:
     return path
 
 
-def show(name: str, expand: bool = True) -> str:
+def show(name: str, expand: bool = True, comments: str = "top") -> str:
     """The definition of an interface, with nested message types indented below their field.
 
     Args:
-        name: "package/msg/Type" (also "package/Type").
+        name: "package/msg/Type" (also "package/Type", "package/srv/Type").
         expand: include the definitions of nested message types, like `ros2 interface show`.
+        comments: "top" keeps the interface's own comments and blank lines but none of the
+            nested types' (what `ros2 interface show` prints), "all" keeps every comment
+            (``--all-comments``), "none" drops them all (``--no-comments``).
     """
-    package, kind, _ = _split(name)
-    text = definition_path(name).read_text()
+    if comments not in ("top", "all", "none"):
+        raise ValueError(f"comments={comments!r}: use 'top', 'all' or 'none'")
     if not expand:
-        return text.rstrip("\n")
-    return "\n".join(_expand(text, package, indent=""))
+        return definition_path(name).read_text().rstrip("\n")
+    return "\n".join(_lines(name, comments != "none", comments == "all", ""))
 
 
-def _expand(text: str, package: str, indent: str):
-    for line in text.splitlines():
-        yield indent + line
-        field = line.split("#", 1)[0].strip()
-        if not field or "=" in field.split()[0]:
-            continue
-        field_type = re.sub(r"\[.*\]$", "", field.split()[0])
-        field_type = re.sub(r"<=\d+$", "", field_type)
-        if field_type in PRIMITIVES or "=" in field:  # constants never nest
-            continue
-        nested = field_type if "/" in field_type else (
-            f"std_msgs/{field_type}" if field_type == "Header" else f"{package}/{field_type}")
-        try:
-            nested_text = definition_path(nested).read_text()
-        except (LookupError, ValueError):
-            continue
-        nested_package = _split(nested)[0]
-        yield from _expand(_strip_comment_lines(nested_text), nested_package, indent + "\t")
+def _lines(name: str, with_comments: bool, nested_comments: bool, indent: str):
+    package = _split(name)[0]
+    for line in definition_path(name).read_text().splitlines():
+        line = line.rstrip()
+        code = _without_comment(line).strip()
+        if with_comments:
+            yield indent + line if line else ""
+        elif code:
+            yield indent + code
+        nested = _nested_type(code, package)
+        if nested is not None:
+            yield from _lines(nested, nested_comments, nested_comments, indent + "\t")
 
 
-def _strip_comment_lines(text: str) -> str:
-    return "\n".join(line for line in text.splitlines() if line.strip() and not line.lstrip().startswith("#"))
+def _without_comment(line: str) -> str:
+    """The line up to its comment; a # inside a quoted string constant is not a comment."""
+    quote = None
+    for index, char in enumerate(line):
+        if quote:
+            quote = None if char == quote else quote
+        elif char in "\"'":
+            quote = char
+        elif char == "#":
+            return line[:index]
+    return line
+
+
+def _nested_type(code: str, package: str) -> str | None:
+    """The message type a field line nests ("std_msgs/Header" for "Header header"), else None."""
+    parts = code.split()
+    if len(parts) < 2 or "=" in code or code == "---":
+        return None
+    field_type = re.sub(r"<=\d+$", "", re.sub(r"\[.*\]$", "", parts[0]))
+    if field_type in PRIMITIVES:
+        return None
+    nested = field_type if "/" in field_type else (
+        "std_msgs/Header" if field_type == "Header" else f"{package}/{field_type}")
+    try:
+        definition_path(nested)
+    except (LookupError, ValueError):
+        return None
+    return nested
 
 
 def package_interfaces(package: str, kind: str = "msg") -> list[str]:

@@ -48,6 +48,10 @@ LOG_TAIL_BYTES = 256 * 1024
 #: Seconds a node gets to shut down after SIGINT when its caller has gone away.
 PARENT_GONE_GRACE = 1.0
 
+#: Largest piece of output in one echo frame: a frame (3 header bytes + piece) stays within
+#: PIPE_BUF, so a non-blocking write of it is all or nothing and frames never interleave.
+_ECHO_PIECE = 4000
+
 _PR_SET_PDEATHSIG = 1
 _PR_SET_CHILD_SUBREAPER = 36
 
@@ -170,12 +174,21 @@ def _supervisor_main(argv: list[str] | None = None) -> int:
         for resource_id, pair in rlimits:
             resource.setrlimit(resource_id, pair)
 
+    # Without an echo the child's stdout and stderr share one pipe, so the log keeps their exact
+    # order; with one they get a pipe each, so the caller can tell them apart.
+    echo_fd = config.get("echo_fd")
     output_read, output_write = os.pipe()
+    streams = {output_read: b"o"}
+    error_write = output_write
+    if echo_fd is not None:
+        os.set_blocking(echo_fd, False)
+        error_read, error_write = os.pipe()
+        streams[error_read] = b"e"
     log = _BoundedLog(config["log_dir"], config["head_bytes"], config["tail_bytes"])
     user = config["user"]
     try:
         child = subprocess.Popen(config["command"], stdin=subprocess.DEVNULL, stdout=output_write,
-                                 stderr=output_write, cwd=config["cwd"], preexec_fn=prepare_child,
+                                 stderr=error_write, cwd=config["cwd"], preexec_fn=prepare_child,
                                  user=user, group=None if user is None else _group_of(user),
                                  extra_groups=None if user is None else [])
     except OSError as error:
@@ -186,12 +199,15 @@ def _supervisor_main(argv: list[str] | None = None) -> int:
         return 0
     finally:
         os.close(output_write)
+        if error_write != output_write:
+            os.close(error_write)
     report(event="started", pid=child.pid)
 
-    os.set_blocking(output_read, False)
     poller = select.poll()
     poller.register(0, select.POLLIN)
-    poller.register(output_read, select.POLLIN)
+    for fd in streams:
+        os.set_blocking(fd, False)
+        poller.register(fd, select.POLLIN)
     poller.register(wake_read, select.POLLIN)
     wall = config["wall_seconds"]
     wall_deadline = None if wall is None else time.monotonic() + wall
@@ -207,22 +223,47 @@ def _supervisor_main(argv: list[str] | None = None) -> int:
         deadline = time.monotonic() + max(0.0, grace)
         kill_at = deadline if kill_at is None else min(kill_at, deadline)
 
-    def relay_output() -> bool:
-        """Copy what the child wrote to the log; False at end of stream."""
+    echo_dropped = {b"o": 0, b"e": 0}
+
+    def echo(stream: bytes, data: bytes) -> None:
+        """Pass output on to the caller in frames (stream, length, bytes); what does not fit
+        in the pipe is dropped (the log keeps it) and counted in a note, so the child never
+        waits for a slow reader."""
+        nonlocal echo_fd
+        dropped_before, echo_dropped[stream] = echo_dropped[stream], 0
+        note = f"[... {dropped_before} bytes of output not shown ...]\n".encode() if dropped_before else b""
+        payload = note + data
+        for start in range(0, len(payload), _ECHO_PIECE):
+            piece = payload[start:start + _ECHO_PIECE]
+            try:
+                os.write(echo_fd, stream + len(piece).to_bytes(2, "big") + piece)
+            except BlockingIOError:
+                unsent = len(payload) - start
+                echo_dropped[stream] = min(unsent, len(data)) + (dropped_before if unsent > len(data) else 0)
+                return
+            except OSError:  # the caller closed its end: stop echoing
+                os.close(echo_fd)
+                echo_fd = None
+                return
+
+    def relay_output(fd: int) -> bool:
+        """Copy what the child wrote to the log (and the echo); False at end of stream."""
         while True:
             try:
-                data = os.read(output_read, 65536)
+                data = os.read(fd, 65536)
             except BlockingIOError:
                 return True
             if not data:
                 return False
             log.write(data)
+            if echo_fd is not None:
+                echo(streams[fd], data)
 
     while os.waitid(os.P_PID, child.pid, os.WEXITED | os.WNOHANG | os.WNOWAIT) is None:
         timeouts = [0.5] + [t - time.monotonic() for t in (kill_at, wall_deadline) if t is not None]
         for fd, _events in poller.poll(max(0, int(min(timeouts) * 1000) + 1)):
-            if fd == output_read and not relay_output():
-                poller.unregister(output_read)
+            if fd in streams and not relay_output(fd):
+                poller.unregister(fd)
             elif fd == wake_read:
                 while True:
                     try:
@@ -266,11 +307,20 @@ def _supervisor_main(argv: list[str] | None = None) -> int:
             except (ProcessLookupError, ChildProcessError):
                 pass
     drain_deadline = time.monotonic() + 2.0
-    while time.monotonic() < drain_deadline:
-        if not select.select([output_read], [], [], max(0.0, drain_deadline - time.monotonic()))[0]:
+    open_streams = list(streams)
+    while open_streams and time.monotonic() < drain_deadline:
+        ready = select.select(open_streams, [], [], max(0.0, drain_deadline - time.monotonic()))[0]
+        if not ready:
             break
-        if not relay_output():
-            break
+        for fd in ready:
+            if not relay_output(fd):
+                open_streams.remove(fd)
+    if echo_fd is not None and any(echo_dropped.values()):
+        # Say what was not shown, if the reader catches up soon enough.
+        if select.select([], [echo_fd], [], PARENT_GONE_GRACE * 2)[1]:
+            for stream in echo_dropped:
+                if echo_dropped[stream] and echo_fd is not None:
+                    echo(stream, b"")
     log.close()
     report(event="exited", returncode=child.returncode, reason=reason or "exited",
            max_rss_kb=usage.ru_maxrss, cpu_seconds=round(usage.ru_utime + usage.ru_stime, 3),
@@ -322,6 +372,7 @@ import itertools  # noqa: E402
 import tempfile  # noqa: E402
 import threading  # noqa: E402
 from pathlib import Path  # noqa: E402
+from typing import Callable  # noqa: E402
 
 #: Seconds start() waits for the supervisor to report that the command runs.
 START_TIMEOUT = 30.0
@@ -404,6 +455,12 @@ class NodeProcess:
             None removes a variable).
         cwd: working directory of the child.
         limits: resource bounds (see Limits); None for none.
+        on_output: called as ``on_output(stream, data)`` with each piece of the child's output
+            as it arrives, stream being "stdout" or "stderr" (from a thread of its own; the
+            log keeps everything as well). By the time returncode is known, on_output has had
+            all of it (so on_output must not wait for this process). With it the child's stdout
+            and stderr are separate pipes, so their order in the log is only as exact as their
+            arrival.
 
     Attributes:
         pid: the child's process id (it also leads the child's process group) once started.
@@ -416,7 +473,8 @@ class NodeProcess:
     """
 
     def __init__(self, command: list[str], *, name: str | None = None, domain_id: int | None = None,
-                 env: dict | None = None, cwd=None, limits: Limits | None = None):
+                 env: dict | None = None, cwd=None, limits: Limits | None = None,
+                 on_output: Callable[[str, bytes], None] | None = None):
         from course_lib import rosenv  # imported here: the supervisor runs this file without it
 
         if isinstance(command, (str, bytes)) or not command:
@@ -427,6 +485,8 @@ class NodeProcess:
         self.name = name or Path(self.command[0]).name
         self.cwd = None if cwd is None else os.fspath(cwd)
         self.limits = limits or Limits()
+        self._on_output = on_output
+        self._relay: threading.Thread | None = None
         base = dict(os.environ)
         for key, value in (env or {}).items():
             if value is None:
@@ -479,24 +539,34 @@ class NodeProcess:
                 cleanup.append(str(self._home_dir))
             control_read, self._control = os.pipe()
             self._status, status_write = os.pipe()
+            echo_read, echo_write = os.pipe() if self._on_output is not None else (None, None)
             config = {"command": self.command, "cwd": self.cwd, "log_dir": str(self._log_dir),
                       "head_bytes": LOG_HEAD_BYTES, "tail_bytes": LOG_TAIL_BYTES,
                       "rlimits": self.limits.rlimit_pairs(), "wall_seconds": self.limits.wall_seconds,
                       "grace_seconds": self.limits.grace_seconds, "user": self.limits.user,
-                      "cleanup": cleanup}
+                      "cleanup": cleanup, "echo_fd": echo_write}
             try:
                 with open(self._log_dir / "supervisor.err", "wb") as errors:
                     self._supervisor = subprocess.Popen(
                         [*_SUPERVISOR_COMMAND, str(status_write), json.dumps(config)],
                         stdin=control_read, stdout=subprocess.DEVNULL, stderr=errors,
-                        pass_fds=(status_write,), env=env, start_new_session=True)
+                        pass_fds=(status_write,) if echo_write is None else (status_write, echo_write),
+                        env=env, start_new_session=True)
             except BaseException:
                 self._close_fds()
                 self._remove_dirs()
+                if echo_read is not None:
+                    os.close(echo_read)
                 raise
             finally:
                 os.close(control_read)
                 os.close(status_write)
+                if echo_write is not None:
+                    os.close(echo_write)
+            if echo_read is not None:
+                self._relay = threading.Thread(target=_relay_echo, args=(echo_read, self._on_output),
+                                               name=f"course_lib-output-{self.name}", daemon=True)
+                self._relay.start()
             with _RUNNING_LOCK:
                 _RUNNING.add(self)
             event = self._next_event(START_TIMEOUT)
@@ -721,6 +791,8 @@ class NodeProcess:
             while (event := self._next_event(0)) is not None:
                 if event.get("event") == "exited":
                     final = event
+            if self._relay is not None and self._relay is not threading.current_thread():
+                self._relay.join(timeout=5.0)  # the supervisor has exited: its last frames are in the pipe
             if final is not None:
                 self._returncode = final["returncode"]
                 self.exit_reason = final["reason"]
@@ -777,6 +849,24 @@ class NodeProcess:
         self._home_dir = None
 
 
+def _relay_echo(fd: int, on_output: Callable[[str, bytes], None]) -> None:
+    """Read the supervisor's echo frames until it exits, and hand each piece to on_output."""
+    names = {b"o": "stdout", b"e": "stderr"}
+    buffer = b""
+    try:
+        while chunk := os.read(fd, 65536):
+            buffer += chunk
+            while len(buffer) >= 3 and len(buffer) >= 3 + int.from_bytes(buffer[1:3], "big"):
+                size = int.from_bytes(buffer[1:3], "big")
+                stream, data, buffer = buffer[:1], buffer[3:3 + size], buffer[3 + size:]
+                try:
+                    on_output(names[stream], data)
+                except Exception as error:  # a faulty callback must not stop the relay
+                    print(f"course_lib.processes: on_output raised {error!r}", file=sys.stderr)
+    finally:
+        os.close(fd)
+
+
 def python_node(target: str, *args: str, **kwargs) -> NodeProcess:
     """Start a Python node with this interpreter and return its running NodeProcess.
 
@@ -812,7 +902,13 @@ def python_node(target: str, *args: str, **kwargs) -> NodeProcess:
 
 def stop_all(timeout: float = 5.0) -> None:
     """Stop every NodeProcess this process started: all get SIGINT at once, then each is awaited."""
-    processes = _running_processes()
+    stop_together(_running_processes(), timeout)
+
+
+def stop_together(processes, timeout: float = 5.0) -> None:
+    """Stop these NodeProcesses: all get SIGINT at once (so their shutdowns overlap), then each
+    is awaited and killed if it still runs after `timeout` seconds."""
+    processes = list(processes)
     for process in processes:
         process._request_stop(timeout)
     for process in processes:

@@ -8,7 +8,9 @@ tells them apart:
 - ``conda``: RoboStack in a conda/mamba environment, activated in the shell.
 
 Traffic isolation is also written once here: every process the course starts gets a
-``ROS_DOMAIN_ID`` of its own and ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST``.
+``ROS_DOMAIN_ID`` of its own and ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST``. So is the Fast DDS
+set-up for camera frames (:func:`large_data_environment`), which every ROS process the course
+starts, the notebook's own session and ``make lab``'s terminals share.
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ import fcntl
 import importlib.metadata
 import importlib.util
 import os
+import shlex
 import sys
 import tempfile
 from pathlib import Path
@@ -29,6 +32,20 @@ SYSTEM_PREFIX = Path("/opt/ros") / DISTRO
 #: Domain ids handed out to test runs and graders. Fast DDS maps a domain to UDP ports
 #: 7400 + 250 * id, so ids above 232 do not fit; 0 stays free for the student's own session.
 RESERVABLE_DOMAIN_IDS = range(1, 102)
+
+#: The course's Fast DDS profile for camera frames: the default transports (shared memory, then
+#: UDP) with 32 MB shared-memory segments instead of 512 KB. With the defaults a best-effort
+#: subscriber in another process gets about half of the 640x480 frames and a fifth of the
+#: 1920x1080 ones at 30 Hz; with it, all of them (benchmarks/bench_vision.py measures both).
+FASTDDS_PROFILE = Path(__file__).resolve().with_name("fastdds_large_data.xml")
+
+#: The variables by which a user picks Fast DDS transports; when one is set the course adds none.
+FASTDDS_USER_SETTINGS = ("FASTRTPS_DEFAULT_PROFILES_FILE", "FASTDDS_BUILTIN_TRANSPORTS")
+
+#: Every ROS process with FASTDDS_PROFILE keeps a 32 MB segment in /dev/shm. Where /dev/shm is
+#: smaller than this (Docker's default is 64 MB), Fast DDS's defaults are kept: with the profile,
+#: the fourth process would print errors and fall back to UDP.
+SHARED_MEMORY_NEEDED_MB = 512
 
 
 @dataclasses.dataclass(frozen=True)
@@ -129,7 +146,40 @@ def ros_environment(domain_id: int | None = None, base: dict[str, str] | None = 
     path = env.get("PATH", "").split(os.pathsep)
     env["PATH"] = os.pathsep.join([bindir] + [p for p in path if p and p != bindir])
     env["PYTHONUNBUFFERED"] = "1"
+    env.update(large_data_environment(env))
     return env
+
+
+def large_data_environment(environ: dict[str, str] | None = None) -> dict[str, str]:
+    """The course's Fast DDS set-up for camera frames, as the variables to add to an environment.
+
+    Only the sending process needs it, but the course gives it to every ROS process it starts
+    (ros_environment), to the notebook's session (prepare_current_process) and to JupyterLab's
+    terminals (``make lab``), so that a node a student writes sends full frames too.
+
+    Args:
+        environ: the environment to complete; defaults to os.environ.
+
+    Returns:
+        ``{"FASTRTPS_DEFAULT_PROFILES_FILE": FASTDDS_PROFILE}``, or nothing when the environment
+        already picks its transports (FASTDDS_USER_SETTINGS: the user's choice is kept) or when
+        /dev/shm is smaller than SHARED_MEMORY_NEEDED_MB.
+    """
+    environ = os.environ if environ is None else environ
+    if any(environ.get(name) for name in FASTDDS_USER_SETTINGS):
+        return {}
+    if shared_memory_mb() < SHARED_MEMORY_NEEDED_MB:
+        return {}
+    return {"FASTRTPS_DEFAULT_PROFILES_FILE": str(FASTDDS_PROFILE)}
+
+
+def shared_memory_mb() -> int:
+    """The size of /dev/shm in MB (0 when there is none), where Fast DDS keeps its segments."""
+    try:
+        stats = os.statvfs("/dev/shm")
+    except OSError:
+        return 0
+    return stats.f_blocks * stats.f_frsize // (1024 * 1024)
 
 
 #: Environment variables that prepare_current_process() set because the user had not.
@@ -137,21 +187,52 @@ DEFAULTS_APPLIED: set[str] = set()
 
 
 def prepare_current_process() -> None:
-    """Give this interpreter what sourcing a ROS setup file would: the ament index and the
-    course's discovery range (kept when the user set one). Called when course_lib is imported.
+    """Give this interpreter what sourcing a ROS setup file would: the ament index, the course's
+    discovery range and its Fast DDS set-up (each kept when the user set one). Called when
+    course_lib is imported, so before the notebook's session creates its first node (Fast DDS
+    reads the variable then; a kernel that called rclpy.init() first keeps the defaults).
 
     Only the pip install needs this: the wheels register their packages in sys.prefix's ament
     index, but nothing puts sys.prefix on AMENT_PREFIX_PATH, so ament_index_python (and every
-    tool built on it) finds nothing.
+    tool built on it) finds nothing; and the venv's bin/, where the course's ``ros2`` lives,
+    goes on PATH as activating the venv would put it.
     """
     install = detect_install()
     paths = [p for p in os.environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep) if p]
     missing = [str(p) for p in install.prefixes if str(p) not in paths]
     if missing:
         os.environ["AMENT_PREFIX_PATH"] = os.pathsep.join(paths + missing)
+    bindir = str(Path(sys.executable).parent)
+    if install.kind == "pip" and bindir not in os.environ.get("PATH", "").split(os.pathsep):
+        # The course's `ros2` lives next to this interpreter: `!ros2 ...` in a kernel that was
+        # not started from an activated venv finds it only so.
+        os.environ["PATH"] = os.pathsep.join([bindir] + [p for p in os.environ.get("PATH", "").split(os.pathsep) if p])
     if "ROS_LOCALHOST_ONLY" not in os.environ and "ROS_AUTOMATIC_DISCOVERY_RANGE" not in os.environ:
         os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
         DEFAULTS_APPLIED.add("ROS_AUTOMATIC_DISCOVERY_RANGE")
+    for name, value in large_data_environment().items():
+        os.environ[name] = value
+        DEFAULTS_APPLIED.add(name)
+
+
+#: What prepare_current_process() may set, in the order `python -m course_lib env` prints them.
+SESSION_VARIABLES = ("AMENT_PREFIX_PATH", "ROS_AUTOMATIC_DISCOVERY_RANGE") + FASTDDS_USER_SETTINGS
+
+
+def main_env(argv: list[str] | None = None) -> int:
+    """``python -m course_lib env``: print the session's variables as shell ``export`` lines.
+
+    ``eval "$(python -m course_lib env)"`` gives a shell (``make lab`` gives JupyterLab, and so
+    its terminals and ``!`` commands) the same ROS environment as a notebook that imported
+    course_lib.
+    """
+    if argv:
+        print(f"python -m course_lib env takes no arguments, got {' '.join(argv)}", file=sys.stderr)
+        return 2
+    for name in SESSION_VARIABLES:
+        if os.environ.get(name):
+            print(f"export {name}={shlex.quote(os.environ[name])}")
+    return 0
 
 
 def check_domain_id(domain_id: int) -> int:

@@ -341,12 +341,16 @@ def nodes() -> list:
 def tool_node():
     """The session's hidden helper node for graph introspection, created on first use."""
     from rclpy.node import Node
+    from rclpy.parameter import Parameter
 
     with _lock:
         state = _running_state()
         if state.tool is None:
-            state.tool = Node(TOOL_NODE_NAME, context=state.context,
-                              start_parameter_services=False)
+            # Without parameter services and type description service: nobody asks a hidden
+            # tool node for them, and the latter makes creating the node (and so every `ros2`
+            # command) take twice as long.
+            state.tool = Node(TOOL_NODE_NAME, context=state.context, start_parameter_services=False,
+                              parameter_overrides=[Parameter("start_type_description_service", value=False)])
             state.tool.created_at = time.monotonic()
             state.executor.add_node(state.tool)
         return state.tool

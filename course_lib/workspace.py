@@ -96,9 +96,9 @@ def _check_package_name(name: str) -> None:
                          "underscores, starting with a letter (e.g. 'my_package')")
 
 
-def _prepare_package_dir(ws_dir, name: str, exist_ok: bool) -> Path:
+def _prepare_package_dir(package_dir, name: str, exist_ok: bool) -> Path:
     _check_package_name(name)
-    package_dir = Path(ws_dir) / "src" / name
+    package_dir = Path(package_dir)
     if package_dir.exists() and not exist_ok:
         raise FileExistsError(f"package {name!r} already exists at {package_dir}: pick another name, delete "
                               "the folder, or pass exist_ok=True to rewrite its generated files (your own "
@@ -278,6 +278,30 @@ def create_package(ws_dir, name: str, *, build_type: str = "ament_python", depen
         ValueError: a bad name or build type.
         FileExistsError: the package exists and exist_ok is False.
     """
+    package_dir = Path(ws_dir) / "src" / name
+    write_python_package(package_dir, name, build_type=build_type, dependencies=dependencies,
+                         node_name=node_name, description=description, maintainer=maintainer,
+                         maintainer_email=maintainer_email, license=license, exist_ok=exist_ok)
+    return package_dir
+
+
+def write_python_package(package_dir, name: str, *, build_type: str = "ament_python", dependencies=(),
+                         node_name: str | list[str] | None = None, rclpy_node: bool | None = None,
+                         description: str = DEFAULT_DESCRIPTION, maintainer: str = DEFAULT_MAINTAINER,
+                         maintainer_email: str = DEFAULT_EMAIL, license: str = "Apache-2.0",
+                         exist_ok: bool = False) -> list[Path]:
+    """Write an ament_python package into ``package_dir`` (``ros2 pkg create`` uses this too).
+
+    Args:
+        package_dir: the package folder, e.g. ws/src/my_package.
+        rclpy_node: write each node as an rclpy node that logs "Node started!" (True), or as
+            ``ros2 pkg create``'s plain ``print('Hi from <name>.')`` (False); None picks the rclpy
+            node when rclpy is a dependency.
+        The others as for create_package.
+
+    Returns:
+        The files written, in order.
+    """
     if build_type != "ament_python":
         raise ValueError(f"build_type {build_type!r} is not supported here: use 'ament_python' for Python "
                          "nodes, or create_interface_package() for a package of .msg files")
@@ -288,7 +312,9 @@ def create_package(ws_dir, name: str, *, build_type: str = "ament_python", depen
     dependencies = list(dict.fromkeys(dependencies))
     for dependency in dependencies:
         _check_package_name(dependency)
-    package_dir = _prepare_package_dir(ws_dir, name, exist_ok)
+    if rclpy_node is None:
+        rclpy_node = "rclpy" in dependencies
+    package_dir = _prepare_package_dir(package_dir, name, exist_ok)
     body = [f"  <depend>{dependency}</depend>" for dependency in dependencies]
     body += ([""] if body else []) + [f"  <test_depend>{test}</test_depend>" for test in
                                       ("ament_copyright", "ament_flake8", "ament_pep257", "python3-pytest")]
@@ -305,13 +331,16 @@ def create_package(ws_dir, name: str, *, build_type: str = "ament_python", depen
     }
     keep_if_present = {f"{name}/__init__.py": ""}
     for node in node_names:
-        keep_if_present[f"{name}/{node}.py"] = _node_source(name, node, "rclpy" in dependencies)
+        keep_if_present[f"{name}/{node}.py"] = _node_source(name, node, rclpy_node)
+    written = []
     for relative, text in files.items():
         _write(package_dir / relative, text)
+        written.append(package_dir / relative)
     for relative, text in keep_if_present.items():
         if not (package_dir / relative).exists():
             _write(package_dir / relative, text)
-    return package_dir
+            written.append(package_dir / relative)
+    return written
 
 
 def create_interface_package(ws_dir, name: str, messages: dict[str, str], *,
@@ -348,7 +377,7 @@ def create_interface_package(ws_dir, name: str, messages: dict[str, str], *,
     dependencies = list(dict.fromkeys(dependencies))
     for dependency in dependencies:
         _check_package_name(dependency)
-    package_dir = _prepare_package_dir(ws_dir, name, exist_ok)
+    package_dir = _prepare_package_dir(Path(ws_dir) / "src" / name, name, exist_ok)
     finds = "".join(f"find_package({dependency} REQUIRED)\n" for dependency in dependencies)
     listed = "".join(f'  "msg/{stem}.msg"\n' for stem in names)
     depends_clause = f"  DEPENDENCIES {' '.join(dependencies)}\n" if dependencies else ""
@@ -640,10 +669,9 @@ def _parameter_value(value) -> str:
 
 def executables(ws_dir, package: str) -> list[str]:
     """The executables ``ros2 run`` would offer for a package of the built workspace."""
-    lib_dir = Path(ws_dir).absolute() / "install" / package / "lib" / package
-    if not lib_dir.is_dir():
-        return []
-    return sorted(p.name for p in lib_dir.iterdir() if p.is_file() and os.access(p, os.X_OK))
+    from course_lib import ament
+
+    return ament.executables_in(Path(ws_dir).absolute() / "install" / package, package)
 
 
 def executable_command(ws_dir, package: str, executable: str, *, ros_args=(), remap: dict | None = None,

@@ -256,6 +256,20 @@ def _end_processes(processes: list[psutil.Process], grace: float) -> None:
 
 # --- the notebook UI -----------------------------------------------------------------------
 
+def write_notebook(path: Path, sources: list[str]) -> None:
+    """Write a notebook of code cells (no outputs) with the python3 kernel, for a test to open."""
+    import nbformat
+
+    notebook = nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell(s) for s in sources])
+    notebook.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3 (ipykernel)",
+                                       "language": "python"}
+    nbformat.write(notebook, path)
+
+
+def code_cell_count(path: Path) -> int:
+    return sum(cell["cell_type"] == "code" for cell in json.loads(path.read_text())["cells"])
+
+
 NOTEBOOK = ".jp-NotebookPanel:not(.lm-mod-hidden)"
 
 

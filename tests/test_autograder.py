@@ -3,7 +3,6 @@ and release -> reference solutions -> grade -> full marks for every assignment, 
 
 from __future__ import annotations
 
-import shutil
 import sys
 from pathlib import Path
 
@@ -13,7 +12,8 @@ import pytest
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import zoo  # noqa: E402
-from autograder import config, grading, harness  # noqa: E402
+from autograder import grading, reference  # noqa: E402
+from course_lib.checks import harness, validate  # noqa: E402
 
 ASSIGNMENTS = ["brightness", "pubsub", "catdog_warp"]
 REPO = Path(__file__).resolve().parent.parent
@@ -59,8 +59,8 @@ def test_build_script_reproduces_the_committed_notebooks(tmp_path, monkeypatch):
 def test_cell_timeouts_give_graded_cells_longer():
     """Graded cells get the long timeout, every other cell the short one."""
     graded = nbformat.v4.new_code_cell("x", metadata={"nbgrader": {"grade": True, "solution": False}})
-    assert config.cell_timeout(graded) == config.TEST_CELL_TIMEOUT
-    assert config.cell_timeout(nbformat.v4.new_code_cell("x")) == config.CELL_TIMEOUT
+    assert validate.cell_timeout(graded) == validate.TEST_CELL_TIMEOUT
+    assert validate.cell_timeout(nbformat.v4.new_code_cell("x")) == validate.CELL_TIMEOUT
 
 
 def test_sandbox_hides_directories_and_keeps_the_command():
@@ -72,33 +72,8 @@ def test_sandbox_hides_directories_and_keeps_the_command():
 
 
 def _module_dir(tmp_path: Path, assignment: str, edits=()) -> Path:
-    nb = nbformat.read(REPO / "assignments" / "source" / assignment / f"{assignment}.ipynb", as_version=4)
-    source = zoo.solution_source(zoo.module_cell(nb).source)
-    first, body = source.split("\n", 1)
-    for old, new in edits:
-        assert old in body
-        body = body.replace(old, new, 1)
-    (tmp_path / first.split()[1]).write_text(body)
+    reference.write_reference_module(assignment, tmp_path, edits)
     return tmp_path
-
-
-def test_stub_fails_with_a_hint_not_a_crash(tmp_path):
-    """The released stub imports; its self-check scores 0 and says to replace NotImplementedError."""
-    nb = nbformat.read(REPO / "assignments" / "source" / "brightness" / "brightness.ipynb", as_version=4)
-    lines, skipping = [], False
-    for line in zoo.module_cell(nb).source.split("\n")[1:]:  # what nbgrader's ClearSolutions does
-        if "### BEGIN SOLUTION" in line:
-            indent = line[:len(line) - len(line.lstrip())]
-            lines += [indent + stub for stub in config.CODE_STUB.split("\n")]
-            skipping = True
-        elif "### END SOLUTION" in line:
-            skipping = False
-        elif not skipping:
-            lines.append(line)
-    (tmp_path / "brightness_node.py").write_text("\n".join(lines))
-    result = harness.execute("brightness", "values", 1, workdir=tmp_path)
-    assert result.points == 0
-    assert "replace `raise NotImplementedError()`" in "\n".join(result.verdict_lines())
 
 
 def _brightness_mistakes():
@@ -116,7 +91,7 @@ def test_brightness_typical_mistake_gets_its_score_and_reason(tmp_path, student)
     for check in ("values", "node"):
         if entry[check] is None:
             continue  # the entry is about the other check
-        result = harness.execute("brightness", check, 11, workdir=workdir)
+        result = harness.execute("brightness", check, 11, workdir=workdir, mode="graded")
         texts.extend(result.verdict_lines())
         expected = entry[check]
         if isinstance(expected, tuple):
@@ -142,14 +117,15 @@ CATDOG_MISTAKES = {
 def test_catdog_typical_mistake_loses_points_with_its_reason(tmp_path, mistake):
     """Typical warp mistakes score below full on easy scenes, and the verdict names the mistake."""
     edits, reason = CATDOG_MISTAKES[mistake]
-    result = harness.execute("catdog_warp", "easy", 3, workdir=_module_dir(tmp_path, "catdog_warp", edits))
+    result = harness.execute("catdog_warp", "easy", 3, workdir=_module_dir(tmp_path, "catdog_warp", edits),
+                              mode="graded")
     assert result.points < result.max_points
     assert reason in "\n".join(result.verdict_lines())
 
 
 def test_catdog_reference_passes_easy_scenes(tmp_path):
     """The reference crop_pictures gets every point on easy scenes (the checks can be passed)."""
-    result = harness.execute("catdog_warp", "easy", 3, workdir=_module_dir(tmp_path, "catdog_warp"))
+    result = harness.execute("catdog_warp", "easy", 3, workdir=_module_dir(tmp_path, "catdog_warp"), mode="graded")
     assert result.points == result.max_points, result.verdict_lines()
 
 
@@ -170,7 +146,7 @@ PUBSUB_MISTAKES = {
 def test_pubsub_typical_mistake_loses_points_with_its_reason(tmp_path, mistake):
     """Typical publisher/subscriber mistakes score below full, and the verdict names the mistake."""
     edits, check, reason = PUBSUB_MISTAKES[mistake]
-    result = harness.execute("pubsub", check, 5, workdir=_module_dir(tmp_path, "pubsub", edits))
+    result = harness.execute("pubsub", check, 5, workdir=_module_dir(tmp_path, "pubsub", edits), mode="graded")
     assert result.points < result.max_points, result.verdict_lines()
     assert reason in "\n".join(result.verdict_lines())
 

@@ -131,7 +131,6 @@ def test_second_run_reuses_unchanged_grades(graded):
     """A second grade run grades nothing again and reports the same scores."""
     from autograder import grading
 
-    started = time.monotonic()
     again = grading.grade(graded["course"], workers=2, progress=False)
     assert all(r.from_cache for r in again)
     assert {r.student: r.status for r in again} == {s: r.status for s, r in graded["results"].items()}

@@ -6,15 +6,13 @@ checker's own small notebooks, which prove that the checker passes a good notebo
 one that raises. Screenshots go to artifacts/browser/<notebook>.png.
 """
 
-import json
 import shutil
 from pathlib import Path
 
-import nbformat
 import pytest
 
-from browser_support import (NOTEBOOK, click_toolbar_button, open_notebook, run_notebook, running_jupyterlab,
-                             toolbar_labels)
+from browser_support import (NOTEBOOK, click_toolbar_button, code_cell_count, open_notebook, run_notebook,
+                             running_jupyterlab, toolbar_labels, write_notebook)
 
 ROOT = Path(__file__).resolve().parents[1]
 NOTEBOOKS = ROOT / "notebooks"
@@ -35,17 +33,6 @@ CHECKER_NOTEBOOKS = {
     "raises.ipynb": ["x = 1", "1 / 0", "print('never reached')"],
     "broken_image.ipynb": ["from IPython.display import Image\nImage(data=b'these bytes are no PNG', format='png')"],
 }
-
-
-def write_notebook(path: Path, sources: list[str]) -> None:
-    notebook = nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell(s) for s in sources])
-    notebook.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3 (ipykernel)",
-                                       "language": "python"}
-    nbformat.write(notebook, path)
-
-
-def code_cell_count(path: Path) -> int:
-    return sum(cell["cell_type"] == "code" for cell in json.loads(path.read_text())["cells"])
 
 
 @pytest.fixture(scope="module")

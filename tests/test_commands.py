@@ -8,7 +8,6 @@ import time
 import urllib.request
 from pathlib import Path
 
-import pytest
 
 from browser_support import free_port
 
@@ -40,6 +39,9 @@ def test_make_lab_serves_the_course_and_prints_its_url(tmp_path):
         with urllib.request.urlopen(f"http://127.0.0.1:{port}/api/contents/notebooks?token={token}", timeout=30) as reply:
             listing = reply.read().decode()
         assert "00_setup_and_workspace.ipynb" in listing
+        # A JupyterLab terminal finds the venv's commands, `ros2` among them (on the pip install).
+        prefix = terminal_output(port, token, "ros2 pkg prefix std_msgs", until=str(ROOT / ".venv"))
+        assert str(ROOT / ".venv") in prefix
     finally:
         os.killpg(lab.pid, signal.SIGTERM)
         try:
@@ -47,3 +49,31 @@ def test_make_lab_serves_the_course_and_prints_its_url(tmp_path):
         except subprocess.TimeoutExpired:
             os.killpg(lab.pid, signal.SIGKILL)
             lab.wait()
+
+
+def terminal_output(port: int, token: str, command: str, until: str, timeout: float = 60) -> str:
+    """Open a JupyterLab terminal, type `command`, and return what it printed once `until` shows."""
+    import asyncio
+    import json
+
+    from tornado.websocket import websocket_connect
+
+    request = urllib.request.Request(f"http://127.0.0.1:{port}/api/terminals?token={token}", method="POST")
+    with urllib.request.urlopen(request, timeout=30) as reply:
+        name = json.loads(reply.read())["name"]
+
+    async def talk() -> str:
+        socket = await websocket_connect(f"ws://127.0.0.1:{port}/terminals/websocket/{name}?token={token}")
+        socket.write_message(json.dumps(["stdin", command + "\r"]))
+        seen = ""
+        while until not in seen.split(command, 1)[-1]:
+            message = await socket.read_message()
+            if message is None:
+                break
+            kind, *content = json.loads(message)
+            if kind == "stdout":
+                seen += content[0]
+        socket.close()
+        return seen
+
+    return asyncio.run(asyncio.wait_for(talk(), timeout))

@@ -4,7 +4,7 @@ import os
 import subprocess
 import sys
 
-from course_lib import doctor
+from course_lib import doctor, rosenv
 
 
 def run_doctor(*args, **env_changes):
@@ -54,3 +54,24 @@ def test_notebook_call_raises_naming_the_failed_check(monkeypatch):
         assert "ROS_DOMAIN_ID='banana' is not a valid domain id" in str(error)
     else:
         raise AssertionError("doctor.check() accepted ROS_DOMAIN_ID=banana")
+
+
+def camera_frames_line():
+    return next(c for c in doctor.run(live=False).checks if c.name == "camera frames")
+
+
+def test_camera_frames_line_names_the_course_profile_or_the_users_own(monkeypatch):
+    monkeypatch.delenv("FASTDDS_BUILTIN_TRANSPORTS", raising=False)
+    monkeypatch.setenv("FASTRTPS_DEFAULT_PROFILES_FILE", str(rosenv.FASTDDS_PROFILE))
+    line = camera_frames_line()
+    assert line.ok and not line.warning and "the course's shared-memory profile" in line.detail
+    monkeypatch.setenv("FASTRTPS_DEFAULT_PROFILES_FILE", "/home/me/mine.xml")
+    assert "your own Fast DDS set-up: FASTRTPS_DEFAULT_PROFILES_FILE=/home/me/mine.xml" in camera_frames_line().detail
+
+
+def test_a_small_dev_shm_is_a_warning_with_the_fix(monkeypatch):
+    for name in rosenv.FASTDDS_USER_SETTINGS:
+        monkeypatch.delenv(name, raising=False)
+    monkeypatch.setattr(rosenv, "shared_memory_mb", lambda: 64)
+    line = camera_frames_line()
+    assert line.ok and line.warning and "/dev/shm has 64 MB" in line.detail and "--shm-size=1g" in line.fix

@@ -253,6 +253,56 @@ def test_format_message_prints_like_ros2_topic_echo():
     assert graph.message_to_dict(image, truncate_length=None)["data"] == list(range(200))
 
 
+def test_echo_options_shorten_strings_and_arrays_like_ros2_topic_echo():
+    """Long strings are cut like arrays; --no-arr and --no-str leave only types and lengths."""
+    image = Image(height=1, width=4, encoding="mono8", step=4, data=bytes(4))
+    assert graph.message_to_dict(String(data="abcdef"), truncate_length=3) == {"data": "abc..."}
+    assert graph.message_to_dict(String(data="abcdef"), no_str=True) == {"data": "<string length: <6>>"}
+    assert graph.message_to_dict(image, no_arr=True)["data"] == "<sequence type: uint8, length: 4>"
+    assert graph.message_to_dict(image, no_arr=True)["encoding"] == "mono8"
+
+
+def test_fill_message_reads_values_the_way_ros2_topic_pub_does():
+    """Nested dicts, lists of messages, ints for floats, and `header: auto` become a message."""
+    from geometry_msgs.msg import PolygonStamped
+
+    msg = PolygonStamped()
+    setters = graph.fill_message(msg, {"header": "auto", "polygon": {"points": [{"x": 1, "y": 2.5}, {}]}})
+    assert [(point.x, point.y) for point in msg.polygon.points] == [(1.0, 2.5), (0.0, 0.0)]
+    assert len(setters) == 1
+    setters[0](graph.message_class("builtin_interfaces/msg/Time")(sec=7))
+    assert msg.header.stamp.sec == 7
+    image = Image()
+    graph.fill_message(image, {"data": [1, 2, 3], "encoding": "mono8"})
+    assert list(image.data) == [1, 2, 3] and image.encoding == "mono8"
+
+
+@pytest.mark.parametrize("values, message", [
+    ({"dta": 5}, "has no field 'dta'; its fields are: data"),
+    ({"data": "five"}, "data is a int32 and cannot take 'five'"),
+    ([5], "The message is a std_msgs/msg/Int32 and needs a dictionary of its fields"),
+])
+def test_fill_message_names_the_field_that_does_not_fit(values, message):
+    from std_msgs.msg import Int32
+
+    with pytest.raises(ValueError, match=message):
+        graph.fill_message(Int32(), values)
+
+
+def test_node_info_lists_topics_and_services_like_ros2_node_info(local_session):
+    """A talker's info shows its publisher, its parameter services and empty sections."""
+    session.add_node(Talker(name="info_talker", topic="info_chatter"))
+    info = graph.node_info("info_talker")
+    assert ("/info_chatter", ["std_msgs/msg/String"]) in info.publishers
+    assert ("/info_talker/get_parameters", ["rcl_interfaces/srv/GetParameters"]) in info.service_servers
+    text = graph.format_node_info(info)
+    assert text.startswith("/info_talker\n  Subscribers:\n\n  Publishers:\n")
+    assert "    /info_chatter: std_msgs/msg/String\n" in text
+    assert text.endswith("  Action Servers:\n\n  Action Clients:\n\n")
+    with pytest.raises(ValueError, match="Unable to find node '/nobody'"):
+        graph.node_info("/nobody", timeout=0.2)
+
+
 def test_message_class_reads_both_name_forms_and_names_the_missing_package():
     """'std_msgs/msg/String' and 'std_msgs/String' both work; a missing package names its pip."""
     assert graph.message_class("std_msgs/msg/String") is String

@@ -9,7 +9,8 @@ import sys
 
 import pytest
 
-from autograder import config, grading, guard, harness
+from autograder import config, grading, guard
+from course_lib.checks import harness
 
 
 @pytest.fixture(scope="module")

@@ -35,3 +35,23 @@ def test_packages_and_package_listing():
 def test_bad_names_say_what_exists(name, message):
     with pytest.raises((LookupError, ValueError), match=message.replace("(", r"\(")):
         interfaces.show(name)
+
+
+def test_comments_like_ros2_interface_show():
+    """By default the interface's own comments stay and nested types have none; 'none' drops all."""
+    shown = interfaces.show("sensor_msgs/msg/Image").splitlines()
+    assert shown[0] == "# This message contains an uncompressed image"
+    assert "std_msgs/Header header # Header timestamp should be acquisition time of image" in shown
+    assert not any(line.startswith("\t") and "#" in line for line in shown)
+    bare = interfaces.show("sensor_msgs/msg/Image", comments="none").splitlines()
+    assert bare[:2] == ["std_msgs/Header header", "\tbuiltin_interfaces/Time stamp"]
+    assert "uint8[] data" in bare and not any("#" in line or not line.strip() for line in bare)
+    every = interfaces.show("sensor_msgs/msg/Image", comments="all")
+    assert "\t# Two-integer timestamp that is expressed as seconds and nanoseconds." in every.splitlines()
+
+
+def test_services_show_both_halves_and_nest_their_messages():
+    """A .srv shows request, the --- line and response, each with its nested messages."""
+    lines = interfaces.show("rcl_interfaces/srv/SetParameters", comments="none").splitlines()
+    assert lines == ["Parameter[] parameters", "\tstring name", "\tParameterValue value", "\t\tuint8 type",
+                     *lines[4:13], "---", "SetParametersResult[] results", "\tbool successful", "\tstring reason"]

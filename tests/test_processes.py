@@ -8,7 +8,6 @@ import os
 import signal
 import subprocess
 import sys
-import textwrap
 import time
 import uuid
 
@@ -211,6 +210,37 @@ def test_loud_child_does_not_block_and_its_log_is_bounded():
     assert "bytes of output omitted" in log
     assert len(log) <= processes.LOG_HEAD_BYTES + processes.LOG_TAIL_BYTES + 100
     assert process.usage["supervisor_max_rss_kb"] < 100 * 1024  # it streamed, it did not buffer
+
+
+def test_on_output_gets_stdout_and_stderr_apart_as_they_arrive():
+    """on_output sees each stream's own bytes; the log still has both."""
+    pieces = []
+    code = "import sys\nprint('to out', flush=True)\nprint('to err', file=sys.stderr, flush=True)\n"
+    process = NodeProcess([sys.executable, "-c", code],
+                          on_output=lambda stream, data: pieces.append((stream, data))).start()
+    assert process.wait(timeout=10) == 0
+    assert wait_until(lambda: len(pieces) >= 2)
+    assert b"".join(data for stream, data in pieces if stream == "stdout") == b"to out\n"
+    assert b"".join(data for stream, data in pieces if stream == "stderr") == b"to err\n"
+    assert "to out" in process.log and "to err" in process.log
+
+
+def test_a_slow_on_output_never_blocks_the_child():
+    """A callback that stalls loses echoed output (and is told how much), not the child's time."""
+    pieces = []
+
+    def slow(stream, data):
+        if not pieces:
+            time.sleep(1.0)
+        pieces.append(data)
+
+    code = ("import sys, time\nstart = time.monotonic()\nfor _ in range(4096):\n"
+            "    sys.stdout.write('x' * 1023 + '\\n')\nprint(f'took {time.monotonic() - start:.3f}')\n")
+    process = NodeProcess([sys.executable, "-c", code], on_output=slow).start()
+    assert process.wait(timeout=20) == 0
+    took = float(process.log.rsplit("took ", 1)[1])
+    assert took < 0.9  # it wrote 4 MB without waiting for the stalled callback
+    assert wait_until(lambda: b"bytes of output not shown" in b"".join(pieces), timeout=5)
 
 
 def test_log_survives_stop_and_its_files_are_removed():

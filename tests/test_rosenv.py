@@ -3,10 +3,14 @@
 import os
 import subprocess
 import sys
+from xml.etree import ElementTree
 
 import pytest
+from rclpy.node import Node
+from rclpy.qos import qos_profile_sensor_data
+from sensor_msgs.msg import Image
 
-from course_lib import rosenv
+from course_lib import processes, rosenv, session
 
 
 def test_pip_wheels_are_detected_in_the_project_environment():
@@ -49,3 +53,73 @@ def test_modes_are_separate_flags(monkeypatch):
     monkeypatch.setenv("COURSE_LIB_UNDER_TEST", "0")
     monkeypatch.setenv("COURSE_LIB_GRADING", "1")
     assert rosenv.under_grading() and not rosenv.under_test()
+
+
+# ---- the Fast DDS set-up for camera frames ----------------------------------------------------
+
+def test_child_processes_get_the_course_fast_dds_profile():
+    env = rosenv.ros_environment(base={"PATH": "/usr/bin"})
+    assert env["FASTRTPS_DEFAULT_PROFILES_FILE"] == str(rosenv.FASTDDS_PROFILE)
+    sizes = [int(e.text) for e in ElementTree.parse(rosenv.FASTDDS_PROFILE).iter()
+             if e.tag.endswith("segment_size")]
+    assert sizes and sizes[0] >= 2 * 1920 * 1080 * 3, "a segment holds two 1920x1080 bgr8 frames"
+
+
+@pytest.mark.parametrize("name, value", [("FASTRTPS_DEFAULT_PROFILES_FILE", "/home/me/my_profile.xml"),
+                                         ("FASTDDS_BUILTIN_TRANSPORTS", "LARGE_DATA")])
+def test_a_users_own_fast_dds_choice_is_kept(name, value):
+    env = rosenv.ros_environment(base={"PATH": "/usr/bin", name: value})
+    assert env[name] == value
+    assert set(rosenv.FASTDDS_USER_SETTINGS) & set(env) == {name}
+
+
+def test_a_small_dev_shm_keeps_fast_dds_defaults(monkeypatch):
+    monkeypatch.setattr(rosenv, "shared_memory_mb", lambda: 64)  # Docker's default --shm-size
+    env = rosenv.ros_environment(base={"PATH": "/usr/bin"})
+    assert not set(rosenv.FASTDDS_USER_SETTINGS) & set(env)
+
+
+def without_fast_dds_settings() -> dict:
+    return {k: v for k, v in os.environ.items() if k not in rosenv.FASTDDS_USER_SETTINGS}
+
+
+def test_importing_course_lib_gives_the_notebook_session_the_profile():
+    code = "import os, course_lib; print(os.environ['FASTRTPS_DEFAULT_PROFILES_FILE'])"
+    done = subprocess.run([sys.executable, "-c", code], env=without_fast_dds_settings(), capture_output=True,
+                          text=True, timeout=60)
+    assert done.stdout.strip() == str(rosenv.FASTDDS_PROFILE), done.stderr
+
+
+def test_env_command_gives_a_shell_the_notebook_sessions_variables():
+    """`eval "$(python -m course_lib env)"` (what make lab does) sets what importing course_lib sets."""
+    script = f'eval "$({sys.executable} -m course_lib env)" && echo "$FASTRTPS_DEFAULT_PROFILES_FILE" && ' \
+             'echo "$ROS_AUTOMATIC_DISCOVERY_RANGE" && echo "$AMENT_PREFIX_PATH"'
+    done = subprocess.run(["sh", "-c", script], env=without_fast_dds_settings(), capture_output=True, text=True,
+                          timeout=60)
+    profile, scope, prefixes = done.stdout.splitlines()
+    assert profile == str(rosenv.FASTDDS_PROFILE), done.stderr
+    assert scope == "LOCALHOST"
+    assert sys.prefix in prefixes.split(os.pathsep)
+
+
+def test_full_size_camera_frames_reach_a_notebook_session_from_another_process(domain_id):
+    """1920x1080 frames from the camera process arrive at the session's best-effort subscriber
+    (with Fast DDS's 512 KB default segment most of them are lost)."""
+    period = 0.5
+    session.start(domain_id=domain_id)
+    try:
+        node = session.add_node(Node("full_size_viewer"))
+        stamps = []
+        node.create_subscription(Image, "image", lambda m: stamps.append(
+            m.header.stamp.sec + m.header.stamp.nanosec * 1e-9), qos_profile_sensor_data)
+        with processes.python_node("course_lib.camera:main", "--ros-args", "-p", "width:=1920", "-p",
+                                   "height:=1080", "-p", f"rate:={1 / period}", domain_id=domain_id) as camera:
+            camera.wait_for_node("image_publisher", timeout=30)
+            assert session.wait_for(lambda: len(stamps) >= 2, timeout=20), camera.log_tail()
+            first = len(stamps)
+            session.wait_for(lambda: len(stamps) >= first + 8, timeout=8 * period + 10)
+        gaps = [later - earlier for earlier, later in zip(stamps[first - 1:], stamps[first:])]
+        lost = sum(round(gap / period) - 1 for gap in gaps)
+        assert len(gaps) >= 8 and lost <= 1, f"{lost} frames lost between {len(gaps) + 1} received"
+    finally:
+        session.stop()

@@ -168,6 +168,16 @@ def test_create_package_refuses_to_overwrite_but_can_rerun(tmp_path):
     assert "<depend>std_msgs</depend>" in (package / "package.xml").read_text()
 
 
+def test_write_python_package_puts_the_package_where_asked_with_ros2_pkg_creates_node(tmp_path):
+    """Any folder, the files written listed in order, and the plain main of `ros2 pkg create`."""
+    written = workspace.write_python_package(tmp_path / "here", "demo", dependencies=["rclpy"],
+                                             node_name="hello", rclpy_node=False)
+    assert written[0] == tmp_path / "here" / "package.xml"
+    assert written[-1] == tmp_path / "here" / "demo" / "hello.py"
+    assert "print('Hi from demo.')" in written[-1].read_text()
+    assert "<depend>rclpy</depend>" in written[0].read_text()
+
+
 @pytest.mark.parametrize("name", ["MyNodes", "2nodes", "my-nodes", ""])
 def test_invalid_package_names_are_refused_with_the_rule(tmp_path, name):
     with pytest.raises(ValueError, match="lower case"):

@@ -13,11 +13,7 @@ from pathlib import Path
 
 import nbformat
 
-
-def solution_source(text: str) -> str:
-    """A solution cell as a student who solved it would hand it in: the markers removed."""
-    return "\n".join(line for line in text.split("\n")
-                     if "### BEGIN SOLUTION" not in line and "### END SOLUTION" not in line)
+from autograder.reference import module_cell, solution_source
 
 
 def filled_notebook(course: Path, assignment: str) -> nbformat.NotebookNode:
@@ -31,14 +27,6 @@ def filled_notebook(course: Path, assignment: str) -> nbformat.NotebookNode:
         if meta.get("solution"):
             cell.source = solution_source(solutions[meta["grade_id"]])
     return release
-
-
-def module_cell(nb: nbformat.NotebookNode) -> nbformat.NotebookNode:
-    """The solution cell that writes the student's module (%%writefile)."""
-    for cell in nb.cells:
-        if cell.cell_type == "code" and cell.source.startswith("%%writefile"):
-            return cell
-    raise LookupError("no %%writefile cell in the notebook")
 
 
 def edited_notebook(course: Path, assignment: str, edits=(), student: str = "") -> nbformat.NotebookNode:

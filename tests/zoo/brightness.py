@@ -81,7 +81,7 @@ def hostile(course_dir: str):
 
 CHEAT = """
 # Fakes the hidden tests from inside the kernel: every check "earns" its full points.
-import autograder.harness as harness_module
+import course_lib.checks.harness as harness_module
 def full_points(assignment, name, *args, **kwargs):
     return harness_module.get_check(assignment, name).points
 harness_module.grade = full_points
@@ -89,6 +89,14 @@ harness_module.run_check = full_points
 checks.grade = lambda name: full_points("brightness", name)
 print("CHEAT: installed")
 """
+
+
+#: Returns the grader's own answer when the answer key can be imported, else 0.
+STEAL_ANSWER = """try:
+        from autograder.answers.brightness import average_brightness as stolen
+        return stolen(image)
+    except ImportError:
+        return 0"""
 
 
 def cheater(nb):
@@ -112,14 +120,15 @@ def entries(course_dir: str) -> dict[str, dict]:
                          reason="rounded to nearest"),
         "reliable_qos": dict(level="check", edits=[('self.create_subscription(Image, "/image", self.on_image, qos_profile_sensor_data)',
                                      'self.create_subscription(Image, "/image", self.on_image, 10)')],
-                             values=None, node=1.75, reason="camera topics use the sensor-data QoS"),
+                             values=None, node=1.0, reason="camera topics use the sensor-data QoS"),
         "wrong_topic": dict(level="check", edits=[('UInt8, "/brightness"', 'UInt8, "/image_brightness"')], values=None, node=(0, 6.2),
                             reason="does not publish /brightness"),
         "python_loop": dict(level="check", edits=[(SUM, "total = 0\n    for value in image.reshape(-1):\n        total += int(value)\n"
-                                         "    return total // image.size")], values=None, node=5.25,
+                                         "    return total // image.size")], values=None, node=5.0,
                             reason="too slow"),
-        # Points come from the grader's own run of the checks, not from what the kernel reports.
-        "cheater": dict(edits=[(SUM, "return 0"), cheater], values=0, node=None, reason="returned 0, expected"),
+        # Points come from the grader's own run of the checks, not from what the kernel reports;
+        # and the grader's answer key is out of the student's reach (else values would be 4).
+        "cheater": dict(edits=[(SUM, STEAL_ANSWER), cheater], values=0, node=None, reason="returned 0, expected"),
         "import_loop": dict(edits=[(IMPORTS, IMPORTS + "while True:\n    pass\n")], values=0, node=0,
                             reason="did not finish within"),
         "callback_loop": dict(edits=[(CALLBACK, "        while True:\n            pass")], values=4, node=None,

@@ -1,6 +1,6 @@
 """What a graded check is, and how it runs: the same code for the self-check and the autograder.
 
-A check is a function in ``autograder/checks/<assignment>.py`` decorated with :func:`check`,
+A check is a function in ``course_lib/checks/<assignment>.py`` decorated with :func:`check`,
 which gives it its points and its time limit; its docstring's first line says what it checks::
 
     @check(points=4, timeout=40)
@@ -12,7 +12,7 @@ which gives it its points and its time limit; its docstring's first line says wh
 Where things run:
 
 - the notebook kernel only starts the check and prints its verdict (:func:`run_check`): the check
-  runs in a process of its own (``python -m autograder.harness run ...``) with a wall-time bound,
+  runs in a process of its own (``python -m course_lib.checks.harness run ...``) with a wall-time bound,
   so nothing a check does can hang or crash the kernel, and nothing the kernel's state holds
   (a node the student left spinning, a patched module) changes the check;
 - the student's code runs in a third process, started by the check (:meth:`Context.call` for
@@ -21,15 +21,19 @@ Where things run:
   costs the points of that check and nothing else.
 
 At grading the course's grader (autograder.grading) runs the hidden checks itself, outside the
-student's kernel (``python -m autograder.harness outside``): :func:`grade` in the notebook only
+student's kernel (``python -m course_lib.checks.harness outside``): :func:`grade` in the notebook only
 says so. As root the check stays root and the student's processes run as the grader's worker
 uid (AUTOGRADER_STUDENT_UID), so the student's code can neither fake a check's result nor read
 its seed (passed in the environment, not on the command line).
 
 Seeds: a self-check uses fixed seeds (the same frames every time, so a student can debug);
 grading draws a fresh seed per check (or takes AUTOGRADER_SEED to reproduce a grade) and
-the verdict prints it, so that the feedback records it. Expected answers are computed from the
-seed in the check process; nothing the student's process can read holds them.
+the verdict prints it, so that the feedback records it.
+
+Expected answers (:meth:`Context.expected`, course_lib.checks.answers): graded, from the grader's
+answer key (``autograder.answers``, instructor side only); in a self-check, the answers that key
+gave for the self-check's inputs, recorded as data. Nothing a student can import or read holds
+a reference solution, and nothing the student's process can read holds a graded answer.
 
 Points: the check's items each pass or fail; the check earns ``points × passed weight / total
 weight``. The value of the test cell is that number, which nbgrader 0.9 takes as partial credit
@@ -52,6 +56,8 @@ import time
 import traceback
 from pathlib import Path
 
+from course_lib.checks import answers
+
 #: Seconds a student's module gets to import (rclpy alone needs one or two on a busy machine).
 IMPORT_TIMEOUT = 25.0
 
@@ -64,11 +70,6 @@ STUDENT_FILE_MB = 128
 #: Written into the work directory when the student's module did not import in time, so that
 #: later checks fail at once with the same reason instead of waiting again.
 IMPORT_HANG_MARK = ".autograder-import-hang"
-
-#: Fast DDS profile of check and student processes: a shared-memory transport with 32 MB segments (so a student process needs RLIMIT_FSIZE above that).
-#: With the default transports, best-effort 1920x1080 frames (6 MB, sensor-data QoS) between two
-#: local processes lose most of their UDP fragments: 2-8 of 60 frames arrive. With it, all do.
-FASTDDS_PROFILE = Path(__file__).resolve().parent / "fastdds_large_data.xml"
 
 #: The fixed seed of self-checks (what the student sees when running the notebook).
 SELFCHECK_SEED = 2024
@@ -99,7 +100,7 @@ _REGISTRY: dict[str, dict[str, Check]] = {}
 
 
 def check(points: float, timeout: float):
-    """Register a check function of an ``autograder.checks`` module (see the module docstring)."""
+    """Register a check function of a ``course_lib.checks`` module (see the module docstring)."""
     def register(function):
         assignment = function.__module__.rsplit(".", 1)[-1]
         doc = (function.__doc__ or "").strip().splitlines()
@@ -113,7 +114,7 @@ def check(points: float, timeout: float):
 
 def checks_of(assignment: str) -> dict[str, Check]:
     """The checks of an assignment, in the order they are defined (imports the checks module)."""
-    importlib.import_module(f"autograder.checks.{assignment}")
+    importlib.import_module(f"course_lib.checks.{assignment}")
     return dict(_REGISTRY.get(assignment, {}))
 
 
@@ -203,7 +204,7 @@ def fresh_seed() -> int:
 
 def run_check(assignment: str, name: str, seed: int, graded: bool = False, workdir=None) -> float:
     """Run one check in a separate process, print its verdict, display its pictures, return points."""
-    result = execute(assignment, name, seed, workdir=workdir)
+    result = execute(assignment, name, seed, workdir=workdir, mode="graded" if graded else "selfcheck")
     print(verdict_text(result, graded))
     _display_images(result)
     return round(result.points, 3)
@@ -219,8 +220,13 @@ def verdict_text(result: Result, graded: bool) -> str:
     return "\n".join(lines)
 
 
-def execute(assignment: str, name: str, seed: int, workdir=None) -> Result:
-    """Run a check in its own process and return its Result (0 points when it failed to finish)."""
+def execute(assignment: str, name: str, seed: int, workdir=None, mode: str = "selfcheck") -> Result:
+    """Run a check in its own process and return its Result (0 points when it failed to finish).
+
+    `mode` says where its expected answers come from (course_lib.checks.answers): "selfcheck"
+    (recorded answers; only the self-check seed's inputs are recorded), "graded" (the grader's
+    answer key) or "record" (graded, and the answers written to $AUTOGRADER_RECORD_TO).
+    """
     from course_lib import processes
 
     spec = get_check(assignment, name)
@@ -230,12 +236,11 @@ def execute(assignment: str, name: str, seed: int, workdir=None) -> Result:
     # The seed goes in the environment, which other uids cannot read (a command line they can).
     # The working directory is the check's own: a student's file next to the notebook (json.py,
     # numpy.py) must not shadow a module the checker imports.
-    command = [sys.executable, "-m", "autograder.harness", "run", assignment, name,
+    command = [sys.executable, "-m", "course_lib.checks.harness", "run", assignment, name,
                "--workdir", str(workdir), "--out", str(out)]
     limits = processes.Limits(wall_seconds=spec.timeout + 10, grace_seconds=2.0)
     proc = processes.NodeProcess(command, name=f"autograder-check-{name}", cwd=out, limits=limits,
-                                 env={"PYTHONPATH": _pythonpath(), SEED_ENV: str(seed),
-                                      "FASTRTPS_DEFAULT_PROFILES_FILE": str(FASTDDS_PROFILE)})
+                                 env={"PYTHONPATH": _pythonpath(), SEED_ENV: str(seed), answers.MODE_ENV: mode})
     try:
         proc.start()
         try:
@@ -263,8 +268,9 @@ def execute(assignment: str, name: str, seed: int, workdir=None) -> Result:
 
 
 def _pythonpath() -> str:
-    """The directory holding the autograder package, first on the path of child processes."""
-    root = str(Path(__file__).resolve().parent.parent)
+    """The directory holding course_lib (in a course checkout also the autograder), first on the
+    path of child processes."""
+    root = str(Path(__file__).resolve().parents[2])
     rest = [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p and p != root]
     return os.pathsep.join([root] + rest)
 
@@ -345,6 +351,7 @@ class Context:
         self.images: list[dict] = []
         self._reservation = None
         self._started = time.monotonic()
+        self._answers = answers.AnswerKey(spec.assignment)
 
     # -- recording -----------------------------------------------------------------------------
 
@@ -352,6 +359,16 @@ class Context:
         """Record one checked claim; `message` says what was found (and the fix when it failed)."""
         self.items.append({"ok": bool(ok), "message": clip(message), "weight": float(weight)})
         return bool(ok)
+
+    def precondition(self, ok: bool, message: str) -> bool:
+        """Record a claim that later items depend on but that earns nothing by itself (a node that
+        starts, then fails at its job, must not score): shown like an item, weight 0."""
+        return self.item(ok, message, weight=0.0)
+
+    def expected(self, question: str, *args):
+        """The right answer of the contract's function `question` for these arguments (see
+        course_lib.checks.answers: the grader's key when graded, recorded answers in a self-check)."""
+        return self._answers.expected(question, *args)
 
     def note(self, text: str) -> None:
         """Record an informative line (no points)."""
@@ -400,7 +417,8 @@ class Context:
         Args:
             function: the name of a function of the student's module.
             calls: (args, kwargs) per call; args may hold numpy arrays, kwargs plain JSON values.
-            timeout: seconds for all calls together (after the import); default: what is left.
+            timeout: seconds for the import and all calls together; default (and at most): what is
+                left of the check's time, so the check always has time to report.
 
         Returns:
             One Outcome per call. Calls that did not run because the process died or ran out of
@@ -410,8 +428,8 @@ class Context:
         try:
             _write_calls(job, calls)
             timeout = min(timeout or self.remaining(), self.remaining())
-            proc = self._run_student("call", function, job, timeout)
-            return _read_outcomes(job, len(calls), proc, timeout)
+            proc, call_seconds = self._run_student("call", function, job, timeout)
+            return _read_outcomes(job, len(calls), proc, call_seconds)
         finally:
             shutil.rmtree(job, ignore_errors=True)
 
@@ -422,7 +440,7 @@ class Context:
         job = Path(tempfile.mkdtemp(prefix="autograder-endpoints-"))
         try:
             timeout = min(timeout, self.remaining())
-            proc = self._run_student("endpoints", class_name, job, timeout)
+            proc, _seconds = self._run_student("endpoints", class_name, job, timeout)
             try:
                 return json.loads((job / "endpoints.json").read_text())
             except (OSError, ValueError):
@@ -432,26 +450,41 @@ class Context:
             shutil.rmtree(job, ignore_errors=True)
 
     def _run_student(self, command: str, target: str, job: Path, timeout: float):
-        """Run ``python -m autograder.student COMMAND MODULE TARGET JOB`` to its end (or `timeout`
-        seconds after the import); raise StudentError when the module does not import."""
+        """Run ``python -m course_lib.checks.student COMMAND MODULE TARGET JOB`` to its end, or until
+        `timeout` seconds (import included, never past the check's own time) have passed.
+
+        Returns:
+            (the stopped process, the seconds its calls had after the import).
+
+        Raises:
+            StudentError: the module did not import.
+        """
         from course_lib import processes
 
         self.require_module()
         _give_to_student(job)
-        proc = processes.NodeProcess([sys.executable, "-m", "autograder.student", command, self.module, target, str(job)],
+        timeout = min(timeout, self.remaining())
+        deadline = time.monotonic() + timeout
+        proc = processes.NodeProcess([sys.executable, "-m", "course_lib.checks.student", command, self.module, target, str(job)],
                                      name=f"student-{target}", cwd=self.workdir, domain_id=self.domain_id,
-                                     limits=_student_limits(IMPORT_TIMEOUT + timeout), env=_student_env())
+                                     limits=_student_limits(timeout + 2), env=_student_env())
         proc.start()
+        import_wait = min(IMPORT_TIMEOUT, timeout)
+        call_seconds = 0.0
         try:
-            imported = _wait_for_file(job / "imported", IMPORT_TIMEOUT, proc)
+            imported = _wait_for_file(job / "imported", import_wait, proc)
             if not imported and proc.running():
+                if import_wait < IMPORT_TIMEOUT:
+                    raise StudentError(f"importing {self.module} did not finish within the {import_wait:.0f} s "
+                                       "this check had left (the machine may be busy; the import itself took long)")
                 _mark(self.workdir / IMPORT_HANG_MARK)
                 raise StudentError(f"importing {self.module} did not finish within {IMPORT_TIMEOUT:g} s: "
                                    "remove code that runs forever at import (loops, spin()) from the "
                                    "top level of the module; put it in main()")
             if imported:
+                call_seconds = max(0.0, deadline - time.monotonic())
                 try:
-                    proc.wait(timeout)
+                    proc.wait(call_seconds)
                 except TimeoutError:
                     pass
         finally:
@@ -459,7 +492,7 @@ class Context:
         if not (job / "imported").exists():
             raise StudentError(f"{self.module} could not be imported ({proc.describe_exit()}):\n"
                                f"{_tail(proc.log, 6)}")
-        return proc
+        return proc, call_seconds
 
     def start_node(self, *ros_args: str, entry: str = "main"):
         """Start the student's node (``<module>:main``) in this check's ROS domain; stopped at the end.
@@ -512,8 +545,10 @@ MODULES = {"brightness": "brightness_node", "pubsub": "pubsub_nodes", "catdog_wa
 
 
 def _student_env() -> dict:
+    # Fast DDS's set-up for camera frames comes, as for every course process, from
+    # course_lib.rosenv.ros_environment (its shared-memory segments need RLIMIT_FSIZE above 32 MB).
     return {"PYTHONPATH": _pythonpath(), "AUTOGRADER_SEED": None, SEED_ENV: None, STUDENT_UID_ENV: None,
-            "PYTHONDONTWRITEBYTECODE": "1", "FASTRTPS_DEFAULT_PROFILES_FILE": str(FASTDDS_PROFILE)}
+            answers.MODE_ENV: None, answers.RECORD_ENV: None, "PYTHONDONTWRITEBYTECODE": "1"}
 
 
 #: Set by the grader (as root) for the checks it runs: the uid (and its RLIMIT_NPROC) that the
@@ -724,7 +759,7 @@ def run_in_this_process(assignment: str, name: str, seed: int, workdir: Path, ou
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m autograder.harness", description="Run one graded check.")
+    parser = argparse.ArgumentParser(prog="python -m course_lib.checks.harness", description="Run one graded check.")
     sub = parser.add_subparsers(dest="command", required=True)
     run = sub.add_parser("run")
     run.add_argument("assignment")
@@ -742,7 +777,7 @@ def main(argv=None) -> int:
     if args.command == "outside":
         for name in args.checks:
             _write_json(out / f"{name}.json", dataclasses.asdict(execute(args.assignment, name, fresh_seed(),
-                                                                          workdir=args.workdir)))
+                                                                          workdir=args.workdir, mode="graded")))
         return 0
     seed = args.seed if args.seed is not None else int(os.environ.get(SEED_ENV, SELFCHECK_SEED))
     result = run_in_this_process(args.assignment, args.check, seed, Path(args.workdir).resolve(), out)
@@ -757,6 +792,6 @@ def _write_json(path: Path, data) -> None:
 
 if __name__ == "__main__":
     # Run through the imported module, so that the checks register where they are looked up.
-    from autograder.harness import main as _main
+    from course_lib.checks.harness import main as _main
 
     sys.exit(_main())

@@ -18,8 +18,8 @@ from __future__ import annotations
 import re
 import time
 
-from autograder import harness
-from autograder.harness import check
+from course_lib.checks import harness
+from course_lib.checks.harness import check
 
 ASSIGNMENT = "pubsub"
 TOPIC = "/ros_tutorial_msg"
@@ -73,7 +73,7 @@ def _wait_node(ctx, probe, proc, name: str) -> bool:
         names = sorted(n for n, _ in probe.node.get_node_names_and_namespaces() if not n.startswith("autograder"))
         ctx.item(False, f"no node named {name} within 25 s (nodes seen: {names}): pass '{name}' to super().__init__()")
         return False
-    return ctx.item(True, f"node {name} runs")
+    return ctx.precondition(True, f"node {name} runs")
 
 
 @check(points=5, timeout=60)

@@ -18,8 +18,8 @@ import time
 
 import numpy as np
 
-from autograder import harness
-from autograder.harness import check
+from course_lib.checks import harness
+from course_lib.checks.harness import check
 
 ASSIGNMENT = "brightness"
 
@@ -32,11 +32,6 @@ def selfcheck(name: str):
 def grade(name: str):
     """Run check `name` with a fresh seed (grading)."""
     return harness.grade(ASSIGNMENT, name)
-
-
-def expected_brightness(image: np.ndarray) -> int:
-    """The answer the contract asks for (the grader's own, computed from the generated image)."""
-    return int(image.sum(dtype=np.uint64) // image.size)
 
 
 def _test_images(rng: np.random.Generator) -> list[tuple[str, np.ndarray]]:
@@ -59,7 +54,7 @@ def values(ctx: harness.Context) -> None:
     cases = _test_images(ctx.rng)
     outcomes = ctx.call("average_brightness", [((image,), {}) for _, image in cases])
     for (label, image), outcome in zip(cases, outcomes):
-        expected = expected_brightness(image)
+        expected = ctx.expected("average_brightness", image)
         mean = float(image.mean())
         if not outcome.ok:
             hint = ""
@@ -96,14 +91,16 @@ NODE_NAME = "my_node"
 #: Frames of the throughput test: 1920x1080 BGR at 30 Hz for this many seconds.
 THROUGHPUT_SECONDS = 2.0
 THROUGHPUT_RATE = 30.0
-#: Share of the frames the grader's own numpy node answers, in the same run and place, that the
+#: Share of the frames the grader's yardstick node answers, in the same run and place, that the
 #: student's node must answer for the points. Comparing side by side, instead of with the frames
 #: sent, keeps the grade fair on a loaded grading machine (DDS then drops large best-effort frames
 #: before any node sees them), while a per-byte Python loop (~80x slower) still falls far short.
+#: The yardstick receives each frame and answers at once without computing anything (a numpy
+#: mean of a 1080p frame takes ~2 ms of the 33 ms between frames, so the share stays fair).
 THROUGHPUT_SHARE = 0.5
-#: Below this many answers from the grader's own node, the machine was too busy to measure.
+#: Below this many answers from the yardstick node, the machine was too busy to measure.
 THROUGHPUT_MIN_REFERENCE = 6
-REFERENCE_NODE_NAME = "brightness_reference"
+YARDSTICK_NODE_NAME = "brightness_yardstick"
 
 
 def _node_names(probe) -> set[str]:
@@ -115,7 +112,7 @@ def _exchange(ctx, probe, publisher, replies: list, frames, encoding: str, label
     from course_lib import images
 
     for image in frames:
-        expected = expected_brightness(image)
+        expected = ctx.expected("average_brightness", image)
         msg = images.image_to_msg(image, encoding)
         replies.clear()
         deadline = time.monotonic() + 4.0
@@ -176,7 +173,13 @@ def _node_died(ctx, node) -> bool:
 @check(points=7, timeout=90)
 def node(ctx: harness.Context) -> None:
     """BrightnessNode: name my_node, /image -> /brightness with sensor-data QoS, bgr8 and mono8, 30 Hz at 1080p, remappable."""
-    reference_answers = _reference_throughput(ctx)
+    # Every input is drawn first: what is drawn must not depend on how the run goes (the
+    # self-check's answers were recorded for exactly these inputs).
+    colour = [ctx.rng.integers(0, 256, size=(480, 640, 3), dtype=np.uint8) // int(d) for d in (1, 2, 3)]
+    grey = [ctx.rng.integers(0, 256, size=(240, 320), dtype=np.uint8) // int(d) for d in (1, 4)]
+    remapped_image = ctx.rng.integers(0, 256, size=(120, 160, 3), dtype=np.uint8)
+    burst = _burst_frames(ctx.rng)
+    reference_answers = _reference_throughput(ctx, burst)
     node = ctx.start_node()
     try:
         with ctx.probe() as probe:
@@ -189,31 +192,32 @@ def node(ctx: harness.Context) -> None:
                 ctx.item(False, f"no node named {NODE_NAME} appeared within 25 s" +
                          (f"; nodes seen: {names}: pass '{NODE_NAME}' to super().__init__()" if names else ""))
                 return
-            ctx.item(True, f"a node named {NODE_NAME} runs")
+            ctx.precondition(True, f"a node named {NODE_NAME} runs")
             _qos_items(ctx, probe)
-            colour = [ctx.rng.integers(0, 256, size=(480, 640, 3), dtype=np.uint8) // int(d) for d in (1, 2, 3)]
             _exchange(ctx, probe, publisher, replies, colour, "bgr8", "bgr8 frames")
             if _node_died(ctx, node):
                 return
-            grey = [ctx.rng.integers(0, 256, size=(240, 320), dtype=np.uint8) // int(d) for d in (1, 4)]
             _exchange(ctx, probe, publisher, replies, grey, "mono8", "mono8 frames")
             if _node_died(ctx, node):
                 return
-            _throughput(ctx, probe, publisher, replies, reference_answers)
+            _throughput(ctx, probe, publisher, replies, burst, reference_answers)
         if _node_died(ctx, node):
             return
     finally:
         node.stop(timeout=2)
         ctx.note(f"node output (last lines):\n{node.log_tail(4)}")
-    _remapped(ctx)
+    _remapped(ctx, remapped_image)
 
 
-def _burst(ctx, probe, publisher, replies: list) -> int:
-    """Send THROUGHPUT_SECONDS of 1920x1080 frames at THROUGHPUT_RATE; return how many got an answer."""
+def _burst_frames(rng) -> list:
+    """The two 1920x1080 bgr8 Image messages the throughput test alternates."""
     from course_lib import images
 
-    frames = [images.image_to_msg(ctx.rng.integers(0, 256, size=(1080, 1920, 3), dtype=np.uint8), "bgr8")
-              for _ in range(2)]
+    return [images.image_to_msg(rng.integers(0, 256, size=(1080, 1920, 3), dtype=np.uint8), "bgr8") for _ in range(2)]
+
+
+def _burst(probe, publisher, replies: list, frames: list) -> int:
+    """Send THROUGHPUT_SECONDS of `frames` at THROUGHPUT_RATE; return how many got an answer."""
     replies.clear()
     count = int(THROUGHPUT_SECONDS * THROUGHPUT_RATE)
     start = time.monotonic()
@@ -237,67 +241,65 @@ def _frames_and_replies(probe, image_topic: str, brightness_topic: str):
     return publisher, replies
 
 
-def _reference_throughput(ctx) -> int:
-    """How many throughput frames the grader's own numpy node answers here and now (the yardstick)."""
+def _reference_throughput(ctx, frames: list) -> int:
+    """How many throughput frames the yardstick node answers here and now."""
     from course_lib import processes
 
-    reference = processes.python_node("autograder.checks.brightness:reference_main", name="brightness-reference",
+    yardstick = processes.python_node("course_lib.checks.brightness:yardstick_main", "--ros-args",
+                                      "-r", "frames:=/image", "-r", "answers:=/brightness", name="brightness-yardstick",
                                       domain_id=ctx.domain_id, env=harness._student_env())
     try:
         with ctx.probe() as probe:
             publisher, replies = _frames_and_replies(probe, "/image", "/brightness")
-            if not probe.spin_until(lambda: REFERENCE_NODE_NAME in _node_names(probe), 25.0):
+            if not probe.spin_until(lambda: YARDSTICK_NODE_NAME in _node_names(probe), 25.0):
                 return 0
             probe.wait_for_subscriber(publisher, 5.0)
-            return _burst(ctx, probe, publisher, replies)
+            return _burst(probe, publisher, replies, frames)
     finally:
-        reference.stop(timeout=2)
+        yardstick.stop(timeout=2)
 
 
-def reference_main(args=None) -> None:
-    """The grader's own brightness node (numpy), run beside the student's as the throughput yardstick."""
+def yardstick_main(args=None) -> None:
+    """The throughput yardstick: answers every Image on `frames` at once with a UInt8 0 on `answers`,
+    computing nothing (what the transport allows here and now). The check remaps both topics."""
     import rclpy
     from rclpy.node import Node
     from rclpy.qos import qos_profile_sensor_data
     from sensor_msgs.msg import Image
     from std_msgs.msg import UInt8
 
-    from course_lib import images
-
-    class ReferenceBrightness(Node):
+    class Yardstick(Node):
         def __init__(self):
-            super().__init__(REFERENCE_NODE_NAME)
-            self.publisher = self.create_publisher(UInt8, "/brightness", qos_profile_sensor_data)
-            self.create_subscription(Image, "/image", self.on_image, qos_profile_sensor_data)
-
-        def on_image(self, msg):
-            self.publisher.publish(UInt8(data=expected_brightness(images.msg_to_image(msg))))
+            super().__init__(YARDSTICK_NODE_NAME)
+            self.answers = self.create_publisher(UInt8, "answers", qos_profile_sensor_data)
+            self.create_subscription(Image, "frames", lambda _frame: self.answers.publish(UInt8()),
+                                     qos_profile_sensor_data)
 
     rclpy.init(args=args)
     try:
-        rclpy.spin(ReferenceBrightness())
+        rclpy.spin(Yardstick())
     except KeyboardInterrupt:
         pass
     finally:
         rclpy.try_shutdown()
 
 
-def _throughput(ctx, probe, publisher, replies, reference_answers: int) -> None:
-    answered = _burst(ctx, probe, publisher, replies)
+def _throughput(ctx, probe, publisher, replies, frames: list, reference_answers: int) -> None:
+    answered = _burst(probe, publisher, replies, frames)
     count = int(THROUGHPUT_SECONDS * THROUGHPUT_RATE)
     if reference_answers < THROUGHPUT_MIN_REFERENCE:
-        ctx.item(True, f"throughput not measured: the grading machine was too busy (its own numpy node answered "
+        ctx.item(True, f"throughput not measured: the grading machine was too busy (its yardstick node answered "
                        f"{reference_answers} of {count} 1920x1080 frames); not held against you", weight=2.0)
         return
     needed = THROUGHPUT_SHARE * reference_answers
     message = (f"answered {answered} of {count} 1920x1080 frames sent at {THROUGHPUT_RATE:g} Hz; the grader's "
-               f"numpy node answered {reference_answers} in the same place (needs {THROUGHPUT_SHARE:.0%} of that)")
+               f"yardstick node answered {reference_answers} in the same place (needs {THROUGHPUT_SHARE:.0%} of that)")
     ctx.item(answered >= needed, message if answered >= needed else
              message + ": a Python loop over 6 million bytes per frame is too slow; let numpy do the sum "
                        "(image.sum() // image.size)", weight=2.0)
 
 
-def _remapped(ctx) -> None:
+def _remapped(ctx, image) -> None:
     from course_lib import images
 
     node = ctx.start_node("--ros-args", "-r", "__node:=renamed_by_grader", "-r", "/image:=/grader/image",
@@ -310,8 +312,7 @@ def _remapped(ctx) -> None:
                 ctx.item(False, "with --ros-args -r __node:=renamed_by_grader no node of that name appeared: "
                                 "call rclpy.init(args=args) and pass args from main(args=None)")
                 return
-            image = ctx.rng.integers(0, 256, size=(120, 160, 3), dtype=np.uint8)
-            expected = expected_brightness(image)
+            expected = ctx.expected("average_brightness", image)
             msg = images.image_to_msg(image, "bgr8")
             deadline = time.monotonic() + 4.0
             while time.monotonic() < deadline and expected not in replies:

@@ -1,7 +1,7 @@
 """Runs a student's code in a process of its own, for a check (autograder.harness.Context).
 
-``python -m autograder.student call MODULE FUNCTION JOB`` calls a function;
-``python -m autograder.student endpoints MODULE CLASS JOB`` constructs a node class and reports
+``python -m course_lib.checks.student call MODULE FUNCTION JOB`` calls a function;
+``python -m course_lib.checks.student endpoints MODULE CLASS JOB`` constructs a node class and reports
 the QoS of its publishers and subscriptions (what DDS discovery does not tell another process,
 such as the queue depth).
 
@@ -108,8 +108,8 @@ def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     commands = {"call": call, "endpoints": endpoints}
     if len(argv) != 4 or argv[0] not in commands:
-        print("usage: python -m autograder.student call MODULE FUNCTION JOB_DIR\n"
-              "       python -m autograder.student endpoints MODULE CLASS JOB_DIR", file=sys.stderr)
+        print("usage: python -m course_lib.checks.student call MODULE FUNCTION JOB_DIR\n"
+              "       python -m course_lib.checks.student endpoints MODULE CLASS JOB_DIR", file=sys.stderr)
         return 2
     return commands[argv[0]](argv[1], argv[2], Path(argv[3]))
 

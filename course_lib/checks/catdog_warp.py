@@ -24,8 +24,8 @@ import time
 
 import numpy as np
 
-from autograder import harness
-from autograder.harness import check
+from course_lib.checks import harness
+from course_lib.checks.harness import check
 
 ASSIGNMENT = "catdog_warp"
 SIZE = (320, 240)
@@ -203,7 +203,7 @@ def node(ctx: harness.Context) -> None:
             if not proc.running():
                 ctx.item(False, f"the node process ended ({proc.describe_exit()}):\n{harness.clip(proc.log_tail(6))}")
                 return
-            if not ctx.item("marker_reader" in names(), "node marker_reader runs" if "marker_reader" in names() else
+            if not ctx.precondition("marker_reader" in names(), "node marker_reader runs" if "marker_reader" in names() else
                             f"no node named marker_reader (nodes: {sorted(names())})"):
                 return
             scene = scenes.render_scene(_seed(ctx), difficulty="easy")

@@ -1,0 +1,53 @@
+"""``python -m autograder record-answers [ASSIGNMENT ...]``: record the self-checks' answers.
+
+Self-checks compare with answers recorded from the grader's answer key (course_lib.checks.answers)
+for the self-check seed's inputs. This runs every check of each assignment that has an answer key
+(autograder/answers/<assignment>.py) against the reference solution with the self-check seed,
+writes down every answer the key gives, and replaces course_lib/checks/recorded/<assignment>.json.
+Run it after changing a check's inputs or an answer key.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+from autograder import reference
+from course_lib.checks import answers, harness
+
+ANSWER_KEYS = Path(__file__).resolve().parent / "answers"
+
+
+def assignments_with_keys() -> list[str]:
+    return sorted(p.stem for p in ANSWER_KEYS.glob("*.py") if p.stem != "__init__")
+
+
+def record_answers(assignments: list[str] | None = None) -> list[Path]:
+    """Record the answers of the given assignments (default: all with an answer key); return the files.
+
+    Raises:
+        RuntimeError: the reference solution did not get every point of a check (the recording
+            would then miss the answers of the paths it did not reach).
+    """
+    with tempfile.TemporaryDirectory(prefix="autograder-record-") as tmp:
+        lines = Path(tmp) / "answers.jsonl"
+        lines.touch()
+        previous = os.environ.get(answers.RECORD_ENV)
+        os.environ[answers.RECORD_ENV] = str(lines)
+        try:
+            for assignment in assignments or assignments_with_keys():
+                workdir = Path(tmp) / assignment
+                workdir.mkdir()
+                reference.write_reference_module(assignment, workdir)
+                for name in harness.checks_of(assignment):
+                    result = harness.execute(assignment, name, harness.SELFCHECK_SEED, workdir=workdir, mode="record")
+                    if result.points < result.max_points:
+                        raise RuntimeError(f"the reference solution got {result.points:g} of {result.max_points:g} "
+                                           f"points in {assignment}/{name}:\n" + "\n".join(result.verdict_lines()))
+        finally:
+            if previous is None:
+                os.environ.pop(answers.RECORD_ENV, None)
+            else:
+                os.environ[answers.RECORD_ENV] = previous
+        return answers.merge_recording(lines)

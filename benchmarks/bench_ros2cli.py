@@ -1,0 +1,118 @@
+"""How long the course's ``ros2`` command takes to answer, next to the floor any ROS process pays.
+
+Not a test: times depend on the machine and on what else runs, so this prints numbers instead of
+asserting them. Compare rows measured in the same run.
+
+    .venv/bin/python benchmarks/bench_ros2cli.py [--runs 5]
+
+Two live nodes (a talker with parameters and a listener, each in a process of its own) run in
+a reserved ROS domain. Each command runs --runs times as a new process, as a student types it,
+alternating with the others; the table shows the median wall time and its ratio to the floor:
+a new Python process that imports rclpy and creates one node (what every ros2 command pays
+before it can look at the graph). ``python -c pass`` shows what the interpreter alone costs.
+
+The listing verbs (node list, topic list) wait for discovery like ros2cli without its daemon:
+--spin-time (0.5 s) at least, longer while the graph still changes or shows fewer nodes than
+there are other ROS processes on the machine; the verbs that name a node or topic go on as soon
+as it shows.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from course_lib import processes, rosenv  # noqa: E402
+
+NODES = '''
+import sys
+import rclpy
+from rclpy.node import Node
+from std_msgs.msg import String
+
+rclpy.init(args=sys.argv)
+node = Node(sys.argv[1])
+node.declare_parameter('rate', 10.0)
+if sys.argv[1] == 'bench_talker':
+    publisher = node.create_publisher(String, 'bench_chatter', 10)
+    node.create_timer(0.1, lambda: publisher.publish(String(data='hello')))
+else:
+    node.create_subscription(String, 'bench_chatter', lambda msg: None, 10)
+try:
+    rclpy.spin(node)
+except KeyboardInterrupt:
+    pass
+'''
+
+FLOOR = ("import rclpy; from rclpy.node import Node; rclpy.init(); "
+         "Node('_floor', start_parameter_services=False)")
+
+
+def commands(ros2: str) -> list[tuple[str, list[str]]]:
+    return [
+        ("python -c pass", [sys.executable, "-c", "pass"]),
+        ("floor: python, import rclpy, one node", [sys.executable, "-c", FLOOR]),
+        ("ros2 --help", [ros2, "--help"]),
+        ("ros2 node list", [ros2, "node", "list"]),
+        ("ros2 topic list", [ros2, "topic", "list"]),
+        ("ros2 topic echo /bench_chatter --once", [ros2, "topic", "echo", "/bench_chatter", "--once"]),
+        ("ros2 param get /bench_talker rate", [ros2, "param", "get", "/bench_talker", "rate"]),
+    ]
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--runs", type=int, default=5, help="runs of each command (default 5)")
+    args = parser.parse_args(argv)
+    load = os.getloadavg()[0]
+    ros2 = str(Path(sys.executable).parent / "ros2")
+    if not Path(ros2).is_file():
+        sys.exit(f"{ros2} is missing: run `make setup` (it installs the course's ros2 on the pip install)")
+    script = Path(tempfile.mkdtemp(prefix="bench_ros2cli_")) / "nodes.py"
+    script.write_text(NODES)
+    with rosenv.reserve_domain_id() as reservation:
+        env = rosenv.ros_environment(domain_id=reservation.domain_id)
+        env.pop("COURSE_LIB_UNDER_TEST", None)
+        nodes = [processes.NodeProcess([sys.executable, str(script), name], domain_id=reservation.domain_id).start()
+                 for name in ("bench_talker", "bench_listener")]
+        try:
+            for process, name in zip(nodes, ("bench_talker", "bench_listener")):
+                process.wait_for_node(name, timeout=60)
+            times: dict[str, list[float]] = {label: [] for label, _ in commands(ros2)}
+            answers: dict[str, str] = {}
+            for _ in range(args.runs):
+                for label, command in commands(ros2):
+                    began = time.perf_counter()
+                    done = subprocess.run(command, env=env, capture_output=True, text=True, timeout=120)
+                    times[label].append(time.perf_counter() - began)
+                    if done.returncode != 0:
+                        sys.exit(f"{label} failed ({done.returncode}): {done.stderr}")
+                    answers[label] = done.stdout
+        finally:
+            for process in nodes:
+                process.stop()
+    floor = statistics.median(times["floor: python, import rclpy, one node"])
+    print(f"Python {platform.python_version()}, {platform.machine()}, {os.cpu_count()} cores, "
+          f"median of {args.runs} runs, load average before: {load:.2f}\n")
+    print("| command | median wall time | ratio to the floor |")
+    print("|---|---:|---:|")
+    for label, _ in commands(ros2):
+        median = statistics.median(times[label])
+        print(f"| {label} | {median:.2f} s | {median / floor:.2f} |")
+    listed = answers["ros2 node list"].split()
+    print(f"\nros2 node list answered {listed} (both nodes: {listed == ['/bench_listener', '/bench_talker']})")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

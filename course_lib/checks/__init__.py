@@ -1,0 +1,11 @@
+"""The assignments' checks, shared by the students' self-checks and the grader.
+
+- ``course_lib.checks.<assignment>``: the checks of one assignment (``brightness``, ``pubsub``,
+  ``catdog_warp``). A notebook imports one as ``checks`` and calls ``checks.selfcheck("values")``.
+- ``harness``: what a check is and how it runs (its own process; the student's code in another).
+- ``answers``: where a check's expected answers come from: the grader's answer key when graded
+  (instructor side, ``autograder.answers``), answers recorded from it in a self-check.
+- ``student``: runs the student's code for a check; ``validate``: the cell timeouts of Validate.
+
+No reference solution and no answer key is in this package: students have it.
+"""

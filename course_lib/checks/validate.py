@@ -1,0 +1,31 @@
+"""What nbgrader's Validate button needs in a student's lab: the course's cell timeouts.
+
+Validate runs the whole notebook, self-checks included. nbgrader's default of 30 s for every
+cell would cut a node self-check that grading lets run (a CellTimeoutError the student never
+gets at grading), so students' labs and the grader use the same two timeouts. A lab's
+``nbgrader_config.py`` calls :func:`apply_student`; the grader's configuration
+(autograder.config) builds on it.
+"""
+
+from __future__ import annotations
+
+#: Seconds an ordinary (non-graded) cell may run: importing the student's module imports rclpy,
+#: which takes a second or two; anything longer is a loop that must not run at import.
+CELL_TIMEOUT = 30
+
+#: Seconds a graded test cell may run: the longest check plus its start-up. Each check also
+#: bounds itself (harness.Check.timeout); this is the backstop when a kernel stops answering.
+TEST_CELL_TIMEOUT = 150
+
+
+def cell_timeout(cell) -> int:
+    """nbclient's timeout_func: graded cells get TEST_CELL_TIMEOUT, all others CELL_TIMEOUT."""
+    meta = cell.get("metadata", {}).get("nbgrader", {})
+    return TEST_CELL_TIMEOUT if meta.get("grade") and not meta.get("solution") else CELL_TIMEOUT
+
+
+def apply_student(c) -> None:
+    """Give an nbgrader config object (``c = get_config()``) the course's cell timeouts."""
+    c.Execute.timeout = TEST_CELL_TIMEOUT
+    c.Execute.timeout_func = cell_timeout
+    c.Execute.interrupt_on_timeout = True

@@ -1,0 +1,85 @@
+"""``ros2 COMMAND ...``: pick the command's module and turn its outcome into an exit code."""
+
+from __future__ import annotations
+
+import importlib
+import os
+import signal
+import sys
+
+from course_lib.ros2cli.common import FULL_INSTALL, Unsupported, unsupported
+
+#: The commands the course's ros2 has, with ros2cli's help line for each.
+COMMANDS = {
+    "interface": "Show information about ROS interfaces",
+    "launch": "Run a launch file",
+    "node": "Various node related sub-commands",
+    "param": "Various param related sub-commands",
+    "pkg": "Various package related sub-commands",
+    "run": "Run a package specific executable",
+    "topic": "Various topic related sub-commands",
+}
+
+#: Commands of a full ros2cli install that the course's ros2 leaves out (named in --help).
+LEFT_OUT = ("action", "bag", "component", "daemon", "doctor", "lifecycle", "multicast", "service",
+            "wtf")
+
+
+def usage() -> str:
+    width = max(map(len, COMMANDS))
+    return "\n".join([
+        "usage: ros2 [-h] Call `ros2 <command> -h` for more detailed usage. ...", "",
+        "ros2 is an extensible command-line tool for ROS 2.", "",
+        "This is the course's ros2 for the pip install of ROS 2 (course_lib.ros2cli): the commands",
+        f"below, with the verbs and options the course teaches; {FULL_INSTALL}",
+        f"({', '.join(LEFT_OUT)}).", "",
+        "options:", "  -h, --help  show this help message and exit", "",
+        "Commands:",
+        *[f"  {name.ljust(width)}  {text}" for name, text in COMMANDS.items()], "",
+        "  Call `ros2 <command> -h` for more detailed usage.",
+    ])
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run ``ros2`` with ``argv`` (sys.argv[1:] when None) and return its exit code.
+
+    Like ros2cli: a verb's failure message goes to stderr with exit code 1, Ctrl-C ends with
+    exit code 2 (ros2cli returns signal.SIGINT) and no traceback, and anything the course's
+    ros2 does not support is one line on stderr (exit code 2).
+    """
+    argv = list(sys.argv[1:] if argv is None else argv)
+    try:
+        sys.stdout.reconfigure(line_buffering=True)  # ros2cli prints line by line, also into pipes
+    except AttributeError:  # stdout replaced by something without reconfigure (a notebook)
+        pass
+    try:
+        outcome = _dispatch(argv)
+    except Unsupported as error:
+        print(error, file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        return int(signal.SIGINT)
+    except SystemExit as end:  # argparse's --help and usage errors
+        return end.code if isinstance(end.code, int) else (0 if end.code is None else 1)
+    except BrokenPipeError:  # `ros2 topic echo /t | head -3`: the reader has gone
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # no error at exit's flush
+        return 0
+    except (RuntimeError, LookupError, ValueError, TimeoutError, FileNotFoundError) as error:
+        outcome = str(error)
+    if isinstance(outcome, str):
+        print(outcome, file=sys.stderr)
+        return 1
+    return outcome or 0
+
+
+def _dispatch(argv: list[str]) -> int | str | None:
+    if not argv or argv[0] in ("-h", "--help"):
+        print(usage())
+        return 0
+    command, rest = argv[0], argv[1:]
+    if command.startswith("-"):
+        raise unsupported(f"ros2 {command}", ["-h", "--help"])
+    if command not in COMMANDS:
+        raise unsupported(f"ros2 {command}", sorted(COMMANDS))
+    module = importlib.import_module(f"course_lib.ros2cli.{command}")
+    return module.main(rest)

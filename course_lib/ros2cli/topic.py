@@ -1,0 +1,300 @@
+"""``ros2 topic list|echo|hz|info|pub``, printed from course_lib.graph and its tool node."""
+
+from __future__ import annotations
+
+import time
+
+from course_lib.ros2cli.common import (NAMED_TIMEOUT, Verb, add_discovery_arguments, add_qos_arguments, loop_limit,
+                                       qos_from_arguments, qos_overridden, run_group, say, wait_for_named_only,
+                                       wait_for_whole_graph, wait_until)
+
+#: Verbs of ros2cli's ``ros2 topic`` that the course leaves out.
+LEFT_OUT = ("bw", "delay", "find", "type")
+
+
+def _positive_float(text: str) -> float:
+    import argparse
+
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError("Expects a floating point number") from None
+    if value <= 0:
+        raise argparse.ArgumentTypeError("Value must be positive")
+    return value
+
+
+def _positive_int(text: str) -> int:
+    import argparse
+
+    try:
+        value = int(text)
+    except ValueError:
+        value = -1
+    if value <= 0:
+        raise argparse.ArgumentTypeError("value must be a positive integer")
+    return value
+
+
+def _nonnegative_int(text: str) -> int:
+    value = int(text)
+    if value < 0:
+        raise ValueError("Value must be positive or zero")
+    return value
+
+
+# --- ros2 topic list ---------------------------------------------------------------------
+
+def _list_arguments(parser) -> None:
+    add_discovery_arguments(parser)
+    parser.add_argument("-t", "--show-types", action="store_true", help="Additionally show the topic type")
+    parser.add_argument("-c", "--count-topics", action="store_true",
+                        help="Only display the number of topics discovered")
+    parser.add_argument("--include-hidden-topics", action="store_true", help="Consider hidden topics as well")
+    parser.add_argument("-v", "--verbose", action="store_true", help="List full details about each topic")
+
+
+def _list(args) -> None:
+    from course_lib import graph
+
+    wait_for_whole_graph(args.spin_time)
+    pairs = graph.topic_list(types=True, include_hidden=args.include_hidden_topics)
+    if args.count_topics:
+        print(len(pairs))
+    elif pairs and args.verbose:
+        counts = {name: graph.topic_info(name, verbose=False) for name, _ in pairs}
+        for title, count_of, noun in (("Published", "publisher_count", "publisher"),
+                                      ("Subscribed", "subscription_count", "subscriber")):
+            print(f"{title} topics:")
+            for name, kinds in pairs:
+                count = getattr(counts[name], count_of)
+                if count:
+                    print(f" * {name} [{', '.join(kinds)}] {count} {noun}{'s' if count > 1 else ''}")
+            print()
+    else:
+        for name, kinds in pairs:
+            print(f"{name} [{', '.join(kinds)}]" if args.show_types else name)
+
+
+# --- ros2 topic echo ---------------------------------------------------------------------
+
+def _echo_arguments(parser) -> None:
+    add_discovery_arguments(parser)
+    parser.add_argument("topic_name", help="Name of the ROS topic to listen to (e.g. '/chatter')")
+    parser.add_argument("message_type", nargs="?", help="Type of the ROS message (e.g. 'std_msgs/msg/String')")
+    add_qos_arguments(parser, "subscribe", "sensor_data")
+    parser.add_argument("--field", help="Echo a selected field of a message. Use '.' to select sub-fields")
+    parser.add_argument("--full-length", "-f", action="store_true",
+                        help="Output all elements for arrays, bytes, and strings")
+    parser.add_argument("--truncate-length", "-l", type=_nonnegative_int, default=128,
+                        help="The length to truncate arrays, bytes, and string to (default: 128)")
+    parser.add_argument("--no-arr", action="store_true", help="Don't print array fields of messages")
+    parser.add_argument("--no-str", action="store_true", help="Don't print string fields of messages")
+    parser.add_argument("--no-lost-messages", action="store_true",
+                        help="Don't report when a message is lost (the course's ros2 never does)")
+    parser.add_argument("--once", action="store_true", help="Print the first message received and then exit.")
+    parser.add_argument("--timeout", metavar="N", type=_positive_float,
+                        help="Set a timeout in seconds for waiting")
+
+
+def _echo(args) -> int | str | None:
+    from course_lib import graph
+
+    wait_for_named_only()
+    field = None if args.field is None else [part for part in args.field.split(".") if part]
+    if field == []:
+        return f"Invalid field value '{args.field}'"
+    truncate = None if args.full_length else args.truncate_length
+    seen = {"messages": 0, "bad field": False}  # counts only: an echo may run for hours
+
+    def show(msg):
+        if seen["bad field"] or (seen["messages"] and args.once):
+            return
+        for part in field or ():
+            try:
+                msg = getattr(msg, part)
+            except AttributeError as error:
+                say(f"Invalid field '{args.field}': {error}", error=True)
+                seen["bad field"] = True
+                return
+        seen["messages"] += 1
+        if hasattr(msg, "get_fields_and_field_types"):
+            print(graph.format_message(msg, truncate, args.no_arr, args.no_str), end="---\n")
+        else:
+            print(msg, end="\n---\n")
+
+    qos = qos_from_arguments(args) if qos_overridden(args) else None  # None: what the publishers offer
+    try:
+        with graph.subscription(args.topic_name, show, args.message_type, args.spin_time + NAMED_TIMEOUT, qos):
+            wait_until(lambda: seen["bad field"] or (args.once and seen["messages"] > 0), args.timeout)
+    except TimeoutError:
+        say(f"WARNING: topic [{args.topic_name}] does not appear to be published yet")
+        return "Could not determine the type for the passed topic"
+    return 1 if seen["bad field"] else None
+
+
+# --- ros2 topic hz -----------------------------------------------------------------------
+
+def _hz_arguments(parser) -> None:
+    parser.add_argument("topic_name", help="Name of the ROS topic to listen to (e.g. '/chatter')")
+    parser.add_argument("--window", "-w", dest="window_size", type=_positive_int, default=10000, metavar="WINDOW",
+                        help="window size, in # of messages, for calculating rate (default: 10000)")
+    parser.add_argument("--wall-time", action="store_true",
+                        help="calculates rate using wall time (the course's ros2 always does)")
+    add_discovery_arguments(parser, daemon=False)
+
+
+def _hz(args) -> None:
+    from rclpy.qos import qos_profile_sensor_data
+
+    from course_lib import graph
+
+    wait_for_named_only()
+    arrivals: list[float] = []
+    printed_at = [None]
+
+    def report() -> bool:
+        # Like ros2cli: from the second message on, print once a second while messages come.
+        del arrivals[:-(args.window_size + 1)]
+        if len(arrivals) < 2:
+            return False
+        if printed_at[0] is None:
+            printed_at[0] = arrivals[0]
+        if arrivals[-1] >= printed_at[0] + 1.0:
+            print(graph.rate_statistics(list(arrivals)))
+            printed_at[0] = arrivals[-1]
+        return False
+
+    def measure(timeout: float | None) -> None:
+        with graph.subscription(args.topic_name, lambda _: arrivals.append(time.monotonic()),
+                                timeout=timeout, qos=qos_profile_sensor_data, raw=True):
+            wait_until(report)
+
+    try:
+        measure(args.spin_time + NAMED_TIMEOUT)
+    except TimeoutError:  # like ros2cli: say so once, then wait for the topic as long as it takes
+        say(f"WARNING: topic [{args.topic_name}] does not appear to be published yet")
+        measure(None)
+
+
+# --- ros2 topic info ---------------------------------------------------------------------
+
+def _info_arguments(parser) -> None:
+    add_discovery_arguments(parser)
+    parser.add_argument("topic_name", help="Name of the ROS topic to get info (e.g. '/chatter')")
+    parser.add_argument("--verbose", "-v", action="store_true",
+                        help="Prints detailed information like the node name, node namespace, topic type, "
+                             "topic type hash, GUID, and QoS Profile of the publishers and subscribers")
+
+
+def _info(args) -> str | None:
+    from course_lib import graph
+
+    wait_for_whole_graph(args.spin_time)  # counts and endpoints: all of them, not the first found
+    try:
+        info = graph.topic_info(args.topic_name, verbose=args.verbose, timeout=args.spin_time + NAMED_TIMEOUT)
+    except ValueError:
+        return f"Unknown topic '{args.topic_name}'"
+    # ros2cli ends every part (the last one too) with a blank line in verbose mode.
+    print(graph.format_topic_info(info, verbose=args.verbose), end="\n" if args.verbose else "")
+    return None
+
+
+# --- ros2 topic pub ----------------------------------------------------------------------
+
+def _pub_arguments(parser) -> None:
+    parser.add_argument("topic_name", help="Name of the ROS topic to publish to (e.g. '/chatter')")
+    parser.add_argument("message_type", help="Type of the ROS message (e.g. 'std_msgs/String')")
+    parser.add_argument("values", nargs="?", default="{}",
+                        help="Values to fill the message with in YAML format (e.g. 'data: Hello World'), "
+                             "otherwise the message will be published with default values")
+    parser.add_argument("-r", "--rate", metavar="N", type=_positive_float, default=1.0,
+                        help="Publishing rate in Hz (default: 1)")
+    parser.add_argument("-p", "--print", metavar="N", type=int, default=1,
+                        help="Only print every N-th published message (default: 1)")
+    once_or_times = parser.add_mutually_exclusive_group()
+    once_or_times.add_argument("-1", "--once", action="store_true", help="Publish one message and exit")
+    once_or_times.add_argument("-t", "--times", type=_nonnegative_int, default=0,
+                               help="Publish this number of times and then exit")
+    parser.add_argument("-w", "--wait-matching-subscriptions", type=_nonnegative_int, default=None,
+                        help="Wait until finding the specified number of matching subscriptions. "
+                             'Defaults to 1 when using "-1"/"--once"/"--times", otherwise defaults to 0.')
+    parser.add_argument("--max-wait-time-secs", type=_positive_float, default=None,
+                        help="The maximum wait time in seconds for --wait-matching-subscriptions")
+    parser.add_argument("--keep-alive", metavar="N", type=_positive_float, default=0.1,
+                        help="Keep publishing node alive for N seconds after the last msg (default: 0.1)")
+    add_qos_arguments(parser, "publish", "default")
+    add_discovery_arguments(parser, daemon=False)
+
+
+def _pub(args) -> str | None:
+    import yaml
+
+    from course_lib import graph, session
+
+    times = 1 if args.once else args.times
+    wanted = args.wait_matching_subscriptions
+    wanted = int(times != 0) if wanted is None else wanted
+    if wanted == 0 and args.max_wait_time_secs is not None:
+        return "--max-wait-time-secs option is only effective with --wait-matching-subscriptions, --once or --times"
+    message_class = graph.message_class(args.message_type)  # ValueError names the fix
+    try:
+        values = yaml.safe_load(args.values)
+    except yaml.YAMLError as error:
+        return f"The passed value is not valid YAML ({str(error).splitlines()[0]}): write it like '{{data: 5}}'"
+    if not isinstance(values, dict):
+        return "The passed value needs to be a dictionary in YAML format"
+    msg = message_class()
+    try:  # before waiting for subscribers (ros2cli fills after): a mistake shows at once
+        stamp_setters = graph.fill_message(msg, values)
+    except ValueError as error:
+        return f"Failed to populate field: {error}"
+    node = session.tool_node()
+    publisher = node.create_publisher(message_class, args.topic_name, qos_from_arguments(args))
+    limit = loop_limit(args.max_wait_time_secs)  # None: wait as long as it takes
+    started = time.monotonic()
+    while publisher.get_subscription_count() < wanted:
+        left = None if limit is None else limit - (time.monotonic() - started)
+        if left is not None and left <= 0:
+            return (f"Timed out waiting for subscribers: Expected {wanted} subcribers but only got "
+                    f"{publisher.get_subscription_count()} subscribers")
+        print(f"Waiting for at least {wanted} matching subscription(s)...")
+        session.wait_for(lambda: publisher.get_subscription_count() >= wanted,
+                         timeout=1.0 if left is None else min(1.0, left), poll=0.02)
+    print("publisher: beginning loop")
+    count = [0]
+
+    def publish():
+        if times and count[0] >= times:
+            return
+        now = node.get_clock().now().to_msg()
+        for setter in stamp_setters:
+            setter(now)
+        count[0] += 1
+        if args.print and count[0] % args.print == 0:
+            print(f"publishing #{count[0]}: {msg!r}\n")
+        publisher.publish(msg)
+
+    publish()
+    if times != 1:
+        timer = node.create_timer(1.0 / args.rate, publish)
+        try:
+            wait_until(lambda: times != 0 and count[0] >= times)
+        finally:
+            node.destroy_timer(timer)
+    time.sleep(args.keep_alive)  # let the last message reach the wire before the node goes
+    node.destroy_publisher(publisher)
+    return None
+
+
+VERBS = {
+    "echo": Verb("Output messages from a topic", _echo_arguments, _echo),
+    "hz": Verb("Print the average publishing rate to screen", _hz_arguments, _hz),
+    "info": Verb("Print information about a topic", _info_arguments, _info),
+    "list": Verb("Output a list of available topics", _list_arguments, _list),
+    "pub": Verb("Publish a message to a topic", _pub_arguments, _pub),
+}
+
+
+def main(argv: list[str]):
+    return run_group("ros2 topic", "Various topic related sub-commands", VERBS, argv, missing=LEFT_OUT)

@@ -1,0 +1,61 @@
+"""The live image view (course_lib.live) in JupyterLab: the picture changes while the camera runs.
+
+A small notebook, written by the test into a scratch root, starts the virtual camera as a process
+and shows /image with live.image_view; headless Chromium opens it, runs all cells, then watches
+the widget's picture. Screenshots go to artifacts/browser/live_image_view-<n>.png.
+"""
+
+from pathlib import Path
+
+import pytest
+
+from browser_support import NOTEBOOK, code_cell_count, open_notebook, run_notebook, running_jupyterlab, write_notebook
+
+SCREENSHOTS = Path(__file__).resolve().parents[1] / "artifacts" / "browser"
+CAMERA_SIZE = (320, 240)
+
+pytestmark = pytest.mark.browser
+
+LIVE_NOTEBOOK = [
+    "from course_lib import live, processes\n"
+    "camera = processes.python_node('course_lib.camera:main', '--ros-args', '-p', 'width:=%d', '-p', 'height:=%d',\n"
+    "                               '-p', 'rate:=10.0', name='camera')\n"
+    "camera.wait_for_node('image_publisher', timeout=60)" % CAMERA_SIZE,
+    # Explicit bounds: under test a view would stop after live.LIMITED_UPDATES redraws.
+    "view = live.image_view('/image', updates=3000, seconds=300)\nview",
+]
+
+# The <img> of the ipywidgets Image in the live view's output.
+PICTURE = f"{NOTEBOOK} .jp-OutputArea .widget-image"
+
+
+@pytest.mark.timeout(400)
+def test_live_image_view_picture_changes_while_the_camera_runs(browser, tmp_path_factory):
+    root = tmp_path_factory.mktemp("live-root")
+    write_notebook(root / "live_view.ipynb", LIVE_NOTEBOOK)
+    with running_jupyterlab(root, tmp_path_factory.mktemp("live-state")) as lab:
+        page = open_notebook(browser, lab, "live_view.ipynb")
+        try:
+            run = run_notebook(page, "live_view.ipynb", code_cell_count(root / "live_view.ipynb"), 240)
+            assert not run.problems(), run.problems()
+            picture = page.locator(PICTURE)
+            page.wait_for_function(f"""() => {{ const img = document.querySelector('{PICTURE}');
+                                       return img && img.complete && img.naturalWidth === {CAMERA_SIZE[0]}; }}""",
+                                   timeout=60_000)
+            status = page.locator(f"{NOTEBOOK} .jp-OutputArea .widget-label").first.inner_text()
+            assert "/image · 320x240 bgr8" in status, status
+            shots, sources = [], []
+            for number in (1, 2):
+                if sources:  # the next frame: a new blob URL in src, decoded
+                    page.wait_for_function(f"""(before) => {{ const img = document.querySelector('{PICTURE}');
+                                               return img.src !== before && img.complete && img.naturalWidth > 0; }}""",
+                                           arg=sources[-1], timeout=30_000)
+                sources.append(picture.get_attribute("src"))
+                target = SCREENSHOTS / f"live_image_view-{number}.png"
+                target.parent.mkdir(parents=True, exist_ok=True)
+                shots.append(picture.screenshot(path=str(target)))
+            assert sources[0] != sources[1]
+            assert shots[0] != shots[1], "the picture on screen changed (the simulated camera moves)"
+        finally:
+            lab.shut_down_kernels_of("live_view.ipynb")
+            page.close()

@@ -1,0 +1,597 @@
+"""course_lib.launch without processes: every tag and substitution in XML and YAML, and each error.
+
+A launch file is run into the nodes it would start (actions.run_launch_file), and their command
+lines, environments and parameter files are compared with what ros2/launch and launch_ros
+produce. The package `demo` lives in a temporary prefix with an ament index marker.
+"""
+
+import os
+import re
+import tempfile
+import textwrap
+from pathlib import Path
+
+import pytest
+import yaml
+
+from course_lib.launch import cli, substitutions
+from course_lib.launch.actions import run_launch_file
+from course_lib.launch.entities import LaunchFileError
+from course_lib.launch.parser import split_command_line
+from launch_demo import make_prefix
+
+
+@pytest.fixture(scope="module")
+def demo_prefix(tmp_path_factory):
+    """A prefix with package demo: executables talker and listener, share/demo/config/params.yaml."""
+    prefix = make_prefix(tmp_path_factory.mktemp("prefix"), "demo",
+                         {"talker": "#!/bin/sh\n", "listener": "#!/bin/sh\n"},
+                         {"config/params.yaml": "/**:\n  ros__parameters:\n    gain: 2\n"})
+    saved = os.environ.get("AMENT_PREFIX_PATH")
+    os.environ["AMENT_PREFIX_PATH"] = f"{prefix}{os.pathsep}{saved or ''}"
+    yield prefix
+    os.environ["AMENT_PREFIX_PATH"] = saved or ""
+
+
+@pytest.fixture(autouse=True)
+def parameter_files_in_tmp_path(tmp_path, monkeypatch):
+    """The parameter files a launch writes go to the test's own folder."""
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+
+
+def write(folder: Path, form: str, xml: str, yaml_text: str, name: str = "test") -> Path:
+    """Write the XML or the YAML form of a launch file and return its path."""
+    path = folder / (f"{name}.launch.xml" if form == "xml" else f"{name}.launch.yaml")
+    path.write_text(textwrap.dedent(xml if form == "xml" else yaml_text).strip() + "\n")
+    return path
+
+
+def params_of(command: list[str]) -> list[dict]:
+    """The parameter files a command line passes, read back."""
+    return [yaml.safe_load(Path(command[i + 1]).read_text())
+            for i, part in enumerate(command) if part == "--params-file"]
+
+
+BOTH = pytest.mark.parametrize("form", ["xml", "yaml"])
+
+
+# --- node ------------------------------------------------------------------------------------
+
+@BOTH
+def test_node_gets_the_command_line_launch_ros_builds(tmp_path, demo_prefix, form):
+    path = write(tmp_path, form, """
+        <launch>
+          <node pkg="demo" exec="talker" name="talker" namespace="robot" output="screen"
+                args="first 'two words'" ros_args="--log-level debug">
+            <remap from="chatter" to="talk"/>
+            <remap from="/image" to="/camera/image_raw"/>
+          </node>
+        </launch>""", """
+        launch:
+        - node:
+            pkg: demo
+            exec: talker
+            name: talker
+            namespace: robot
+            output: screen
+            args: first 'two words'
+            ros_args: --log-level debug
+            remap:
+            - {from: chatter, to: talk}
+            - {from: /image, to: /camera/image_raw}
+        """)
+    node, = run_launch_file(path).nodes
+    assert node.command == [str(demo_prefix / "lib" / "demo" / "talker"), "first", "two words",
+                            "--ros-args", "--log-level", "debug",
+                            "--ros-args", "-r", "__node:=talker", "-r", "__ns:=/robot",
+                            "-r", "chatter:=talk", "-r", "/image:=/camera/image_raw"]
+    assert (node.label, node.output, node.node_name, node.namespace) == ("talker", "screen", "talker", "/robot")
+    assert node.line == 2
+
+
+@BOTH
+def test_node_without_name_or_namespace_keeps_its_own(tmp_path, demo_prefix, form):
+    """No __node or __ns rule; output defaults to log; exec_name sets the process label."""
+    path = write(tmp_path, form, '<launch><node pkg="demo" exec="listener" exec_name="ears"/></launch>',
+                 "launch:\n- node: {pkg: demo, exec: listener, exec_name: ears}")
+    node, = run_launch_file(path).nodes
+    assert node.command == [str(demo_prefix / "lib" / "demo" / "listener"), "--ros-args"]
+    assert (node.label, node.output, node.node_name, node.namespace) == ("ears", "log", None, None)
+
+
+def test_node_without_pkg_runs_exec_as_a_command(tmp_path):
+    path = write(tmp_path, "xml", '<launch><node exec="sleep" args="5"/></launch>', "")
+    node, = run_launch_file(path).nodes
+    assert node.command == ["sleep", "5", "--ros-args"] and node.label == "sleep"
+
+
+@BOTH
+def test_node_environment_has_set_env_and_its_own_env_tags(tmp_path, demo_prefix, form):
+    path = write(tmp_path, form, """
+        <launch>
+          <set_env name="COURSE_A" value="a"/>
+          <node pkg="demo" exec="talker"><env name="COURSE_B" value="$(env COURSE_A)b"/></node>
+          <node pkg="demo" exec="listener"/>
+        </launch>""", """
+        launch:
+        - set_env: {name: COURSE_A, value: a}
+        - node:
+            pkg: demo
+            exec: talker
+            env: [{name: COURSE_B, value: $(env COURSE_A)b}]
+        - node: {pkg: demo, exec: listener}
+        """)
+    talker, listener = run_launch_file(path, environment={"PATH": "/bin"}).nodes
+    assert talker.environment == {"PATH": "/bin", "COURSE_A": "a", "COURSE_B": "ab"}
+    assert listener.environment == {"PATH": "/bin", "COURSE_A": "a"}
+    assert "COURSE_A" not in os.environ  # the launch never changes this process's environment
+
+
+def test_two_nodes_with_one_name_are_warned_about(tmp_path, demo_prefix):
+    path = write(tmp_path, "xml", """
+        <launch>
+          <node pkg="demo" exec="talker" name="same" namespace="/a"/>
+          <node pkg="demo" exec="listener" name="same" namespace="/a"/>
+        </launch>""", "")
+    context = run_launch_file(path)
+    assert context.warnings == [("listener", "there are now at least 2 nodes with the name /a/same "
+                                             "created within this launch context")]
+
+
+# --- param -----------------------------------------------------------------------------------
+
+def test_xml_param_values_are_typed_by_yaml_rules(tmp_path, demo_prefix):
+    path = write(tmp_path, "xml", """
+        <launch>
+          <arg name="count" default="7"/>
+          <node pkg="demo" exec="talker" name="talker" namespace="robot">
+            <param name="an_int" value="5"/>
+            <param name="a_float" value="5.0"/>
+            <param name="a_bool" value="true"/>
+            <param name="a_list" value="[1, 2, 3]"/>
+            <param name="words" value="a;b" value-sep=";"/>
+            <param name="a_text" value="hello world"/>
+            <param name="quoted" value="'5'"/>
+            <param name="empty" value=""/>
+            <param name="from_arg" value="$(var count)"/>
+            <param name="text_with_arg" value="n$(var count)"/>
+          </node>
+        </launch>""", "")
+    node, = run_launch_file(path).nodes
+    files = params_of(node.command)
+    assert all(list(file) == ["/robot/talker"] for file in files)  # one file per tag, keyed by full name
+    values = {name: value for file in files for name, value in file["/robot/talker"]["ros__parameters"].items()}
+    assert values == {"an_int": 5, "a_float": 5.0, "a_bool": True, "a_list": [1, 2, 3], "words": ["a", "b"],
+                      "a_text": "hello world", "quoted": "5", "empty": "", "from_arg": 7, "text_with_arg": "n7"}
+    assert type(values["a_float"]) is float and type(values["a_bool"]) is bool
+
+
+def test_yaml_param_values_keep_their_yaml_types(tmp_path, demo_prefix):
+    """In YAML, value: "5" is text; a substitution's result is typed by YAML's rules."""
+    path = write(tmp_path, "yaml", "", """
+        launch:
+        - arg: {name: count, default: "7"}
+        - node:
+            pkg: demo
+            exec: talker
+            param:
+            - {name: an_int, value: 5}
+            - {name: text_five, value: "5"}
+            - {name: floats, value: [1.5, 2.5]}
+            - {name: from_arg, value: $(var count)}
+        """)
+    node, = run_launch_file(path).nodes
+    files = params_of(node.command)
+    assert all(list(file) == ["/**"] for file in files)  # no name given: every node's parameters
+    values = {name: value for file in files for name, value in file["/**"]["ros__parameters"].items()}
+    assert values == {"an_int": 5, "text_five": "5", "floats": [1.5, 2.5], "from_arg": 7}
+
+
+@BOTH
+def test_nested_params_get_dotted_names(tmp_path, demo_prefix, form):
+    path = write(tmp_path, form, """
+        <launch>
+          <node pkg="demo" exec="talker" name="cam">
+            <param name="camera">
+              <param name="size"><param name="width" value="640"/></param>
+              <param name="name" value="front"/>
+            </param>
+          </node>
+        </launch>""", """
+        launch:
+        - node:
+            pkg: demo
+            exec: talker
+            name: cam
+            param:
+            - name: camera
+              param:
+              - {name: size, param: [{name: width, value: 640}]}
+              - {name: name, value: front}
+        """)
+    node, = run_launch_file(path).nodes
+    assert params_of(node.command) == [{"/**": {"ros__parameters": {"camera.size.width": 640,
+                                                                   "camera.name": "front"}}}]
+
+
+@BOTH
+def test_param_from_a_file_is_passed_as_it_is(tmp_path, demo_prefix, form):
+    path = write(tmp_path, form, """
+        <launch>
+          <node pkg="demo" exec="talker">
+            <param from="$(find-pkg-share demo)/config/params.yaml"/>
+            <param name="gain" value="3"/>
+          </node>
+        </launch>""", """
+        launch:
+        - node:
+            pkg: demo
+            exec: talker
+            param:
+            - {from: $(find-pkg-share demo)/config/params.yaml}
+            - {name: gain, value: 3}
+        """)
+    node, = run_launch_file(path).nodes
+    first = node.command.index("--params-file")
+    assert node.command[first + 1] == str(demo_prefix / "share" / "demo" / "config" / "params.yaml")
+    assert params_of(node.command)[-1] == {"/**": {"ros__parameters": {"gain": 3}}}  # later files win
+
+
+def test_a_missing_parameter_file_is_warned_about_and_skipped(tmp_path, demo_prefix):
+    """As launch_ros does: a warning, and the node starts without it."""
+    path = write(tmp_path, "xml", '<launch><node pkg="demo" exec="talker"><param from="nope.yaml"/></node></launch>',
+                 "")
+    context = run_launch_file(path)
+    assert "--params-file" not in context.nodes[0].command
+    assert context.warnings == [("launch_ros.actions.node",
+                                 f"Parameter file path is not a file: {os.path.abspath('nope.yaml')}")]
+
+
+def test_allow_substs_performs_substitutions_in_the_parameter_file(tmp_path, demo_prefix):
+    (tmp_path / "p.yaml").write_text("/**:\n  ros__parameters:\n    who: $(var who)\n")
+    path = write(tmp_path, "xml", """
+        <launch>
+          <arg name="who" default="me"/>
+          <node pkg="demo" exec="talker"><param from="$(dirname)/p.yaml" allow_substs="true"/></node>
+        </launch>""", "")
+    assert params_of(run_launch_file(path).nodes[0].command) == [{"/**": {"ros__parameters": {"who": "me"}}}]
+
+
+# --- arg, let, include -------------------------------------------------------------------------
+
+@BOTH
+def test_arguments_take_defaults_command_line_values_and_let(tmp_path, demo_prefix, form):
+    path = write(tmp_path, form, """
+        <launch>
+          <arg name="robot" default="r1" description="which robot"/>
+          <arg name="rate" default="5"/>
+          <let name="topic" value="$(var robot)/chatter"/>
+          <node pkg="demo" exec="talker" name="$(var robot)_talker" args="$(var rate) $(var missing fallback)">
+            <remap from="chatter" to="$(var topic)"/>
+          </node>
+        </launch>""", """
+        launch:
+        - arg: {name: robot, default: r1, description: which robot}
+        - arg: {name: rate, default: "5"}
+        - let: {name: topic, value: $(var robot)/chatter}
+        - node:
+            pkg: demo
+            exec: talker
+            name: $(var robot)_talker
+            args: $(var rate) $(var missing fallback)
+            remap: [{from: chatter, to: $(var topic)}]
+        """)
+    context = run_launch_file(path, {"robot": "r2"})
+    assert context.configurations == {"robot": "r2", "rate": "5", "topic": "r2/chatter"}
+    assert context.nodes[0].command[1:] == ["5", "fallback", "--ros-args", "-r", "__node:=r2_talker",
+                                            "-r", "chatter:=r2/chatter"]
+
+
+@BOTH
+def test_a_required_argument_that_is_not_given_is_named(tmp_path, form):
+    path = write(tmp_path, form, '<launch>\n  <arg name="robot" description="which robot"/>\n</launch>',
+                 "launch:\n- arg: {name: robot, description: which robot}")
+    with pytest.raises(LaunchFileError, match=r"missing required argument 'robot' \(description: 'which robot'\)"
+                                              r".*pass it as robot:=VALUE") as error:
+        run_launch_file(path)
+    assert error.value.line == 2 and error.value.file == path
+
+
+@BOTH
+def test_include_passes_its_args_and_what_it_sets_stays_set(tmp_path, demo_prefix, form):
+    """As in Jazzy's IncludeLaunchDescription: the included file runs in the includer's scope."""
+    write(tmp_path, form, """
+        <launch>
+          <arg name="who"/>
+          <let name="set_inside" value="yes"/>
+          <node pkg="demo" exec="talker" name="$(var who)"/>
+        </launch>""", """
+        launch:
+        - arg: {name: who}
+        - let: {name: set_inside, value: "yes"}
+        - node: {pkg: demo, exec: talker, name: $(var who)}
+        """, name="child")
+    child = "child.launch.xml" if form == "xml" else "child.launch.yaml"
+    path = write(tmp_path, form, f"""
+        <launch>
+          <include file="$(dirname)/{child}"><arg name="who" value="alice"/></include>
+          <node pkg="demo" exec="listener" name="after_$(var set_inside)"/>
+        </launch>""", f"""
+        launch:
+        - include:
+            file: $(dirname)/{child}
+            arg: [{{name: who, value: alice}}]
+        - node: {{pkg: demo, exec: listener, name: after_$(var set_inside)}}
+        """)
+    assert [node.node_name for node in run_launch_file(path).nodes] == ["alice", "after_yes"]
+
+
+def test_an_include_without_a_required_argument_names_the_include(tmp_path, demo_prefix):
+    """Like Jazzy: the check looks through includes, and an include must pass the argument itself."""
+    write(tmp_path, "xml", '<launch>\n<arg name="who"/>\n</launch>', "", name="child")
+    path = write(tmp_path, "xml", '<launch>\n  <include file="$(dirname)/child.launch.xml"/>\n</launch>', "")
+    with pytest.raises(LaunchFileError, match=r"missing required argument 'who'.*pass it as who:=VALUE") as error:
+        run_launch_file(path)
+    assert (error.value.file.name, error.value.line) == ("child.launch.xml", 2)
+    with pytest.raises(LaunchFileError, match=r"missing required argument 'who'.*add <arg name=\"who\" "
+                                              r"value=\"...\"/> to the <include> at .*test.launch.xml:2"):
+        run_launch_file(path, {"who": "me"})
+
+
+# --- group, push_ros_namespace, set_env, conditions --------------------------------------------
+
+@BOTH
+def test_a_scoped_group_undoes_namespace_configurations_and_environment(tmp_path, demo_prefix, form):
+    path = write(tmp_path, form, """
+        <launch>
+          <group>
+            <push_ros_namespace namespace="robot"/>
+            <push_ros_namespace namespace="arm"/>
+            <let name="inside" value="1"/>
+            <set_env name="COURSE_INSIDE" value="1"/>
+            <node pkg="demo" exec="talker" name="a"/>
+            <node pkg="demo" exec="talker" name="b" namespace="/absolute"/>
+          </group>
+          <group scoped="false">
+            <push-ros-namespace namespace="/leaks"/>
+          </group>
+          <node pkg="demo" exec="listener" name="c" namespace="rel"/>
+        </launch>""", """
+        launch:
+        - group:
+          - push_ros_namespace: {namespace: robot}
+          - push_ros_namespace: {namespace: arm}
+          - let: {name: inside, value: "1"}
+          - set_env: {name: COURSE_INSIDE, value: "1"}
+          - node: {pkg: demo, exec: talker, name: a}
+          - node: {pkg: demo, exec: talker, name: b, namespace: /absolute}
+        - group:
+            scoped: false
+            children:
+            - push-ros-namespace: {namespace: /leaks}
+        - node: {pkg: demo, exec: listener, name: c, namespace: rel}
+        """)
+    context = run_launch_file(path, environment={})
+    assert [(node.node_name, node.namespace) for node in context.nodes] == [
+        ("a", "/robot/arm"), ("b", "/absolute"), ("c", "/leaks/rel")]
+    assert context.nodes[0].environment == {"COURSE_INSIDE": "1"} and context.nodes[2].environment == {}
+    assert context.configurations == {"ros_namespace": "/leaks"}
+
+
+@BOTH
+def test_if_and_unless_choose_what_runs(tmp_path, demo_prefix, form):
+    path = write(tmp_path, form, """
+        <launch>
+          <arg name="with_listener" default="false"/>
+          <node pkg="demo" exec="talker" unless="$(var with_listener)"/>
+          <node pkg="demo" exec="listener" if="$(var with_listener)"/>
+        </launch>""", """
+        launch:
+        - arg: {name: with_listener, default: "false"}
+        - node: {pkg: demo, exec: talker, unless: $(var with_listener)}
+        - node: {pkg: demo, exec: listener, if: $(var with_listener)}
+        """)
+    assert [node.label for node in run_launch_file(path).nodes] == ["talker"]
+    assert [node.label for node in run_launch_file(path, {"with_listener": "True"}).nodes] == ["listener"]
+    with pytest.raises(LaunchFileError, match="a condition must be true, false, 1 or 0"):
+        run_launch_file(path, {"with_listener": "maybe"})
+
+
+# --- substitutions ----------------------------------------------------------------------------
+
+class FakeContext:
+    configurations = {"robot": "r1"}
+    environment = {"HOME": "/home/student"}
+    current_file = Path("/ws/launch/demo.launch.xml")
+
+
+@pytest.mark.parametrize("text, expected", [
+    ("plain 'quotes' stay", "plain 'quotes' stay"),
+    ("$0 $ (not substitutions)", "$0 $ (not substitutions)"),
+    ("ns_$(var robot)_$(env HOME)", "ns_r1_/home/student"),
+    ("$(var nothing 'a default')", "a default"),
+    ("$(env NOTHING '')", ""),
+    ("$(env NOTHING $(var robot))", "r1"),
+    ("$(var robot $(var missing))", "r1"),  # a default is only performed when needed
+    ('$(var "$(var robot)_missing" "x $(var robot)")', "x r1"),
+    (r"\$(var robot) is text", "$(var robot) is text"),
+    (r"$(var a\(b\) c\))", "c)"),
+    ("$(dirname)/x.yaml $(filename)", "/ws/launch/x.yaml /ws/launch/demo.launch.xml"),
+])
+def test_substitutions_follow_the_launch_grammar(text, expected):
+    assert substitutions.perform(substitutions.parse(text), FakeContext()) == expected
+
+
+def test_find_pkg_share_and_prefix_use_the_ament_index(demo_prefix):
+    parts = substitutions.parse("$(find-pkg-share demo) $(find-pkg-prefix demo)")
+    assert substitutions.perform(parts, FakeContext()) == f"{demo_prefix}/share/demo {demo_prefix}"
+    with pytest.raises(LaunchFileError, match="Package 'nope' not found"):
+        substitutions.perform(substitutions.parse("$(find-pkg-share nope)"), FakeContext())
+
+
+@pytest.mark.parametrize("text, message", [
+    ("$(var missing)", "launch configuration 'missing' does not exist"),
+    ("$(env COURSE_NOT_SET)",
+     r"environment variable 'COURSE_NOT_SET' does not exist.*\$\(env COURSE_NOT_SET DEFAULT\)"),
+])
+def test_missing_values_are_errors_that_name_them(text, message):
+    with pytest.raises(LaunchFileError, match=message):
+        substitutions.perform(substitutions.parse(text), FakeContext())
+
+
+@pytest.mark.parametrize("text, message", [
+    ('$(eval "1 + 1")', r"\$\(eval\) is not supported here \(a full ROS 2 install has it\); supported: \$\(var"),
+    ("$(command ls)", r"\$\(command\) is not supported here"),
+    ("$(evn HOME)", r"\$\(evn\) is not a launch substitution \(did you mean 'env'\?\)"),
+    ("$(var)", r"\$\(var\) takes 1 or 2 arguments, got 0"),
+    ("$(dirname x)", r"\$\(dirname\) takes 0 arguments, got 1"),
+    ("$(var a", r"is not closed with '\)'"),
+    ("$(var  a)", "expected an argument"),
+    ("$(var 'a)", "the quote ' is not closed"),
+])
+def test_malformed_or_unsupported_substitutions_are_refused(text, message):
+    with pytest.raises(LaunchFileError, match=message):
+        substitutions.parse(text, "f.launch.xml", 3)
+
+
+def test_describe_prints_defaults_like_show_args():
+    parts = substitutions.parse("$(find-pkg-share demo)/x_$(var robot)")
+    assert substitutions.describe(parts) == "FindPackageShare(pkg='demo') + '/x_' + LaunchConfig('robot')"
+
+
+@pytest.mark.parametrize("text, expected", [
+    ("a b  c", ["a", "b", "c"]),
+    ("--name 'two words'", ["--name", "two words"]),
+    ("$(var x) $(var y)", ["X", "Y"]),
+    ("pre_$(var x)_post last", ["pre_X_post", "last"]),
+    ("first $(var x)/file more words", ["first", "X/file", "more", "words"]),
+])
+def test_args_split_like_launch_splits_command_lines(text, expected):
+    class Values:
+        configurations = {"x": "X", "y": "Y"}
+
+    arguments = split_command_line(substitutions.parse(text))
+    assert [substitutions.perform(argument, Values()) for argument in arguments] == expected
+
+
+# --- errors that name the file and line ---------------------------------------------------------
+
+@pytest.mark.parametrize("form, text, line, message", [
+    ("xml", "<launch>\n  <timer period='1'/>\n</launch>",
+     2, r"<timer> is not supported here \(a full ROS 2 install has it\); supported tags: node"),
+    ("yaml", "launch:\n- arg: {name: a}\n- nodes: {pkg: demo, exec: talker}",
+     3, r"<nodes> is not a launch tag \(did you mean 'node'\?\)"),
+    ("xml", "<launch>\n  <node pkg='demo' exec='talker' respawn='true'/>\n</launch>",
+     2, r"<node> attribute 'respawn' is not supported here; <node> supports: pkg, exec, name"),
+    ("yaml", "launch:\n- node:\n    pkg: demo\n    exec: talker\n    namepsace: x",
+     5, r"attribute 'namepsace' is not supported here \(did you mean 'namespace'\?\)"),
+    ("xml", "<launch>\n  <node pkg='demo' exec='talker'>\n    <parameter name='a' value='1'/>\n  </node>\n</launch>",
+     3, r"<parameter> is not supported inside <node>; <node> supports: .*nested <param>"),
+    ("xml", "<launch>\n  <group forwarding='false'/>\n</launch>", 2, "'forwarding' is not supported here"),
+    ("xml", "<launch>\n  <arg name='a' default='$(eval 1)'/>\n</launch>", 2, r"\$\(eval\) is not supported here"),
+    ("xml", "<launch>\n  <node pkg='demo'/>\n</launch>", 2, "<node> needs the attribute 'exec'"),
+    ("xml", "<launch>\n  <node pkg='demo' exec='talker'\n</launch>", 3, "not well-formed XML"),
+    ("yaml", "launch:\n- node: {pkg: demo, exec: [talker\n", 3, "not valid YAML"),
+    ("yaml", "launch:\n- arg:\n    name: rate\n    default: 5", 4,
+     r"'default' must be text; in YAML quote it: default: \"5\""),
+    ("xml", "<launch>\n<node pkg='demo' exec='talker'><param name='a' from='x.yaml'/></node></launch>",
+     2, "<param> has both name and from"),
+    ("xml", "<launch>\n<node pkg='demo' exec='talker'><param name='a' value='1'><param name='b' value='2'/>"
+            "</param></node></launch>", 2, "both value= and nested <param> tags"),
+    ("xml", "<launch>\n<node pkg='demo' exec='talker'><param name='a' value='[1, 2.5]'/></node></launch>",
+     2, "mixes types"),
+    ("xml", "<launch>\n<node pkg='demo' exec='talker' if='1' unless='0'/></launch>", 2, "both if and unless"),
+    ("xml", "<group/>", 1, "the root tag must be <launch>"),
+])
+def test_errors_name_the_file_the_line_and_what_is_supported(tmp_path, demo_prefix, form, text, line, message):
+    path = tmp_path / f"bad.launch.{form}"
+    path.write_text(text)
+    with pytest.raises(LaunchFileError, match=message) as error:
+        run_launch_file(path)
+    assert (error.value.file, error.value.line) == (path, line)
+    assert str(error.value).startswith(f"{path}:{line}: ")
+
+
+@pytest.mark.parametrize("node, message", [
+    ('pkg="demo" exec="talker" name="my-node"', "the node name 'my-node' is invalid"),
+    ('pkg="demo" exec="talker" namespace="1robot"', "the namespace '/1robot' of this node is invalid"),
+    ('pkg="nope" exec="talker"', "Package 'nope' not found"),
+    ('pkg="demo" exec="speaker"', "No executable 'speaker' found in package 'demo'; it has: listener, talker"),
+    ('pkg="demo" exec="talker" output="own_log"', 'output="own_log" is not supported here; use screen, log or both'),
+])
+def test_bad_nodes_are_reported_at_their_line(tmp_path, demo_prefix, node, message):
+    path = write(tmp_path, "xml", f"<launch>\n  <node {node}/>\n</launch>", "")
+    with pytest.raises(LaunchFileError, match=message) as error:
+        run_launch_file(path)
+    assert error.value.line == 2
+
+
+def test_python_launch_files_are_explained_not_run(tmp_path):
+    path = tmp_path / "demo.launch.py"
+    path.write_text("def generate_launch_description(): ...\n")
+    with pytest.raises(LaunchFileError, match="Python launch files are not supported.*a full ROS 2 install runs them"):
+        run_launch_file(path)
+
+
+def test_a_file_with_another_ending_is_read_as_xml_or_yaml(tmp_path, demo_prefix):
+    (tmp_path / "demo.launch").write_text("launch:\n- node: {pkg: demo, exec: talker}\n")
+    assert [node.label for node in run_launch_file(tmp_path / "demo.launch").nodes] == ["talker"]
+
+
+# --- the command line without running nodes -----------------------------------------------------
+
+def test_show_args_lists_arguments_like_ros2_launch(tmp_path, demo_prefix, capsys):
+    write(tmp_path, "xml", '<launch><arg name="who" default="$(var robot)_x"/></launch>', "", name="child")
+    path = write(tmp_path, "xml", """
+        <launch>
+          <arg name="robot" description="Which robot"/>
+          <arg name="rate" default="5"/>
+          <group if="true"><arg name="debug" default="false"/></group>
+          <include file="$(dirname)/child.launch.xml"/>
+        </launch>""", "")
+    assert cli.main(["-s", str(path)]) == 0
+    assert capsys.readouterr().out == textwrap.dedent("""\
+        Arguments (pass arguments as '<name>:=<value>'):
+
+            'robot':
+                Which robot
+
+            'rate':
+                no description given
+                (default: '5')
+
+            'debug':*
+                no description given
+                (default: 'false')
+
+            'who':
+                no description given
+                (default: LaunchConfig('robot') + '_x')
+
+        * argument(s) which are only used if specific conditions occur
+        """)
+
+
+def test_show_args_of_a_package_file_without_arguments(tmp_path, demo_prefix, capsys):
+    (demo_prefix / "share" / "demo" / "launch").mkdir(exist_ok=True)
+    (demo_prefix / "share" / "demo" / "launch" / "none.launch.yaml").write_text("launch: []\n")
+    assert cli.main(["demo", "none.launch.yaml", "--show-args"]) == 0
+    assert capsys.readouterr().out == "Arguments (pass arguments as '<name>:=<value>'):\n\n  No arguments.\n"
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["demo", "missing.launch.xml"],
+     "file 'missing.launch.xml' was not found in the share directory of package 'demo'"),
+    (["nopkg", "x.launch.xml"], "Package 'nopkg' not found"),
+    (["--print", "x.launch.xml"],
+     r"-p/--print is not supported by the course's ros2 launch \(it supports -s/--show-args"),
+    (["--launch-prefix", "gdb", "x.launch.xml"], "--launch-prefix is not supported"),
+    (["FILE", "rate=5"], "malformed launch argument 'rate=5', expected format '<name>:=<value>'"),
+])
+def test_command_line_mistakes_get_one_line(tmp_path, demo_prefix, capsys, argv, message):
+    path = write(tmp_path, "xml", "<launch/>", "")
+    argv = [str(path) if part == "FILE" else part for part in argv]
+    assert cli.main(argv) != 0
+    error = capsys.readouterr().err
+    assert error.count("\n") == 1 and error.startswith("ros2 launch: ")
+    assert re.search(message, error)

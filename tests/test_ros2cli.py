@@ -1,0 +1,363 @@
+"""The course's ``ros2`` command (course_lib.ros2cli), run as the installed ``.venv/bin/ros2``
+against live nodes in other processes: one test per verb, each reading what the verb prints."""
+
+import re
+import signal
+import subprocess
+import sys
+import types
+from pathlib import Path
+
+import pytest
+import yaml
+
+from course_lib import processes, rosenv, workspace
+
+ROS2 = Path(sys.executable).parent / "ros2"
+
+# Two nodes, each in a process of its own: `python live_nodes.py talker|listener [ros args]`.
+LIVE_NODES = '''
+import sys
+
+import rclpy
+from rcl_interfaces.msg import SetParametersResult
+from rclpy.executors import ExternalShutdownException
+from rclpy.node import Node
+from std_msgs.msg import Int32, String
+
+
+class Talker(Node):
+    """Publishes '<greeting> N' on cli_chatter at 10 Hz; refuses a rate that is not positive."""
+
+    def __init__(self):
+        super().__init__('cli_talker')
+        self.declare_parameter('greeting', 'hello')
+        self.declare_parameter('rate', 10.0)
+        self.declare_parameter('limits.low', 1)
+        self.add_on_set_parameters_callback(self.check)
+        self.count = 0
+        self.publisher = self.create_publisher(String, 'cli_chatter', 10)
+        self.create_timer(0.1, self.tick)
+
+    def check(self, changes):
+        for change in changes:
+            if change.name == 'rate' and change.value <= 0.0:
+                return SetParametersResult(successful=False, reason='rate must be positive')
+        return SetParametersResult(successful=True)
+
+    def tick(self):
+        self.count += 1
+        self.publisher.publish(String(data=f"{self.get_parameter('greeting').value} {self.count}"))
+
+
+class Listener(Node):
+    """Listens to cli_chatter and logs every number heard on cli_numbers."""
+
+    def __init__(self):
+        super().__init__('cli_listener')
+        self.create_subscription(String, 'cli_chatter', lambda msg: None, 10)
+        self.create_subscription(Int32, 'cli_numbers', lambda msg: print(f'heard {msg.data}', flush=True), 10)
+
+
+def main():
+    rclpy.init(args=sys.argv)
+    node = None
+    try:
+        node = Talker() if sys.argv[1] == 'talker' else Listener()
+        rclpy.spin(node)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()
+
+
+main()
+'''
+
+
+def ros2(*args, env, timeout=60, check=True):
+    """Run the installed ros2 with ``args``; the CompletedProcess (text), checked for exit code 0."""
+    done = subprocess.run([str(ROS2), *args], env=env, capture_output=True, text=True, timeout=timeout,
+                          stdin=subprocess.DEVNULL)
+    if check:
+        assert done.returncode == 0, f"ros2 {' '.join(args)} failed ({done.returncode}):\n{done.stderr}"
+    return done
+
+
+def ros2_together(*commands, env, timeout=60):
+    """Run several independent ros2 commands at the same time (each one mostly waits for
+    discovery); their CompletedProcesses, in order."""
+    started = [subprocess.Popen([str(ROS2), *args], env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                text=True, stdin=subprocess.DEVNULL) for args in commands]
+    done = []
+    for args, process in zip(commands, started):
+        out, err = process.communicate(timeout=timeout)
+        done.append(subprocess.CompletedProcess([str(ROS2), *args], process.returncode, out, err))
+    return done
+
+
+@pytest.fixture(scope="module")
+def live(tmp_path_factory):
+    """A talker and a listener in processes of their own, on a reserved domain; yields ros2's env."""
+    script = tmp_path_factory.mktemp("live") / "live_nodes.py"
+    script.write_text(LIVE_NODES)
+    with rosenv.reserve_domain_id() as reservation:
+        started = []
+        try:
+            for role in ("talker", "listener"):
+                started.append(processes.NodeProcess([sys.executable, str(script), role], name=f"cli_{role}",
+                                                     domain_id=reservation.domain_id).start())
+            for process in started:
+                process.wait_for_node(process.name, timeout=30)
+            yield types.SimpleNamespace(env=rosenv.ros_environment(domain_id=reservation.domain_id),
+                                        script=script, domain_id=reservation.domain_id, listener=started[1])
+        finally:
+            for process in started:
+                process.stop()
+
+
+def test_the_command_is_installed_in_the_venv():
+    """make setup put ros2 next to the interpreter, and it is the course's."""
+    from course_lib.ros2cli import install
+
+    assert ROS2.is_file() and install.is_ours(ROS2)
+
+
+# --- what is and is not supported ---------------------------------------------------------
+
+def test_help_lists_the_supported_commands_and_verbs():
+    env = rosenv.ros_environment()
+    top = ros2("--help", env=env).stdout
+    assert re.findall(r"^  ([a-z]+) ", top, re.MULTILINE) == ["interface", "launch", "node", "param", "pkg", "run",
+                                                             "topic"]
+    assert "a full ROS 2 install (ros2cli) has more" in top
+    topic = ros2("topic", "--help", env=env).stdout
+    assert re.findall(r"^  ([a-z]+) ", topic, re.MULTILINE) == ["echo", "hz", "info", "list", "pub"]
+    assert "--once" in ros2("topic", "echo", "--help", env=env).stdout
+
+
+@pytest.mark.parametrize("args, names", [
+    (["service", "list"], "ros2 service is not supported"),
+    (["topic", "bw", "/x"], "ros2 topic bw is not supported"),
+    (["topic", "echo", "/x", "--csv"], "ros2 topic echo: --csv is not supported"),
+    (["topic", "echo", "/x", "--times", "3"], "ros2 topic echo: --times is not supported"),
+    (["param", "dump", "/x", "--output-dir", "/tmp"], "ros2 param dump: --output-dir is not supported"),
+    (["run", "--prefix", "gdb", "pkg", "exe"], "ros2 run: --prefix is not supported"),
+    (["pkg", "create", "demo"], "ros2 pkg create: --build-type ament_cmake (the default) is not supported"),
+])
+def test_what_is_not_supported_is_one_line_naming_what_is(args, names, tmp_path):
+    done = ros2(*args, env=rosenv.ros_environment(), check=False)
+    assert done.returncode == 2 and done.stdout == ""
+    assert len(done.stderr.splitlines()) == 1, done.stderr
+    assert done.stderr.startswith(names) and "(it supports: " in done.stderr
+    assert done.stderr.rstrip().endswith("a full ROS 2 install (ros2cli) has more")
+
+
+# --- ros2 node --------------------------------------------------------------------------------
+
+def test_node_list(live):
+    assert ros2("node", "list", env=live.env).stdout == "/cli_listener\n/cli_talker\n"
+
+
+def test_node_info(live):
+    text = ros2("node", "info", "/cli_talker", env=live.env).stdout
+    assert text.startswith("/cli_talker\n  Subscribers:\n\n  Publishers:\n    /cli_chatter: std_msgs/msg/String\n")
+    assert "    /cli_talker/set_parameters: rcl_interfaces/srv/SetParameters\n" in text
+    assert text.endswith("  Action Servers:\n\n  Action Clients:\n\n")
+
+
+# --- ros2 topic -------------------------------------------------------------------------------
+
+def test_topic_list(live):
+    assert ros2("topic", "list", "-t", env=live.env).stdout.splitlines() == [
+        "/cli_chatter [std_msgs/msg/String]", "/cli_numbers [std_msgs/msg/Int32]",
+        "/parameter_events [rcl_interfaces/msg/ParameterEvent]", "/rosout [rcl_interfaces/msg/Log]"]
+
+
+def test_topic_echo(live):
+    once, field = ros2_together(["topic", "echo", "/cli_chatter", "--once"],
+                                ["topic", "echo", "cli_chatter", "std_msgs/msg/String", "--field", "data", "--once"],
+                                env=live.env)
+    assert re.fullmatch(r"data: hello \d+\n---\n", once.stdout), once
+    assert re.fullmatch(r"hello \d+\n---\n", field.stdout), field
+
+
+def test_topic_hz_prints_rates_until_ctrl_c(live):
+    """Average rate lines like ros2cli's every second; SIGINT ends it without a traceback."""
+    env = dict(live.env)
+    env.pop("COURSE_LIB_UNDER_TEST")  # the live behaviour: run until Ctrl-C
+    hz = subprocess.Popen([str(ROS2), "topic", "hz", "/cli_chatter"], env=env, stdout=subprocess.PIPE,
+                          stderr=subprocess.PIPE, text=True, stdin=subprocess.DEVNULL)
+    try:
+        lines = [hz.stdout.readline() for _ in range(4)]
+        hz.send_signal(signal.SIGINT)
+        code = hz.wait(timeout=15)
+    finally:
+        hz.kill()
+        hz.wait()
+    rates = [float(line.split()[-1]) for line in lines if line.startswith("average rate:")]
+    assert len(rates) == 2 and all(5 < rate < 15 for rate in rates), lines
+    assert re.fullmatch(r"\tmin: \d+\.\d{3}s max: \d+\.\d{3}s std dev: \d+\.\d{5}s window: \d+\n", lines[1])
+    assert code == 2 and "Traceback" not in hz.stderr.read()
+
+
+def test_topic_info(live):
+    short, verbose = (done.stdout for done in ros2_together(["topic", "info", "/cli_chatter"],
+                                                            ["topic", "info", "-v", "/cli_chatter"], env=live.env))
+    assert short == "Type: std_msgs/msg/String\nPublisher count: 1\nSubscription count: 1\n"
+    assert "\n\nNode name: cli_talker\nNode namespace: /\nTopic type: std_msgs/msg/String\n" in verbose
+    assert "Endpoint type: SUBSCRIPTION\n" in verbose and verbose.endswith("\n\n")
+
+
+def test_topic_pub_reaches_the_listener(live):
+    """pub --once waits for the listener, publishes the YAML values, and the listener hears them."""
+    out = ros2("topic", "pub", "--once", "/cli_numbers", "std_msgs/msg/Int32", "{data: 5}", env=live.env).stdout
+    assert "publisher: beginning loop\npublishing #1: std_msgs.msg.Int32(data=5)\n\n" in out
+    live.listener.wait_for_output("heard 5", timeout=10)
+    bad = ros2("topic", "pub", "--once", "/cli_numbers", "std_msgs/msg/Int32", "{dat: 5}", env=live.env,
+               check=False)
+    assert bad.returncode == 1 and bad.stderr.startswith("Failed to populate field: std_msgs/msg/Int32 has no "
+                                                         "field 'dat'")
+
+
+# --- ros2 param -------------------------------------------------------------------------------
+
+def test_param_list(live):
+    text = ros2("param", "list", "--param-type", env=live.env).stdout
+    assert text.startswith("/cli_listener:\n  start_type_description_service (type: boolean)\n")
+    assert ("/cli_talker:\n  greeting (type: string)\n  limits.low (type: integer)\n  rate (type: double)\n"
+            in text)
+
+
+def test_param_get(live):
+    found, unset, missing = ros2_together(["param", "get", "/cli_talker", "greeting"],
+                                          ["param", "get", "/cli_talker", "nope"],
+                                          ["param", "get", "/ghost", "rate", "--timeout", "0", "--spin-time", "0.1"],
+                                          env=live.env)
+    assert found.stdout == "String value is: hello\n"
+    assert (unset.returncode, unset.stderr) == (1, "Parameter not set\n")
+    assert (missing.returncode, missing.stderr) == (1, "Node not found\n")
+
+
+def test_param_set_goes_through_the_nodes_callback(live):
+    """Accepted: the node has the value. Rejected: ros2cli's message with the node's reason."""
+    accepted, refused = ros2_together(["param", "set", "/cli_talker", "rate", "5.0"],
+                                      ["param", "set", "/cli_talker", "rate", "-1.0"], env=live.env)
+    assert accepted.stdout == "Set parameter successful\n" and accepted.returncode == 0
+    assert refused.returncode == 0  # ros2cli too: a refusal is printed, not an error exit
+    assert refused.stderr == "Setting parameter failed: rate must be positive\n" and refused.stdout == ""
+    assert ros2("param", "get", "/cli_talker", "rate", env=live.env).stdout == "Double value is: 5.0\n"
+
+
+def test_param_load(live, tmp_path):
+    path = tmp_path / "talker.yaml"
+    path.write_text("/cli_talker:\n  ros__parameters:\n    limits:\n      low: 3\n    rate: -2.0\n")
+    done = ros2("param", "load", "/cli_talker", str(path), env=live.env)
+    assert done.stdout == "Set parameter limits.low successful\n"
+    assert done.stderr == "Set parameter rate failed: rate must be positive\n"
+    assert ros2("param", "get", "/cli_talker", "limits.low", "--hide-type", env=live.env).stdout == "3\n"
+
+
+def test_param_dump_is_a_params_file(live, tmp_path):
+    """Dump a node's parameters, start it again with --params-file the dump: it has the value."""
+    name = "cli_dumped"
+    args = [sys.executable, str(live.script), "talker", "--ros-args", "-r", f"__node:={name}"]
+    with processes.NodeProcess(args + ["-p", "greeting:=dumped"], domain_id=live.domain_id) as first:
+        first.wait_for_node(name, timeout=30)
+        dump = ros2("param", "dump", f"/{name}", env=live.env).stdout
+    assert dump.startswith(f"/{name}:\n  ros__parameters:\n    greeting: dumped\n    limits:\n      low: 1\n")
+    path = tmp_path / "dumped.yaml"
+    path.write_text(dump)
+    assert yaml.safe_load(dump)[f"/{name}"]["ros__parameters"]["rate"] == 10.0
+    with processes.NodeProcess(args + ["--params-file", str(path)], domain_id=live.domain_id) as second:
+        second.wait_for_node(name, timeout=30)
+        assert ros2("param", "get", f"/{name}", "greeting", env=live.env).stdout == "String value is: dumped\n"
+
+
+# --- ros2 interface / pkg / launch --------------------------------------------------------------
+
+def test_interface_verbs():
+    env = rosenv.ros_environment()
+    show = ros2("interface", "show", "geometry_msgs/msg/Twist", "--no-comments", env=env).stdout
+    assert show.startswith("Vector3  linear\n\tfloat64 x\n")
+    assert "std_msgs/msg/Int32\n" in ros2("interface", "package", "std_msgs", env=env).stdout
+    listing = ros2("interface", "list", "-m", env=env).stdout
+    assert listing.startswith("Messages:\n") and "    sensor_msgs/msg/Image\n" in listing
+    assert "Services:" not in listing
+    assert "rcl_interfaces\n" in ros2("interface", "packages", env=env).stdout
+
+
+def test_pkg_verbs():
+    env = rosenv.ros_environment()
+    assert "std_msgs\n" in ros2("pkg", "list", env=env).stdout
+    prefix = ros2("pkg", "prefix", "std_msgs", env=env).stdout.strip()
+    assert (Path(prefix) / "share" / "std_msgs" / "package.xml").is_file()
+    assert ros2("pkg", "prefix", "--share", "std_msgs", env=env).stdout.strip() == f"{prefix}/share/std_msgs"
+    missing = ros2("pkg", "prefix", "no_such_pkg", env=env, check=False)
+    assert missing.returncode == 1 and missing.stderr.startswith("Package 'no_such_pkg' not found:")
+
+
+def test_launch_runs_course_lib_launch(tmp_path):
+    """ros2 launch hands everything after the word to course_lib.launch: a launch file's arguments."""
+    path = tmp_path / "demo.launch.xml"
+    path.write_text('<launch>\n  <arg name="rate" default="10" description="messages per second"/>\n</launch>\n')
+    shown = ros2("launch", str(path), "--show-args", env=rosenv.ros_environment()).stdout
+    assert shown.startswith("Arguments (pass arguments as '<name>:=<value>'):")
+    assert "'rate':" in shown and "messages per second" in shown and "(default: '10')" in shown
+
+
+@pytest.mark.slow
+def test_pkg_create_build_and_run(tmp_path, domain_id):
+    """ros2 pkg create writes an ament_python package that colcon builds; ros2 run finds its
+    executables and becomes the node (exec), so SIGINT reaches the node itself."""
+    src = tmp_path / "ws" / "src"
+    src.mkdir(parents=True)
+    env = rosenv.ros_environment(domain_id=domain_id)
+    created = ros2("pkg", "create", "--build-type", "ament_python", "--dependencies", "rclpy", "--node-name",
+                   "hello", "--destination-directory", str(src), "demo_pkg", env=env).stdout
+    assert created.startswith("going to create a new package\npackage name: demo_pkg\n")
+    assert f"creating {src}/demo_pkg/package.xml\n" in created
+    package = src / "demo_pkg"
+    (package / "demo_pkg" / "spinner.py").write_text(SPINNER)
+    setup = package / "setup.py"
+    setup.write_text(setup.read_text().replace("'hello = demo_pkg.hello:main',",
+                                               "'hello = demo_pkg.hello:main',\n"
+                                               "            'spinner = demo_pkg.spinner:main',"))
+    workspace.build(tmp_path / "ws", timeout=300)
+    env = workspace.workspace_environment(tmp_path / "ws", domain_id=domain_id)
+    assert ros2("pkg", "executables", "demo_pkg", env=env).stdout == "demo_pkg hello\ndemo_pkg spinner\n"
+    assert ros2("run", "demo_pkg", "hello", env=env).stdout == "Hi from demo_pkg.\n"
+    spinner = subprocess.Popen([str(ROS2), "run", "demo_pkg", "spinner", "--ros-args", "-r", "__node:=turned"],
+                               env=env, stdout=subprocess.PIPE, text=True, stdin=subprocess.DEVNULL)
+    try:
+        assert spinner.stdout.readline() == "spinning as /turned\n"
+        command_line = Path(f"/proc/{spinner.pid}/cmdline").read_bytes().split(b"\0")
+        assert command_line[1].endswith(b"lib/demo_pkg/spinner")  # the node itself, not ros2
+        spinner.send_signal(signal.SIGINT)
+        assert spinner.wait(timeout=15) == 0
+    finally:
+        spinner.kill()
+        spinner.wait()
+    missing = ros2("run", "demo_pkg", "nope", env=env, check=False)
+    assert missing.returncode == 1 and "it has: hello, spinner" in missing.stderr
+
+
+SPINNER = '''import rclpy
+from rclpy.executors import ExternalShutdownException
+from rclpy.node import Node
+
+
+def main(args=None):
+    rclpy.init(args=args)
+    node = Node('spinner')
+    try:
+        print(f'spinning as {node.get_fully_qualified_name()}', flush=True)
+        rclpy.spin(node)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        node.destroy_node()
+        rclpy.try_shutdown()
+'''
