@@ -66,12 +66,21 @@ def quiet_add_submission() -> None:
 #: The line of the course's nbgrader_config.py below which the instructor's settings are kept.
 MARKER = "# ---- Your settings below this line are kept when the autograder rewrites this file ----"
 
+#: The repository the grader runs from (it is not installed: students' environments never hold it).
+REPO = Path(__file__).resolve().parent.parent
+
 CONFIG_HEADER = f'''\
 # nbgrader configuration of the course (written by `python -m autograder`).
 # The course's settings live in autograder/config.py; the lines above the marker are rewritten.
+import sys
 from pathlib import Path
 
-from autograder.config import apply
+try:
+    from autograder.config import apply
+except ImportError:  # nbgrader or the formgrader started by hand: the grader's repository
+    sys.modules.pop("autograder", None)  # the course's autograder/ folder (grading records), not the grader
+    sys.path.append({str(REPO)!r})
+    from autograder.config import apply
 
 c = get_config()  # noqa: F821 (provided by nbgrader)
 apply(c, Path(__file__).resolve().parent)

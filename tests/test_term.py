@@ -28,6 +28,8 @@ import zoo  # noqa: E402
 
 pytestmark = [pytest.mark.slow, pytest.mark.timeout(900)]
 
+REPO = Path(__file__).resolve().parent.parent
+
 DUE = "2025-03-14 23:59:00 UTC"
 #: Blackboard's "Download assignment" names: <assignment>_<user>_attempt_<time>_<file name>.
 ON_TIME, LATE = "2025-03-14-20-15-00", "2025-03-16-09-30-00"  # LATE: 1 d 9.5 h late, 2 started days
@@ -43,7 +45,7 @@ def _run(*args: str, env=None) -> subprocess.CompletedProcess:
     import os
 
     done = subprocess.run([sys.executable, "-m", "autograder", *args], capture_output=True, text=True,
-                          env={**os.environ, **(env or {})}, timeout=600)
+                          env={**os.environ, **(env or {})}, timeout=600, cwd=REPO)
     assert done.returncode == 0, done.stdout + done.stderr
     return done
 
