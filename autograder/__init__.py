@@ -1,8 +1,11 @@
 """The course's grader (instructor side; never installed in students' environments).
 
-- ``python -m autograder release|grade|feedback COURSE_DIR``: the instructor's commands
-  (``autograder.grading``, ``autograder.feedback``); ``record-answers``: record the self-checks'
-  answers from the answer keys (``autograder.record``).
+- ``python -m autograder roster|release|collect|grade|feedback|export COURSE_DIR``: the
+  instructor's commands (``autograder.roster``, ``autograder.grading``, ``autograder.collect``,
+  ``autograder.feedback``, ``autograder.export``); ``autograder.gradebook`` writes the grades into
+  nbgrader's gradebook as nbgrader's autograde would, ``autograder.late`` holds due dates and late
+  penalties, ``autograder.guard`` makes nbgrader's own autograde refuse outside the grader;
+  ``record-answers``: record the self-checks' answers from the answer keys (``autograder.record``).
 - ``autograder.answers.<assignment>``: the answer keys the graded checks compare with.
 - ``autograder.reference``: the reference solutions as the source notebooks hold them.
 - ``autograder.config``, ``autograder.kernel``: nbgrader's configuration and the sandboxed kernel.

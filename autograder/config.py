@@ -1,9 +1,11 @@
 """nbgrader configuration of the course, written once here.
 
 ``write_config(course_dir)`` puts an ``nbgrader_config.py`` in a course directory that loads
-:func:`apply`, so that both the nbgrader CLI (run by hand in that directory) and the autograder
-use the same settings. Layout: nbgrader's own (``source/ release/ submitted/ autograded/
-feedback/``), gradebook ``gradebook.db`` (SQLite) in the course root.
+:func:`apply`, so that both the nbgrader CLI (run by hand in that directory, and the formgrader
+started there) and the autograder use the same settings; the instructor's own settings (late
+penalties, the LMS's file names) go below its marker line and are kept. Layout: nbgrader's own
+(``source/ release/ submitted/ autograded/ feedback/``), gradebook ``gradebook.db`` (SQLite) and
+the LMS export ``grades.csv`` in the course root.
 """
 
 from __future__ import annotations
@@ -30,9 +32,77 @@ def apply(c, root: str | Path | None = None) -> None:
     c.OverwriteCells.add_missing_cells = True
     # Students' notebooks may print a lot; the feedback keeps the start of each output.
     c.LimitOutput.max_lines = 400
+    # nbgrader's own autograde (CLI, formgrader button) would run the hidden checks in the
+    # student's kernel, outside the sandbox: it refuses and names the course's grader.
+    c.Autograde.exporter_class = "autograder.guard.GraderOnlyExporter"
+    # `nbgrader export` and `python -m autograder export` write one file, in one format.
+    c.ExportApp.plugin_class = "autograder.export.CourseCsvExport"
+    if root is not None:
+        c.ExportPlugin.to = str(Path(root).resolve() / "grades.csv")
+    # Late penalties per assignment (c.LatePenalty.per_day in the course's nbgrader_config.py).
+    c.AssignLatePenalties.plugin_class = "autograder.late.LatePenalty"
+    # `nbgrader zip_collect`: the file names and times of an LMS download.
+    c.ZipCollectApp.collector_plugin = "autograder.collect.LmsFileNames"
+    quiet_add_submission()
 
 
-CONFIG_TEMPLATE = '''\
+def quiet_add_submission() -> None:
+    """Silence the one SQLAlchemy warning nbgrader's Gradebook.add_submission raises on every new
+    submission ("Object of type <SubmittedAssignment> not in session, add operation along
+    'Student.submissions' will not proceed"): add_submission builds the ORM objects before it adds
+    them to the session, and reading the assignment's notebooks meanwhile autoflushes. Harmless
+    (the objects are added right after), but printed by every grading run. Only that message,
+    only from nbgrader.api."""
+    import warnings
+
+    try:
+        from sqlalchemy.exc import SAWarning
+    except ImportError:
+        return
+    warnings.filterwarnings("ignore", message=r"Object of type <Submitted\w+> not in session",
+                            category=SAWarning, module=r"nbgrader\.api")
+
+
+#: The line of the course's nbgrader_config.py below which the instructor's settings are kept.
+MARKER = "# ---- Your settings below this line are kept when the autograder rewrites this file ----"
+
+#: The repository the grader runs from (it is not installed: students' environments never hold it).
+REPO = Path(__file__).resolve().parent.parent
+
+CONFIG_HEADER = f'''\
+# nbgrader configuration of the course (written by `python -m autograder`).
+# The course's settings live in autograder/config.py; the lines above the marker are rewritten.
+import sys
+from pathlib import Path
+
+try:
+    from autograder.config import apply
+except ImportError:  # nbgrader or the formgrader started by hand: the grader's repository
+    sys.modules.pop("autograder", None)  # the course's autograder/ folder (grading records), not the grader
+    sys.path.append({str(REPO)!r})
+    from autograder.config import apply
+
+c = get_config()  # noqa: F821 (provided by nbgrader)
+apply(c, Path(__file__).resolve().parent)
+
+{MARKER}
+'''
+
+#: What a new course's settings section holds: the settings an instructor may want, commented out.
+SETTINGS_EXAMPLE = '''\
+# Late penalty per assignment: the fraction of the score lost per started day late, capped.
+# Due dates are in the gradebook: python -m autograder release COURSE_DIR --assignment pubsub --duedate "2025-03-14 23:59 Europe/Berlin"
+# c.LatePenalty.per_day = {"pubsub": 0.1, "brightness": 0.1, "catdog_warp": 0.1}
+# c.LatePenalty.maximum = 0.5
+# The time zone of the submission times in your LMS's file names (python -m autograder collect):
+# c.LmsFileNames.timezone = "Europe/Berlin"
+# The file names of your LMS's download, when they differ from autograder.collect.LMS_FILE_NAME
+# (a regular expression with the groups student_id, file_id and, to keep the submission time, timestamp):
+# c.FileNameCollectorPlugin.named_regexp = r"..."
+'''
+
+#: The file earlier versions wrote (no settings section): replaced as a whole.
+_OLD_TEMPLATE = '''\
 # nbgrader configuration of the course (written by `python -m autograder release`).
 # The settings live in autograder/config.py; edit them there.
 from pathlib import Path
@@ -45,8 +115,31 @@ apply(c, Path(__file__).resolve().parent)
 
 
 def write_config(course_dir: Path) -> Path:
-    """Write course_dir/nbgrader_config.py (idempotent) and return its path."""
+    """Write course_dir/nbgrader_config.py (idempotent) and return its path: the course's header,
+    and below the marker the instructor's settings as they are (a new file gets commented examples).
+
+    Raises:
+        ValueError: the file exists but was not written by the autograder (no marker line).
+    """
     path = Path(course_dir) / "nbgrader_config.py"
-    if not path.exists() or path.read_text() != CONFIG_TEMPLATE:
-        path.write_text(CONFIG_TEMPLATE)
+    text = path.read_text() if path.exists() else None
+    if text is None or text == _OLD_TEMPLATE:
+        settings = SETTINGS_EXAMPLE
+    elif MARKER in text:
+        settings = text.split(MARKER, 1)[1].lstrip("\n")
+    else:
+        raise ValueError(f"{path} was not written by the autograder, which needs its own header in it. "
+                         f"Rename your file, run the command again, and copy your settings below the line "
+                         f"'{MARKER}' of the new one.")
+    wanted = CONFIG_HEADER + settings
+    if text != wanted:
+        path.write_text(wanted)
     return path
+
+
+def load(course_dir):
+    """The course's nbgrader configuration (its nbgrader_config.py, instructor's settings included),
+    as a traitlets Config for nbgrader classes used in this process."""
+    from traitlets.config.loader import PyFileConfigLoader
+
+    return PyFileConfigLoader("nbgrader_config.py", path=str(Path(course_dir).resolve())).load_config()

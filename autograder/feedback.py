@@ -1,51 +1,94 @@
-"""Per-student HTML feedback: ``python -m autograder feedback COURSE_DIR``.
+"""Per-student HTML feedback: ``python -m autograder feedback COURSE_DIR [--assignment A] [--student S]``.
 
 nbgrader's ``generate_feedback`` renders each autograded notebook (every check's verdict lines,
 its seed, and for catdog_warp the student's crops beside the expected ones, which the checks
-display as images) to COURSE_DIR/feedback/<student>/<assignment>/<notebook>.html. This module
-adds COURSE_DIR/feedback/<student>/index.html: the scores per assignment and check, and the
-reason when a notebook could not be graded at all (those have no nbgrader feedback page).
+display as images) to COURSE_DIR/feedback/<student>/<assignment>/<notebook>.html; long verdict
+lines wrap there (:data:`WRAP_STYLE`) instead of running off the page. This module adds
+COURSE_DIR/feedback/<student>/index.html: for every assignment graded so far (also those not
+named in this run), the score per check, the due date, the submission time and the late
+penalty, and the reason when a notebook could not be graded at all. Students read only what is
+meant for them: the instructor's notes (nbgrader's log, the fix) stay in the grading report.
 """
 
 from __future__ import annotations
 
 import html
-import json
 from pathlib import Path
 
 from autograder import grading
 
+#: Added to nbgrader's feedback pages: output lines (the verdicts) wrap at the page's width.
+WRAP_STYLE = ("<style id='autograder-wrap'>div.output_area pre, div.output_subarea pre "
+              "{white-space: pre-wrap; overflow-wrap: anywhere;}</style>")
 
-def write_feedback(course_dir, assignment: str | None = None) -> list[Path]:
+
+def write_feedback(course_dir, assignment: str | None = None, student: str | None = None) -> list[Path]:
+    """Write the feedback of one assignment's, one student's or every graded submission; return the
+    index pages written."""
     course = Path(course_dir).resolve()
-    states = sorted((course / "autograder").glob(f"*/{assignment or '*'}/{grading.STATE_FILE}"))
-    results = [json.loads(p.read_text()) for p in states]
-    for name in sorted({r["assignment"] for r in results if r["status"] != "failed"}):
-        grading.run_nbgrader(["generate_feedback", name, "--force"], course)
+    chosen = grading.recorded_results(course, assignment, student)
+    for name in sorted({r.assignment for r in chosen if r.status != "failed"}):
+        grading.run_nbgrader(["generate_feedback", name, "--force", *(["--student", student] if student else [])],
+                             course)
+    for r in chosen:
+        for page in (course / "feedback" / r.student / r.assignment).glob("*.html"):
+            _wrap_lines(page)
     pages = []
-    by_student: dict[str, list[dict]] = {}
-    for result in results:
-        by_student.setdefault(result["student"], []).append(result)
-    for student, items in sorted(by_student.items()):
-        folder = course / "feedback" / student
-        folder.mkdir(parents=True, exist_ok=True)
-        rows = []
-        for r in sorted(items, key=lambda r: r["assignment"]):
-            links = " ".join(f"<a href='{html.escape(p.relative_to(folder).as_posix())}'>{html.escape(p.stem)}</a>"
-                             for p in sorted((folder / r["assignment"]).glob("*.html")))
-            checks = "".join(f"<li>{html.escape(c['cell'])}: {c['auto_score'] or 0:g} / {c['max_score']:g}</li>"
-                             for c in r["cells"])
-            reason = f"<pre>{html.escape(r['reason'].strip())}</pre>" if r["reason"].strip() else ""
-            rows.append(f"<tr><td>{html.escape(r['assignment'])}</td><td>{r['score']:g} / {r['max_score']:g}</td>"
-                        f"<td><ul>{checks}</ul>{reason}</td><td>{links or '(no notebook feedback)'}</td></tr>")
-        page = folder / "index.html"
-        page.write_text(
-            "<!doctype html><meta charset='utf-8'><title>Feedback for " + html.escape(student) + "</title>"
-            "<style>body{font-family:sans-serif}td{vertical-align:top;padding:4px 8px;border-top:1px solid #ccc}"
-            "pre{white-space:pre-wrap;max-width:60em}</style>"
-            f"<h1>Feedback for {html.escape(student)}</h1><table><tr><th>Assignment</th><th>Score</th>"
-            "<th>Checks</th><th>Notebooks</th></tr>" + "".join(rows) + "</table>"
-            "<p>Each check in the notebook pages shows its seed: grading again with AUTOGRADER_SEED=&lt;seed&gt; "
-            "reproduces the frames it used.</p>")
-        pages.append(page)
+    for name in sorted({r.student for r in chosen}):
+        # Every assignment of the student, not only this run's: the index lists them all.
+        pages.append(_write_index(course, name, grading.recorded_results(course, student=name)))
     return pages
+
+
+def _wrap_lines(page: Path) -> None:
+    text = page.read_text()
+    if "id='autograder-wrap'" not in text and "</head>" in text:
+        page.write_text(text.replace("</head>", WRAP_STYLE + "</head>", 1))
+
+
+def _write_index(course: Path, student: str, results: list) -> Path:
+    from autograder import gradebook
+
+    folder = course / "feedback" / student
+    folder.mkdir(parents=True, exist_ok=True)
+    rows = []
+    for r in results:
+        links = " ".join(f"<a href='{html.escape(p.relative_to(folder).as_posix())}'>{html.escape(p.stem)}</a>"
+                         for p in sorted((folder / r.assignment).glob("*.html")))
+        checks = "".join(f"<li>{html.escape(c['cell'])}: {c['auto_score'] or 0:g} / {c['max_score']:g}</li>"
+                         for c in r.cells)
+        reason = f"<pre>{html.escape(r.reason.strip())}</pre>" if r.reason.strip() else ""
+        rows.append(f"<tr><td>{html.escape(r.assignment)}</td><td>{_score(gradebook.lateness(course, student, r.assignment), r)}</td>"
+                    f"<td><ul>{checks}</ul>{reason}</td><td>{links or '(no notebook feedback)'}</td></tr>")
+    page = folder / "index.html"
+    page.write_text(
+        "<!doctype html><meta charset='utf-8'><title>Feedback for " + html.escape(student) + "</title>"
+        "<style>body{font-family:sans-serif}td{vertical-align:top;padding:4px 8px;border-top:1px solid #ccc}"
+        "pre{white-space:pre-wrap;overflow-wrap:anywhere;max-width:60em}</style>"
+        f"<h1>Feedback for {html.escape(student)}</h1><table><tr><th>Assignment</th><th>Score</th>"
+        "<th>Checks</th><th>Notebooks</th></tr>" + "".join(rows) + "</table>"
+        "<p>Each check in the notebook pages shows its seed: grading again with AUTOGRADER_SEED=&lt;seed&gt; "
+        "reproduces the frames it used.</p>")
+    return page
+
+
+def _score(late: dict | None, result) -> str:
+    """The score cell: the final score, and when there is a due date, the submission time and the penalty."""
+    if late is None:
+        return f"{result.score:g} / {result.max_score:g}"
+    text = f"{late['score']:g} / {late['max_score']:g}"
+    if late["duedate"] is not None:
+        text += f"<br><small>due {late['duedate']:%Y-%m-%d %H:%M} UTC"
+        if late["timestamp"] is not None:
+            text += f", submitted {late['timestamp']:%Y-%m-%d %H:%M} UTC"
+        if late["seconds_late"] > 0:
+            text += (f"<br>late by {_duration(late['seconds_late'])}: {late['raw_score']:g} points "
+                     f"− late penalty {late['penalty']:g}")
+        text += "</small>"
+    return text
+
+
+def _duration(seconds: float) -> str:
+    days, rest = divmod(int(seconds), 86400)
+    hours, rest = divmod(rest, 3600)
+    return f"{days} d {hours} h {rest // 60} min" if days else f"{hours} h {rest // 60} min"

@@ -1,4 +1,4 @@
-"""Release, parallel sandboxed autograding with nbgrader, grades.csv.
+"""Release, parallel sandboxed autograding with nbgrader, the grading report.
 
 One submission is graded like this (:func:`grade_submission`, run by a worker thread):
 
@@ -21,20 +21,25 @@ One submission is graded like this (:func:`grade_submission`, run by a worker th
    Their points replace nbgrader's scores of those cells, and their verdicts (seed, what passed
    and failed, pictures) replace the cells' outputs in the autograded notebook.
 5. The trusted grader reads the other cells' scores from the private gradebook, copies the
-   autograded notebook to COURSE_DIR/autograded/, and records the scores in the course
-   gradebook with nbgrader's Gradebook API.
+   autograded notebook to COURSE_DIR/autograded/ (without the grader's temporary paths), and
+   records the scores in the course gradebook as nbgrader's autograde would (autograder.gradebook:
+   graded cells are not "needs manual grading", the submission time and late penalty are kept).
+
+A submission whose notebook is not named as released, or whose timestamp.txt holds no date, is
+not run at all: it gets 0 and a reason that says so (autograder.intake). After a run, the grading
+report (autograder.report) and the LMS export grades.csv (autograder.export) are written again
+from everything graded so far, so a partial run (one student, one assignment) drops no row.
 
 Not root: steps 2-4 fall back to ``unshare --user --map-root-user --net --mount`` when
 unprivileged user namespaces are allowed (network and mounts isolated, but one uid for all
 workers: RLIMIT_NPROC is then shared by the workers, and the student's processes run as the
 same user as the checks, which a determined student could tamper with), else to no
-namespaces at all (no network isolation; the run says so on stderr and in grades.csv's
+namespaces at all (no network isolation; the run says so on stderr and in the grading report's
 ``isolation`` column).
 """
 
 from __future__ import annotations
 
-import csv
 import dataclasses
 import hashlib
 import json
@@ -48,7 +53,7 @@ import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
-from autograder import config, kernel
+from autograder import config, gradebook, intake, kernel
 from course_lib.checks import harness
 
 REPO = Path(__file__).resolve().parent.parent
@@ -70,9 +75,7 @@ def _env_for_tools() -> dict:
     env = dict(os.environ)
     path = [str(REPO)] + [p for p in env.get("PYTHONPATH", "").split(os.pathsep) if p and p != str(REPO)]
     env["PYTHONPATH"] = os.pathsep.join(path)
-    # nbgrader runs `alembic` (gradebook migrations) from PATH: use this environment's.
-    bindir = str(Path(sys.executable).parent)
-    env["PATH"] = os.pathsep.join([bindir] + [p for p in env.get("PATH", "").split(os.pathsep) if p != bindir])
+    env["PATH"] = gradebook.with_this_python(env.get("PATH", ""))
     return env
 
 
@@ -103,15 +106,20 @@ def prepare_course(course_dir) -> Path:
     return course
 
 
-def release(course_dir, assignments: list[str] | None = None) -> list[Path]:
+def release(course_dir, assignments: list[str] | None = None, duedate: str | None = None) -> list[Path]:
     """Write the student versions to COURSE_DIR/release/<assignment>/ (nbgrader generate_assignment).
 
-    This also records each assignment, its cells and its hidden tests in the gradebook.
+    This also records each assignment, its cells and its hidden tests in the gradebook, and the
+    due date when one is given (autograder.late.set_duedate; kept when released again without one).
     """
+    from autograder import late
+
     course = prepare_course(course_dir)
     written = []
     for name in assignments or assignments_in(course):
         run_nbgrader(["generate_assignment", name, "--force"], course)
+        if duedate:
+            late.set_duedate(course, name, duedate)
         written.append(course / "release" / name)
     return written
 
@@ -131,16 +139,19 @@ class Submission:
         return f"{self.student}/{self.assignment}"
 
 
-def find_submissions(course: Path, assignment: str | None = None) -> list[Submission]:
-    """COURSE_DIR/submitted/<student>/<assignment>/ holding at least one notebook, sorted."""
+def find_submissions(course: Path, assignment: str | None = None, student: str | None = None) -> list[Submission]:
+    """COURSE_DIR/submitted/<student>/<assignment>/ holding at least one notebook, sorted (only one
+    assignment's, one student's, when given)."""
     found = []
     submitted = course / "submitted"
     if not submitted.is_dir():
         return found
-    for student in sorted(p for p in submitted.iterdir() if p.is_dir()):
-        for folder in sorted(p for p in student.iterdir() if p.is_dir()):
+    for folder_of_student in sorted(p for p in submitted.iterdir() if p.is_dir()):
+        if student is not None and folder_of_student.name != student:
+            continue
+        for folder in sorted(p for p in folder_of_student.iterdir() if p.is_dir()):
             if (assignment is None or folder.name == assignment) and any(folder.glob("*.ipynb")):
-                found.append(Submission(student.name, folder.name, folder))
+                found.append(Submission(folder_of_student.name, folder.name, folder))
     return found
 
 
@@ -287,17 +298,23 @@ class GradeResult:
     max_score: float = 0.0
     cells: list[dict] = dataclasses.field(default_factory=list)
     status: str = "graded"       # graded | failed (the notebook could not be run to the end)
-    reason: str = ""
+    reason: str = ""             # for the student (the feedback shows it)
+    detail: str = ""             # for the instructor only (the fix, nbgrader's log): the grading report
     seconds: float = 0.0
     isolation: str = ""
     from_cache: bool = False     # True: an earlier run's result (the submission did not change)
     kernel_uid: int | None = None  # the uid the student's code ran as (root isolation only)
 
+    @classmethod
+    def from_dict(cls, data: dict) -> "GradeResult":
+        """A result as recorded (autograder.json), also one written by an older grader."""
+        names = {field.name for field in dataclasses.fields(cls)}
+        return cls(**{key: value for key, value in data.items() if key in names})
 
-def _cell_scores(gradebook: Path, sub: Submission) -> list[dict]:
-    from nbgrader.api import Gradebook
 
-    with Gradebook(f"sqlite:///{gradebook}") as gb:
+def _cell_scores(root: Path, sub: Submission) -> list[dict]:
+    """The scores nbgrader gave the submission's cells in the gradebook of the course root `root`."""
+    with gradebook.open_gradebook(root) as gb:
         submission = gb.find_submission(sub.assignment, sub.student)
         cells = []
         for notebook in submission.notebooks:
@@ -314,6 +331,13 @@ def grade_submission(sub: Submission, course: Path, domain_id: int) -> GradeResu
 
     started = time.monotonic()
     result = GradeResult(sub.student, sub.assignment, submission_digest(sub, course), isolation=isolation())
+    problem = intake.check(course, sub.student, sub.assignment, sub.path)
+    if problem is not None:  # nothing to run: say why and how to fix it
+        result.status, result.reason, result.detail = "failed", problem.reason, problem.fix
+        _keep_autograded(course, sub, None)
+        _keep_log(course, sub, problem.fix + "\n")
+        result.seconds = round(time.monotonic() - started, 1)
+        return result
     work = Path(tempfile.mkdtemp(prefix="autograder-work-"))
     try:
         os.chmod(work, 0o711)
@@ -357,7 +381,7 @@ def grade_submission(sub: Submission, course: Path, domain_id: int) -> GradeResu
         log = proc.log
         autograded = root / "autograded" / sub.student / sub.assignment
         try:
-            result.cells = _cell_scores(root / "gradebook.db", sub)
+            result.cells = _cell_scores(root, sub)
         except Exception as error:  # no submission in the gradebook: nbgrader did not get that far
             result.cells = []
             result.status = "failed"
@@ -366,25 +390,19 @@ def grade_submission(sub: Submission, course: Path, domain_id: int) -> GradeResu
             result.status = "failed"
             result.reason = f"nbgrader autograde ended with {proc.describe_exit()}"
         if result.status == "failed":
-            result.reason = _explain_failure(log, proc) + "\n" + result.reason + "\n" + \
-                "\n".join(log.strip().splitlines()[-15:])
+            # The student reads the first line; nbgrader's log is for the instructor.
+            result.detail = result.reason.strip() + "\n" + "\n".join(log.strip().splitlines()[-15:])
+            result.reason = _explain_failure(log, proc)
         if result.status != "failed":
             # As root the kernel ran in a subfolder of its own uid (autograder.kernel), where the
             # notebook wrote the student's module.
             workdir = autograded / kernel.WORK_SUBDIR if result.kernel_uid is not None else autograded
             _grade_outside(sub, result, work, autograded, workdir, domain_id, env, hide)
+            _scrub_paths(autograded, work)
         if any(c["auto_score"] is None for c in result.cells):
-            result.reason += " (some cells need manual grading)"
-        target = course / "autograded" / sub.student / sub.assignment
-        if target.exists():
-            shutil.rmtree(target)
-        if autograded.is_dir() and result.status != "failed":
-            shutil.copytree(autograded, target, symlinks=True,
-                            ignore=shutil.ignore_patterns("__pycache__", ".autograder-*"))
-        else:
-            target.mkdir(parents=True, exist_ok=True)
-        state_dir(course, sub.student, sub.assignment).mkdir(parents=True, exist_ok=True)
-        (state_dir(course, sub.student, sub.assignment) / "autograder.log").write_text(log[-200000:])
+            result.detail += "\nSome cells need manual grading (the formgrader lists them)."
+        _keep_autograded(course, sub, autograded if result.status != "failed" else None)
+        _keep_log(course, sub, log)
     finally:
         _remove_tree(work)
     result.score = round(sum(c["auto_score"] or 0 for c in result.cells), 3) if result.status != "failed" else 0.0
@@ -433,6 +451,38 @@ def _grade_outside(sub: Submission, result: GradeResult, work: Path, autograded:
     _write_verdicts(autograded, verdicts)
 
 
+def _keep_autograded(course: Path, sub: Submission, autograded: Path | None) -> None:
+    """Replace COURSE_DIR/autograded/<student>/<assignment>/ by the graded copy (None: an empty
+    folder, so that the formgrader lists the submission as autograded, with its score 0)."""
+    target = course / "autograded" / sub.student / sub.assignment
+    if target.exists():
+        shutil.rmtree(target)
+    if autograded is not None and autograded.is_dir():
+        shutil.copytree(autograded, target, symlinks=True, ignore=shutil.ignore_patterns("__pycache__", ".autograder-*"))
+    else:
+        target.mkdir(parents=True, exist_ok=True)
+
+
+def _keep_log(course: Path, sub: Submission, log: str) -> None:
+    folder = state_dir(course, sub.student, sub.assignment)
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / "autograder.log").write_text(log[-200000:])
+
+
+def _scrub_paths(folder: Path, work: Path) -> None:
+    """Remove the grader's folders from the notebooks in `folder`: a traceback of the student's
+    module names it as pubsub_nodes.py, not /tmp/autograder-work-.../.autograder-cwd/pubsub_nodes.py,
+    and the grader's own files by their place in the repository (autograder/student.py)."""
+    prefixes = [f"{folder / kernel.WORK_SUBDIR}{os.sep}", f"{folder}{os.sep}", f"{REPO}{os.sep}"]
+    for path in sorted(folder.glob("*.ipynb")):
+        text = original = path.read_text()
+        for prefix in prefixes:
+            text = text.replace(prefix, "")
+        text = text.replace(str(work), "<grader's work folder>")
+        if text != original:
+            path.write_text(text)
+
+
 def _check_of(grade_id: str) -> str | None:
     """The check a graded cell runs: grade id "check_<name>" (assignments/build.py names them so)."""
     return grade_id.removeprefix("check_") if grade_id.startswith("check_") else None
@@ -457,7 +507,7 @@ def _write_verdicts(folder: Path, verdicts: dict) -> None:
 
 
 def _explain_failure(log: str, proc) -> str:
-    """The first line of a failed submission's reason, in the student's terms."""
+    """A failed submission's reason, in the student's terms."""
     if "Kernel died" in log or "DeadKernelError" in log:
         return ("The notebook's Python kernel died while running your code (a crash such as a segfault, "
                 "os._exit() or sys.exit() at the top level, or being killed for using too much memory): "
@@ -465,7 +515,8 @@ def _explain_failure(log: str, proc) -> str:
     if proc.exit_reason == "wall_seconds":
         return (f"The notebook did not finish within {NOTEBOOK_TIMEOUT:g} s: something in it runs forever "
                 "or waits for input.")
-    return f"nbgrader could not grade the notebook ({proc.describe_exit()})."
+    return (f"The grader could not run your notebook to its end ({proc.describe_exit()}); your instructor has "
+            "the details.")
 
 
 def _remove_tree(path: Path) -> None:
@@ -479,7 +530,7 @@ def _remove_tree(path: Path) -> None:
 
 
 # ---------------------------------------------------------------------------------------------
-# The course gradebook and grades.csv
+# The course gradebook and the recorded results
 # ---------------------------------------------------------------------------------------------
 
 STATE_FILE = "autograder.json"
@@ -491,58 +542,53 @@ def state_dir(course: Path, student: str, assignment: str) -> Path:
     return Path(course) / "autograder" / student / assignment
 
 
-def _store(course: Path, result: GradeResult) -> None:
-    """Record a result in the course gradebook (nbgrader's Gradebook API) and beside the notebook."""
-    from nbgrader.api import Gradebook, MissingEntry
-
-    with Gradebook(f"sqlite:///{course / 'gradebook.db'}") as gb:
-        gb.update_or_create_student(result.student)
-        try:
-            gb.remove_submission(result.assignment, result.student)
-        except MissingEntry:
-            pass
-        gb.add_submission(result.assignment, result.student)
-        max_score = 0.0
-        for notebook in gb.find_assignment(result.assignment).notebooks:
-            for cell in notebook.grade_cells:
-                grade = gb.find_grade(cell.name, notebook.name, result.assignment, result.student)
-                found = [c for c in result.cells if c["cell"] == cell.name and c["notebook"] == notebook.name]
-                grade.auto_score = (found[0]["auto_score"] if found and result.status != "failed" else 0.0)
-                max_score += cell.max_score
-        gb.db.commit()
-    result.max_score = max_score
+def _store(course: Path, result: GradeResult, course_config) -> None:
+    """Record a result in the course gradebook (autograder.gradebook) and beside the notebook."""
+    _record(course, result, course_config)
     target = state_dir(course, result.student, result.assignment)
     target.mkdir(parents=True, exist_ok=True)
     (target / STATE_FILE).write_text(json.dumps(dataclasses.asdict(result), indent=1))
 
 
+def _record(course: Path, result: GradeResult, course_config) -> None:
+    """The result's scores, the submission time and the late penalty, in the course gradebook (a
+    result from an earlier run: the time and penalty only, when the gradebook has its scores)."""
+    scores = {} if result.status == "failed" else {(c["notebook"], c["cell"]): c["auto_score"] for c in result.cells}
+    try:
+        timestamp = gradebook.submitted_timestamp(course / "submitted" / result.student / result.assignment)
+    except ValueError:  # intake.check failed the submission for it, with the fix
+        timestamp = None
+    result.max_score = gradebook.record(course, result.student, result.assignment, scores, timestamp, course_config,
+                                        earlier=result.from_cache)
+
+
 def _cached(course: Path, sub: Submission) -> GradeResult | None:
     path = state_dir(course, sub.student, sub.assignment) / STATE_FILE
     try:
-        data = json.loads(path.read_text())
-        if data["digest"] == submission_digest(sub, course):
-            data["from_cache"] = True
-            return GradeResult(**data)
+        result = GradeResult.from_dict(json.loads(path.read_text()))
+        if result.digest == submission_digest(sub, course):
+            result.from_cache = True
+            return result
     except (OSError, ValueError, KeyError, TypeError):
         pass
     return None
 
 
-CSV_FIELDS = ["student_id", "assignment", "score", "max_score", "status", "from_cache", "seconds", "isolation",
-              "reason"]
+def recorded_results(course, assignment: str | None = None, student: str | None = None) -> list[GradeResult]:
+    """Every result recorded so far (COURSE_DIR/autograder/<student>/<assignment>/autograder.json),
+    or one assignment's, one student's; sorted by student and assignment."""
+    import glob
 
-
-def write_csv(course: Path, results: list[GradeResult]) -> Path:
-    """COURSE_DIR/grades.csv: one row per graded submission (all submissions on disk, cached or not)."""
-    path = course / "grades.csv"
-    rows = sorted(results, key=lambda r: (r.student, r.assignment))
-    with open(path, "w", newline="") as handle:
-        writer = csv.writer(handle)
-        writer.writerow(CSV_FIELDS)
-        for r in rows:
-            writer.writerow([r.student, r.assignment, f"{r.score:g}", f"{r.max_score:g}", r.status, int(r.from_cache),
-                             f"{r.seconds:g}", r.isolation, r.reason.strip().splitlines()[0] if r.reason.strip() else ""])
-    return path
+    pattern = f"{glob.escape(student) if student else '*'}/{glob.escape(assignment) if assignment else '*'}/{STATE_FILE}"
+    results = []
+    for path in sorted((Path(course) / "autograder").glob(pattern)):
+        try:
+            results.append(GradeResult.from_dict(json.loads(path.read_text())))
+        except (OSError, ValueError, TypeError) as error:
+            raise ValueError(f"{path} cannot be read ({error}): delete it and grade that submission again "
+                             f"(python -m autograder grade COURSE_DIR --student {path.parent.parent.name} "
+                             f"--assignment {path.parent.name} --force)") from None
+    return results
 
 
 class _Progress:
@@ -563,21 +609,29 @@ class _Progress:
 
 
 def grade(course_dir, assignment: str | None = None, workers: int = 1, force: bool = False,
-          progress: bool = True) -> list[GradeResult]:
-    """Autograde every submission (or those of one assignment) and write grades.csv.
+          progress: bool = True, student: str | None = None) -> list[GradeResult]:
+    """Autograde every submission (or one assignment's, one student's), then write the grading
+    report and grades.csv again from everything graded so far.
 
-    Unchanged submissions that were graded before are not graded again unless force=True.
-    Returns the results of all submissions found, in (student, assignment) order.
+    Unchanged submissions that were graded before are not graded again unless force=True; their
+    recorded scores go into the gradebook again with the late penalty of today's due dates.
+    Returns the results of the submissions found, in (student, assignment) order.
     """
     from course_lib import rosenv
 
+    from autograder import export, late, report
+
     course = prepare_course(course_dir)
-    subs = find_submissions(course, assignment)
+    course_config = config.load(course)
+    late.check_settings(course_config, assignments_in(course))
+    subs = find_submissions(course, assignment, student)
+    if not subs and (assignment or student):
+        raise ValueError(f"No submission in {course / 'submitted'} matches --student {student or '(any)'} "
+                         f"--assignment {assignment or '(any)'}; the submissions there: "
+                         f"{', '.join(s.key for s in find_submissions(course)) or 'none'}")
     known = set()
     if (course / "gradebook.db").exists():
-        from nbgrader.api import Gradebook
-
-        with Gradebook(f"sqlite:///{course / 'gradebook.db'}") as gb:
+        with gradebook.open_gradebook(course) as gb:
             known = {a.name for a in gb.assignments}
     missing = sorted({s.assignment for s in subs} - known)
     if missing:
@@ -587,6 +641,7 @@ def grade(course_dir, assignment: str | None = None, workers: int = 1, force: bo
     for sub in subs:
         cached = None if force else _cached(course, sub)
         if cached is not None:
+            _record(course, cached, course_config)
             results[sub.key] = cached
         else:
             todo.append(sub)
@@ -597,7 +652,7 @@ def grade(course_dir, assignment: str | None = None, workers: int = 1, force: bo
         with rosenv.reserve_domain_id() as reservation:
             result = grade_submission(sub, course, reservation.domain_id)
         with store_lock:
-            _store(course, result)
+            _store(course, result, course_config)
         if bar:
             bar.update(result)
         return result
@@ -606,5 +661,6 @@ def grade(course_dir, assignment: str | None = None, workers: int = 1, force: bo
         for sub, result in zip(todo, pool.map(work, todo)):
             results[sub.key] = result
     ordered = [results[s.key] for s in subs]
-    write_csv(course, ordered)
+    report.write_report(course, ordered)
+    export.export(course)
     return ordered

@@ -8,7 +8,7 @@ real nbgrader CLI: once with one worker and once (everything graded again) with 
     .venv/bin/python benchmarks/bench_grading.py [--students 2] [--workers 2]
 
 Per assignment it prints the mean seconds per submission (nbgrader's notebook run plus the
-grader's own run of the hidden checks, as grades.csv reports them); then the wall time of each
+grader's own run of the hidden checks, as the grading report gives them); then the wall time of each
 run and the ratio, which is the speed-up of the extra workers on this machine.
 """
 

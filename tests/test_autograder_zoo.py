@@ -116,11 +116,11 @@ def test_submitted_files_are_byte_identical(graded):
     assert _hashes(graded["course"] / "submitted") == graded["before"]
 
 
-def test_grades_csv_lists_every_submission(graded):
-    """grades.csv has one row per submission with student_id, assignment, score and max_score."""
+def test_grading_report_lists_every_submission(graded):
+    """grading_report.csv has one row per submission with student_id, assignment, score and max_score."""
     import csv
 
-    with open(graded["course"] / "grades.csv") as handle:
+    with open(graded["course"] / "grading_report.csv") as handle:
         rows = list(csv.DictReader(handle))
     assert {r["student_id"] for r in rows} == set(graded["entries"])
     assert all(r["assignment"] == "brightness" and r["max_score"] == "11" for r in rows)

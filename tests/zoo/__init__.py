@@ -29,8 +29,8 @@ def filled_notebook(course: Path, assignment: str) -> nbformat.NotebookNode:
     return release
 
 
-def submit(course: Path, student: str, assignment: str, edits=()) -> Path:
-    """Write a zoo submission; each edit is (old, new) applied to the module cell, or a function nb -> None."""
+def edited_notebook(course: Path, assignment: str, edits=(), student: str = "") -> nbformat.NotebookNode:
+    """The filled notebook with `edits`: each (old, new) applied to the module cell, or a function nb -> None."""
     nb = filled_notebook(course, assignment)
     for edit in edits:
         if callable(edit):
@@ -41,6 +41,12 @@ def submit(course: Path, student: str, assignment: str, edits=()) -> Path:
         if old not in cell.source:
             raise ValueError(f"zoo edit for {student}: {old!r} is not in the reference module")
         cell.source = cell.source.replace(old, new, 1)
+    return nb
+
+
+def submit(course: Path, student: str, assignment: str, edits=()) -> Path:
+    """Write a zoo submission (see edited_notebook) where nbgrader's collect step puts it."""
+    nb = edited_notebook(course, assignment, edits, student)
     target = Path(course) / "submitted" / student / assignment / f"{assignment}.ipynb"
     target.parent.mkdir(parents=True, exist_ok=True)
     nbformat.write(nb, target)

@@ -1,0 +1,77 @@
+"""Submissions from an LMS download (a zip with Blackboard's file names) into submitted/, with
+the submission time kept in timestamp.txt; what nbgrader would not grade is reported at once."""
+
+from __future__ import annotations
+
+import datetime
+import zipfile
+
+import pytest
+from traitlets.config import Config
+
+from autograder import collect, config, grading, roster
+
+
+@pytest.mark.parametrize("zone, hour", [("UTC", 9), ("Europe/Berlin", 8)])
+def test_times_in_file_names_are_read_in_the_lms_time_zone(zone, hour):
+    """'2025-03-16-09-30-00' is 09:30 (nbgrader's parser reads 09:00), kept as naive UTC."""
+    settings = Config()
+    settings.LmsFileNames.timezone = zone
+    info = collect.LmsFileNames(config=settings).collect(
+        "/downloads/x_y/pubsub/extracted/pubsub_bob_attempt_2025-03-16-09-30-00_pubsub (1).ipynb")
+    assert info["student_id"] == "bob" and info["file_id"] == "pubsub (1).ipynb"
+    assert info["timestamp"] == datetime.datetime(2025, 3, 16, hour, 30)
+
+
+def test_other_files_and_names_are_skipped():
+    """Blackboard's receipts (.txt) and names without an attempt are not collected."""
+    plugin = collect.LmsFileNames()
+    assert plugin.collect("/d/pubsub_bob_attempt_2025-03-16-09-30-00.txt") is None
+    assert plugin.collect("/d/pubsub.ipynb") is None
+
+
+@pytest.fixture(scope="module")
+def course(tmp_path_factory):
+    root = tmp_path_factory.mktemp("course")
+    grading.release(root, ["pubsub"])
+    (root / "roster.csv").write_text("id\nalice\ncarol\n")
+    roster.import_roster(root, root / "roster.csv")
+    return root
+
+
+def _download(course, folder, names: list[str]):
+    path = folder / "gradebook_pubsub.zip"
+    notebook = (course / "release" / "pubsub" / "pubsub.ipynb").read_bytes()
+    with zipfile.ZipFile(path, "w") as archive:
+        for name in names:
+            archive.writestr(name, notebook)
+    return path
+
+
+def test_collect_puts_each_attempt_in_submitted_with_its_time(course, tmp_path):
+    """alice's two attempts: the later one is kept with its time; carol's renamed notebook and
+    dave (not in the roster) are reported with what to do."""
+    zip_path = _download(course, tmp_path, [
+        "pubsub_alice_attempt_2025-03-14-20-15-00_pubsub.ipynb",
+        "pubsub_alice_attempt_2025-03-15-08-00-00_pubsub.ipynb",
+        "pubsub_carol_attempt_2025-03-14-21-00-00_pubsub (1).ipynb",
+        "pubsub_dave_attempt_2025-03-14-22-00-00_pubsub.ipynb",
+    ])
+    lines = collect.collect(course, "pubsub", [zip_path])
+    assert (course / "submitted" / "alice" / "pubsub" / "timestamp.txt").read_text() == "2025-03-15 08:00:00"
+    assert (course / "submitted" / "alice" / "pubsub" / "pubsub.ipynb").is_file()
+    assert "alice: pubsub.ipynb (submitted 2025-03-15 08:00:00 UTC)" in lines
+    text = "\n".join(lines)
+    assert "'pubsub (1).ipynb', not 'pubsub.ipynb'" in text and "mv " in text
+    assert "dave is not in the roster" in text
+
+
+def test_collect_without_a_release_or_matching_names_says_what_to_do(course, tmp_path):
+    """An assignment not released, and a download whose names match nothing, give the fix."""
+    with pytest.raises(ValueError, match="has not been released.*python -m autograder release"):
+        collect.collect(course, "brightness", [tmp_path / "x.zip"])
+    zip_path = _download(course, tmp_path, ["alice-pubsub.ipynb"])
+    with pytest.raises(ValueError, match="do not match"):
+        collect.collect(course, "pubsub", [zip_path])
+    with pytest.raises(FileNotFoundError, match="does not exist"):
+        collect.collect(course, "pubsub", [tmp_path / "missing.zip"])

@@ -1,0 +1,39 @@
+"""The course's nbgrader_config.py: the autograder rewrites its header and keeps the instructor's
+settings below the marker; a file it did not write is not overwritten."""
+
+from __future__ import annotations
+
+import pytest
+
+from autograder import config
+
+
+def test_new_file_has_the_header_and_commented_examples(tmp_path):
+    text = config.write_config(tmp_path).read_text()
+    assert text.startswith(config.CONFIG_HEADER) and "# c.LatePenalty.per_day" in text
+
+
+def test_instructors_settings_are_kept_and_read(tmp_path):
+    """Settings added below the marker survive a rewrite and reach the loaded configuration."""
+    path = config.write_config(tmp_path)
+    path.write_text(path.read_text().replace(config.CONFIG_HEADER, "# an older header\n" + config.MARKER + "\n")
+                    + "c.LatePenalty.per_day = {'pubsub': 0.1}\n")
+    config.write_config(tmp_path)
+    assert path.read_text().startswith(config.CONFIG_HEADER)
+    loaded = config.load(tmp_path)
+    assert loaded.LatePenalty.per_day == {"pubsub": 0.1}
+    assert loaded.CourseDirectory.root == str(tmp_path.resolve())
+
+
+def test_file_of_an_earlier_version_is_replaced(tmp_path):
+    (tmp_path / "nbgrader_config.py").write_text(config._OLD_TEMPLATE)
+    assert config.MARKER in config.write_config(tmp_path).read_text()
+
+
+def test_file_not_written_by_the_autograder_is_left_alone(tmp_path):
+    """A hand-written nbgrader_config.py stops the command with the way out, and is unchanged."""
+    path = tmp_path / "nbgrader_config.py"
+    path.write_text("c = get_config()\nc.CourseDirectory.course_id = 'mine'\n")
+    with pytest.raises(ValueError, match="not written by the autograder.*copy your settings below the line"):
+        config.write_config(tmp_path)
+    assert "course_id = 'mine'" in path.read_text()
