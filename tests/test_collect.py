@@ -9,7 +9,7 @@ import zipfile
 import pytest
 from traitlets.config import Config
 
-from autograder import collect, config, grading, roster
+from autograder import collect, grading, roster
 
 
 @pytest.mark.parametrize("zone, hour", [("UTC", 9), ("Europe/Berlin", 8)])
