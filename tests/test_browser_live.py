@@ -37,7 +37,10 @@ def test_live_image_view_picture_changes_while_the_camera_runs(browser, tmp_path
         page = open_notebook(browser, lab, "live_view.ipynb")
         try:
             run = run_notebook(page, "live_view.ipynb", code_cell_count(root / "live_view.ipynb"), 240)
-            assert not run.problems(), run.problems()
+            # The live picture is replaced about ten times a second, so the generic check may catch
+            # it between two frames (a new source not yet decoded); the waits below check it instead.
+            problems = [p for p in run.problems() if p != "image does not render in cell 1"]
+            assert not problems, problems
             picture = page.locator(PICTURE)
             page.wait_for_function(f"""() => {{ const img = document.querySelector('{PICTURE}');
                                        return img && img.complete && img.naturalWidth === {CAMERA_SIZE[0]}; }}""",
