@@ -17,6 +17,21 @@ os.environ.pop("ROS_LOCALHOST_ONLY", None)
 os.environ["COURSE_LIB_UNDER_TEST"] = "1"
 
 
+@pytest.fixture(scope="module")
+def session_domain():
+    """A ROS domain reserved for one test module, with the notebook session (course_lib.session,
+    which graph's tool node uses) started on it and stopped at the end."""
+    from course_lib import session
+
+    with rosenv.reserve_domain_id() as reservation:
+        session.stop()
+        session.start(domain_id=reservation.domain_id)
+        try:
+            yield reservation.domain_id
+        finally:
+            session.stop()
+
+
 @pytest.fixture
 def domain_id():
     """A ROS domain id reserved for one test, for tests that need traffic nobody else sees."""

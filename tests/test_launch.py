@@ -98,15 +98,9 @@ def prefix(tmp_path_factory):
 
 
 @pytest.fixture(scope="module")
-def ros_domain():
+def ros_domain(session_domain):
     """A domain of its own for this module, with the session (graph's tool node) on it."""
-    with rosenv.reserve_domain_id() as reservation:
-        session.stop()
-        session.start(domain_id=reservation.domain_id)
-        try:
-            yield reservation.domain_id
-        finally:
-            session.stop()
+    return session_domain
 
 
 def processes_below(path) -> list[psutil.Process]:

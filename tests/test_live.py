@@ -43,23 +43,19 @@ class Numbers(Node):
 
 
 @pytest.fixture(scope="module")
-def ros():
+def ros(session_domain):
     """The session on a reserved domain, the Numbers node in it and a camera process; yields the camera."""
-    with rosenv.reserve_domain_id() as reservation:
-        session.stop()
-        session.start(domain_id=reservation.domain_id)
-        try:
-            session.add_node(Numbers())
-            width, height = CAMERA_SIZE
-            with processes.python_node("course_lib.camera:main", "--ros-args", "-p", f"width:={width}", "-p",
-                                       f"height:={height}", "-p", "rate:=15.0", name="live-test-camera",
-                                       domain_id=reservation.domain_id) as camera:
-                camera.wait_for_node("image_publisher", timeout=60)
-                graph.topic_list(wait_for=["/image", "/level", "/pose", "/grey"], timeout=20)
-                yield camera
-        finally:
-            live.stop_all()
-            session.stop()
+    try:
+        session.add_node(Numbers())
+        width, height = CAMERA_SIZE
+        with processes.python_node("course_lib.camera:main", "--ros-args", "-p", f"width:={width}", "-p",
+                                   f"height:={height}", "-p", "rate:=15.0", name="live-test-camera",
+                                   domain_id=session_domain) as camera:
+            camera.wait_for_node("image_publisher", timeout=60)
+            graph.topic_list(wait_for=["/image", "/level", "/pose", "/grey"], timeout=20)
+            yield camera
+    finally:
+        live.stop_all()
 
 
 def watch(widget) -> list:
