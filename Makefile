@@ -30,7 +30,10 @@ endif
 
 setup: $(VENV)/.setup-done
 
-$(VENV)/.setup-done: environment.txt pyproject.toml course_lib/wheelfix.py course_lib/ros2cli/install.py
+# jsonschema's optional IRI checker rfc3987-syntax (pulled in by jupyter-events) compiles ~30
+# Lark parsers at import: 2-4 s of CPU in every process that imports nbformat (nbgrader, nbclient,
+# Jupyter, the test workers). Nothing here validates IRIs, so the override leaves it out.
+$(VENV)/.setup-done: Makefile environment.txt pyproject.toml course_lib/wheelfix.py course_lib/ros2cli/install.py
 	@$(PYTHON) -c 'import sys; v = sys.version_info[:2]; ok = (3, 10) <= v <= (3, 13); \
 	print("Using Python %d.%d from %s" % (v + (sys.executable,))) if ok else \
 	sys.exit("Python %d.%d found, but the ROS 2 Jazzy wheels exist for CPython 3.10-3.13 only. " \
@@ -40,7 +43,9 @@ $(VENV)/.setup-done: environment.txt pyproject.toml course_lib/wheelfix.py cours
 	@test -x $(PY) || $(PYTHON) -m venv $(VENV_FLAGS) $(VENV)
 	@test -x $(UV) || $(PY) -m pip install --quiet --disable-pip-version-check uv==$(UV_VERSION)
 	@if [ "$(ROS)" != pip ]; then grep -v -E '^(ros-jazzy-|colcon-)' environment.txt > $(REQUIREMENTS); fi
-	$(UV) pip install --quiet --python $(PY) -r $(REQUIREMENTS) -e .
+	@printf 'rfc3987-syntax ; sys_platform == "never"\n' > $(VENV)/overrides.txt
+	$(UV) pip install --quiet --python $(PY) -r $(REQUIREMENTS) --overrides $(VENV)/overrides.txt -e .
+	@$(UV) pip uninstall --quiet --python $(PY) rfc3987-syntax 2>/dev/null || true  # from a venv made before
 	$(PY) -m course_lib repair-wheels
 	$(PY) -m course_lib install-ros2
 	@touch $@
