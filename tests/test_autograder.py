@@ -87,18 +87,24 @@ def test_brightness_typical_mistake_gets_its_score_and_reason(tmp_path, student)
     """Typical brightness mistakes, run through the checks directly: expected points and reason."""
     entry = _brightness_mistakes()[student]
     workdir = _module_dir(tmp_path, "brightness", entry["edits"])
-    texts = []
+    texts, first_failures = [], []
     for check in ("values", "node"):
         if entry[check] is None:
             continue  # the entry is about the other check
         result = harness.execute("brightness", check, 11, workdir=workdir, mode="graded")
         texts.extend(result.verdict_lines())
+        first_failures.extend([line for line in result.verdict_lines() if line.startswith("  ✘ ")][:1])
         expected = entry[check]
         if isinstance(expected, tuple):
             assert expected[0] - 1e-6 <= result.points <= expected[1] + 1e-6, result.verdict_lines()
         else:
             assert result.points == pytest.approx(expected), result.verdict_lines()
-    assert entry["reason"] in "\n".join(texts)
+    text = "\n".join(texts)
+    assert entry["reason"] in text
+    if "first_failure" in entry:  # the first ✘ of a check's verdict names the cause
+        assert any(entry["first_failure"] in line for line in first_failures), texts
+    for phrase in entry.get("absent", ()):
+        assert phrase not in text, texts
 
 
 CATDOG_MISTAKES = {

@@ -145,9 +145,17 @@ class Result:
     seconds: float = 0.0
 
     def verdict_lines(self) -> list[str]:
+        """The points, then what failed (each cause followed by its consequences), then what passed."""
         lines = [f"{self.name}: {_fmt(self.points)} of {_fmt(self.max_points)} points"]
         for item in self.items:
-            lines.append(("  ✔ " if item["ok"] else "  ✘ ") + item["message"])
+            if not item["ok"] and not item.get("consequence"):
+                lines.append("  ✘ " + item["message"])
+        for item in self.items:
+            if item.get("consequence"):
+                lines.append("    ↳ ✘ " + item["message"])
+        for item in self.items:
+            if item["ok"]:
+                lines.append("  ✔ " + item["message"])
         lines.extend("  · " + note for note in self.notes)
         if self.error:
             lines.append("  ! " + self.error)
@@ -360,6 +368,12 @@ class Context:
         self.items.append({"ok": bool(ok), "message": clip(message), "weight": float(weight)})
         return bool(ok)
 
+    def consequence(self, message: str, weight: float = 1.0) -> bool:
+        """Record a claim that fails because of a failure recorded before it (not a mistake of its
+        own): it loses its weight, and the verdict lists it under the causes, marked ↳."""
+        self.items.append({"ok": False, "message": clip(message), "weight": float(weight), "consequence": True})
+        return False
+
     def precondition(self, ok: bool, message: str) -> bool:
         """Record a claim that later items depend on but that earns nothing by itself (a node that
         starts, then fails at its job, must not score): shown like an item, weight 0."""
@@ -494,8 +508,9 @@ class Context:
                                f"{_tail(proc.log, 6)}")
         return proc, call_seconds
 
-    def start_node(self, *ros_args: str, entry: str = "main"):
+    def start_node(self, *ros_args: str, entry: str = "main", tag: str = ""):
         """Start the student's node (``<module>:main``) in this check's ROS domain; stopped at the end.
+        Nodes started at the same time need different `tag`s (a process of the same name is replaced).
 
         Returns:
             The running course_lib.processes.NodeProcess (see its log, running(), describe_exit()).
@@ -504,7 +519,7 @@ class Context:
 
         self.require_module()
         limits = _student_limits(self.remaining() + 5)
-        return processes.python_node(f"{self.module}:{entry}", *ros_args, name=f"student-{self.module}-{entry}",
+        return processes.python_node(f"{self.module}:{entry}", *ros_args, name=f"student-{self.module}-{entry}{tag}",
                                      cwd=self.workdir, domain_id=self.domain_id, limits=limits, env=_student_env())
 
     @property

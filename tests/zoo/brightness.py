@@ -108,7 +108,8 @@ def cheater(nb):
 def entries(course_dir: str) -> dict[str, dict]:
     """student id -> {"edits", "values", "node", "reason"}: expected points per check (a number, a
     (low, high) range when fresh seeds decide how many items fail, or None: not asserted) and a
-    phrase the autograded notebook's outputs must contain. Entries with level="check" are typical
+    phrase the autograded notebook's outputs must contain (optional: `first_failure`, a phrase of the
+    first ✘ line of a check's verdict, and `absent`, phrases it must not contain). Entries with level="check" are typical
     mistakes in the module only: tests/test_autograder.py runs the checks on them directly (no
     nbgrader run), which is much cheaper; the rest go through the parallel nbgrader zoo run."""
     return {
@@ -120,7 +121,13 @@ def entries(course_dir: str) -> dict[str, dict]:
                          reason="rounded to nearest"),
         "reliable_qos": dict(level="check", edits=[('self.create_subscription(Image, "/image", self.on_image, qos_profile_sensor_data)',
                                      'self.create_subscription(Image, "/image", self.on_image, 10)')],
-                             values=None, node=1.0, reason="camera topics use the sensor-data QoS"),
+                             values=None, node=1.0, reason="incompatible QoS",
+                             # The cause comes first; what follows from it says so and guesses nothing.
+                             first_failure="the subscription on /image is reliable",
+                             absent=("Python loop", "namespaces")),
+        # numpy's uint64 is no Python int: check 1 says so, and the node's crash in publish() is named.
+        "numpy_int": dict(level="check", edits=[(SUM, "return image.sum() // image.size")], values=0, node=2.0,
+                          reason="put a Python int in it", first_failure="the node process ended"),
         "wrong_topic": dict(level="check", edits=[('UInt8, "/brightness"', 'UInt8, "/image_brightness"')], values=None, node=(0, 6.2),
                             reason="does not publish /brightness"),
         "python_loop": dict(level="check", edits=[(SUM, "total = 0\n    for value in image.reshape(-1):\n        total += int(value)\n"
