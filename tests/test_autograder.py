@@ -129,6 +129,19 @@ def test_catdog_typical_mistake_loses_points_with_its_reason(tmp_path, mistake):
     assert reason in "\n".join(result.verdict_lines())
 
 
+def test_catdog_picture_reported_from_its_first_marker_loses_points_in_every_grading(tmp_path):
+    """Each of a picture's four markers is hidden in turn in every grading, not left to a random
+    draw: a crop_pictures that reports a picture whenever its first marker is seen always loses."""
+    edits = [("if all(m in found for m in markers):", "if markers[0] in found:"),
+             ("found[m][c] for m, c in", "found.get(m, found[markers[0]])[c] for m, c in")]
+    workdir = _module_dir(tmp_path, "catdog_warp", edits)
+    for seed in (3, 4):
+        result = harness.execute("catdog_warp", "missing_and_none", seed, workdir=workdir, mode="graded")
+        assert result.points < result.max_points, result.verdict_lines()
+        failed = [item["message"] for item in result.items if not item["ok"]]
+        assert len(failed) == 6 and all("although markers" in m for m in failed), result.verdict_lines()
+
+
 def test_catdog_reference_passes_easy_scenes(tmp_path):
     """The reference crop_pictures gets every point on easy scenes (the checks can be passed)."""
     result = harness.execute("catdog_warp", "easy", 3, workdir=_module_dir(tmp_path, "catdog_warp"), mode="graded")
