@@ -263,16 +263,40 @@ def execute(assignment: str, name: str, seed: int, workdir=None, mode: str = "se
             result = Result(assignment, name, 0.0, spec.points, seed,
                             error=f"The check did not finish ({proc.describe_exit()}); "
                                   f"its last output:\n{proc.log_tail(8)}")
-        for image in result.images:
-            path = out / image.pop("file", "")
-            if path.is_file():
-                image["png"] = base64.b64encode(path.read_bytes()).decode()
+        _embed_images(result, out)
     finally:
         proc.stop(timeout=3)
         shutil.rmtree(out, ignore_errors=True)
     result.points = max(0.0, min(result.points, spec.points))
     result.seconds = round(time.monotonic() - started, 2)
     return result
+
+
+def _embed_images(result: Result, out: Path) -> None:
+    """Replace the file names of the result's pictures (written to `out`) by their PNG bytes."""
+    for image in result.images:
+        path = out / image.pop("file", "")
+        if path.is_file():
+            image["png"] = base64.b64encode(path.read_bytes()).decode()
+
+
+def run_outside(assignment: str, names: list[str], workdir, out: Path) -> None:
+    """The grader's run of a graded notebook's checks: each with a fresh seed and the answer key,
+    one after the other in this process (one interpreter start-up for all of them; the student's
+    code they call runs in processes of its own, bounded in time), each result in out/<name>.json."""
+    os.environ[answers.MODE_ENV] = "graded"
+    for name in names:
+        spec = get_check(assignment, name)
+        scratch = Path(tempfile.mkdtemp(prefix=f"autograder-{name}-"))
+        started = time.monotonic()
+        try:
+            result = run_in_this_process(assignment, name, fresh_seed(), Path(workdir).resolve(), scratch)
+            _embed_images(result, scratch)
+        finally:
+            shutil.rmtree(scratch, ignore_errors=True)
+        result.points = max(0.0, min(result.points, spec.points))
+        result.seconds = round(time.monotonic() - started, 2)
+        _write_json(out / f"{name}.json", dataclasses.asdict(result))
 
 
 def _pythonpath() -> str:
@@ -790,9 +814,7 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     out = Path(args.out)
     if args.command == "outside":
-        for name in args.checks:
-            _write_json(out / f"{name}.json", dataclasses.asdict(execute(args.assignment, name, fresh_seed(),
-                                                                          workdir=args.workdir, mode="graded")))
+        run_outside(args.assignment, args.checks, args.workdir, out)
         return 0
     seed = args.seed if args.seed is not None else int(os.environ.get(SEED_ENV, SELFCHECK_SEED))
     result = run_in_this_process(args.assignment, args.check, seed, Path(args.workdir).resolve(), out)
