@@ -112,8 +112,10 @@ def test_validate_fails_a_wrong_average_and_shows_the_failing_checks(browser, la
     # Every failed cell is shown by its source; the node publishes average_brightness's 0 as well.
     failed = re.findall(r"The following cell failed:\s*#[^\n]*\nchecks\.selfcheck\('(\w+)'\)", result.text)
     assert failed == ["values", "node"], said(result, lab)
-    # A wrong number is partial credit, not a crash or a timeout: each check ran and scored its cell.
-    assert result.text.count("Partial credit; passed some but not all of the tests") == 2, said(result, lab)
+    # A wrong number fails the self-checks, without a crash or a timeout: each check ran, and
+    # Validate lists what to fix (the ✘ lines), not a bare "Partial credit".
+    assert result.text.count("What to fix:") == 2 and "✘" in result.text, said(result, lab)
+    assert "Partial credit" not in result.text, said(result, lab)
     assert "Traceback" not in result.text and "CellTimeoutError" not in result.text, said(result, lab)
 
 

@@ -170,17 +170,27 @@ def _fmt(value: float) -> str:
 # In the kernel: start a check and show its verdict
 # ---------------------------------------------------------------------------------------------
 
-def selfcheck(assignment: str, name: str) -> float | None:
-    """Run a check with the fixed self-check seed, print what passed and failed, return its points.
+def selfcheck(assignment: str, name: str) -> None:
+    """Run a check with the fixed self-check seed and print what passed and failed; when points
+    were lost, also write what to fix to stderr, where nbgrader's Validate looks for a cell's
+    errors (it then lists those lines instead of a bare "Partial credit"). Returns nothing, so that
+    the cell does not end with a bare number.
 
-    Under grading (COURSE_LIB_GRADING=1) it does nothing and returns None: the hidden test that
-    follows it in the same cell runs the check with a fresh seed.
+    Under grading (COURSE_LIB_GRADING=1) it does nothing: the hidden test that follows it in the
+    same cell runs the check with a fresh seed.
     """
     from course_lib import rosenv
 
     if rosenv.under_grading():
-        return None
-    return run_check(assignment, name, SELFCHECK_SEED)
+        return
+    result = execute(assignment, name, SELFCHECK_SEED, mode="selfcheck")
+    print(verdict_text(result, graded=False))
+    _display_images(result)
+    if result.points < result.max_points:
+        lines = [line.strip() for line in result.verdict_lines() if line.lstrip().startswith(("✘", "↳", "!"))]
+        sys.stderr.write(f"Self-check {name}: {_fmt(result.points)} of {_fmt(result.max_points)} points. "
+                         "What to fix:\n" + "\n".join(lines) + "\n")
+        sys.stderr.flush()
 
 
 #: Set by the course's grader (autograder.grading) for the notebook run: the hidden tests do not
