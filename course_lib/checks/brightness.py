@@ -163,10 +163,12 @@ def _topic_items(ctx, probe) -> str | None:
     or None when the graph shows nothing in the way."""
     from rclpy.qos import ReliabilityPolicy
 
-    probe.spin_until(lambda: probe.node.get_subscriptions_info_by_topic("/image")
-                     and probe.node.get_publishers_info_by_topic("/brightness"), 3.0)
-    subs = [i for i in probe.node.get_subscriptions_info_by_topic("/image") if i.node_name == NODE_NAME]
-    pubs = [i for i in probe.node.get_publishers_info_by_topic("/brightness") if i.node_name == NODE_NAME]
+    def endpoints():  # the node's own (the yardstick subscribes /image too)
+        return ([i for i in probe.node.get_subscriptions_info_by_topic("/image") if i.node_name == NODE_NAME],
+                [i for i in probe.node.get_publishers_info_by_topic("/brightness") if i.node_name == NODE_NAME])
+
+    probe.spin_until(lambda: all(endpoints()), 3.0)
+    subs, pubs = endpoints()
     topics = {name: types for name, types in probe.node.get_topic_names_and_types()}
     blocker = None
     if not subs:
