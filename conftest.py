@@ -44,10 +44,34 @@ def domain_id():
 LONGEST_FIRST = ("test_term.py", "test_autograder_zoo.py", "test_autograder.py", "test_browser.py")
 
 
-def pytest_collection_modifyitems(items):
-    """Move the items of LONGEST_FIRST to the front, in that order (the rest keep theirs)."""
+#: Set to 1 to run the lessons under nbmake even when tests/test_browser.py runs them in Chromium.
+NBMAKE_LESSONS_ENV = "COURSE_TEST_NBMAKE_LESSONS"
+
+
+def _lessons_run_in_chromium(config, items) -> bool:
+    """True when this run's browser test runs every lesson top to bottom in JupyterLab (Chromium
+    on PATH, the test collected): that run checks all nbmake checks (every code cell ran, no
+    error) and more (what JupyterLab shows), so nbmake's run of the same lessons is skipped."""
+    import shutil
+
+    if os.environ.get(NBMAKE_LESSONS_ENV) == "1" or shutil.which("chromium") is None:
+        return False
+    return any(item.name.startswith("test_course_notebook_runs_clean_in_jupyterlab[") for item in items)
+
+
+def pytest_collection_modifyitems(config, items):
+    """Move the items of LONGEST_FIRST to the front, in that order (the rest keep theirs); skip
+    nbmake's lesson runs when the browser test runs the lessons (see _lessons_run_in_chromium)."""
     def rank(item):
         name = item.path.name
         return LONGEST_FIRST.index(name) if name in LONGEST_FIRST else len(LONGEST_FIRST)
 
     items.sort(key=rank)
+    if _lessons_run_in_chromium(config, items):
+        run_in_lab = {item.name.split("[", 1)[1].rstrip("]") for item in items
+                      if item.name.startswith("test_course_notebook_runs_clean_in_jupyterlab[")}
+        skip = pytest.mark.skip(reason=f"runs top to bottom in JupyterLab (tests/test_browser.py); "
+                                       f"{NBMAKE_LESSONS_ENV}=1 runs it under nbmake too")
+        for item in items:
+            if item.path.suffix == ".ipynb" and item.path.name in run_in_lab:
+                item.add_marker(skip)
