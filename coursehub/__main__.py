@@ -73,7 +73,18 @@ def _write_passwords(path: Path, passwords: dict) -> None:
 
 
 def remove_course(course) -> None:
-    """Delete the course's accounts (and homes), its group, its exchange folder and the hub directory."""
+    """Delete the course's accounts (and homes), its group, its exchange folder and the hub directory.
+
+    Raises:
+        ValueError: a course account still runs processes (the hub is running).
+    """
+    import psutil
+
+    uids = {pwd.getpwnam(u).pw_uid for u in [course.instructor, *course.students] if accounts.exists(u)}
+    running = [p.pid for p in psutil.process_iter(["uids"]) if p.info["uids"] and p.info["uids"].real in uids]
+    if running:
+        raise ValueError(f"the course's accounts still run {len(running)} processes (e.g. {running[:5]}): stop the hub "
+                         "first (Ctrl-C where `make hub` runs), then remove the course")
     for user in [course.instructor, *course.students]:
         accounts.remove_user(user, course.group)
     accounts.remove_group(course.group)

@@ -34,6 +34,8 @@ async def _join(reader, writer, open_target) -> None:
         return
     try:
         await asyncio.gather(_pipe(reader, target_writer), _pipe(target_reader, writer))
+    except asyncio.CancelledError:
+        pass  # the door closes (its loop ends): both connections close below
     finally:
         writer.close()
         target_writer.close()

@@ -119,7 +119,7 @@ def running_hub(prefix: str, students: list[str], hub_dir: Path, scratch: Path, 
     roster = scratch / f"{prefix}-roster.csv"
     roster.write_text("id,first_name,last_name\n" + "".join(f"{prefix}{s},{s.title()},Test\n" for s in students))
     port, hub_port = free_port_pair(), free_port_pair()
-    process = None
+    process, hub = None, None
     try:
         coursehub(hub_dir, "create-course", str(roster), "--instructor", f"{prefix}i", "--group", f"{prefix}g",
                   "--exchange", str(hub_dir / "exchange"), "--port", str(port), "--hub-port", str(hub_port))
@@ -144,13 +144,11 @@ def running_hub(prefix: str, students: list[str], hub_dir: Path, scratch: Path, 
             hub.released = releasing.submit(lambda: [coursehub(hub_dir, "release", name) for name in release])
             yield hub
     finally:
-        if process is not None and process.poll() is None:
-            process.send_signal(signal.SIGINT)
-            try:
-                process.wait(60)
-            except subprocess.TimeoutExpired:
-                process.kill()
-                process.wait(10)
+        if hub is not None:
+            hub.stop()
+        elif process is not None:
+            process.kill()
+            process.wait(10)
         if (hub_dir / "course.json").exists():
             coursehub(hub_dir, "remove-course")
 
