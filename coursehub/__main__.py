@@ -96,7 +96,8 @@ def start(course) -> int:
     """Run the hub in the foreground (Ctrl-C stops it and every server)."""
     proxy = Path(sys.prefix) / "chp" / "node_modules" / ".bin" / "configurable-http-proxy"
     if not proxy.exists():
-        raise FileNotFoundError(f"configurable-http-proxy is not installed at {proxy}: run `make hub-deps` (or `make hub`)")
+        raise FileNotFoundError(f"configurable-http-proxy is not installed at {proxy}: "
+                                "run `make hub-deps` (or `make hub`)")
     env = dict(os.environ, COURSEHUB_HUB_DIR=str(course.hub_dir), PYTHONPATH=str(REPO),
                PATH=os.pathsep.join([str(Path(sys.executable).parent), os.environ.get("PATH", os.defpath)]))
     os.chdir(course.hub_dir)
@@ -109,7 +110,8 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument("--hub-dir", type=Path, default=course_settings.DEFAULT_HUB_DIR,
                         help=f"where the hub keeps the course (default {course_settings.DEFAULT_HUB_DIR})")
     sub = parser.add_subparsers(dest="command", required=True)
-    cre = sub.add_parser("create-course", help="Linux accounts, exchange and nbgrader course from a roster CSV (id column)")
+    cre = sub.add_parser("create-course",
+                         help="Linux accounts, exchange and nbgrader course from a roster CSV (id column)")
     cre.add_argument("roster", type=Path)
     cre.add_argument("--instructor", required=True, help="the instructor's user name (created when missing)")
     cre.add_argument("--group", default="ros2cv", help="Linux group of the course's accounts (default ros2cv)")

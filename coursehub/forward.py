@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import asyncio
 import os
+import stat
 
 CHUNK = 256 * 1024
 
@@ -29,7 +30,7 @@ async def _pipe(reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> N
 async def _join(reader, writer, open_target) -> None:
     try:
         target_reader, target_writer = await open_target()
-    except OSError:
+    except OSError:  # nothing listens yet (a server still starting), or a refused socket
         writer.close()
         return
     try:
@@ -41,10 +42,21 @@ async def _join(reader, writer, open_target) -> None:
         target_writer.close()
 
 
-async def tcp_to_unix(host: str, port: int, path: str) -> asyncio.Server:
-    """Listen on host:port; each connection is joined to a new connection to the unix socket `path`."""
-    return await asyncio.start_server(
-        lambda r, w: _join(r, w, lambda: asyncio.open_unix_connection(path)), host, port)
+async def tcp_to_unix(host: str, port: int, path: str, owner: int | None = None) -> asyncio.Server:
+    """Listen on host:port; each connection is joined to a new connection to the unix socket `path`.
+
+    With `owner`, only a socket of that uid is connected to (not a symlink, not another user's
+    socket): the folder of server.sock belongs to the student, who could otherwise point the
+    hub's door at someone else's socket.
+    """
+    def connect():
+        if owner is not None:
+            found = os.lstat(path)
+            if not stat.S_ISSOCK(found.st_mode) or found.st_uid != owner:
+                raise ConnectionRefusedError(f"{path} is not a socket of uid {owner}")
+        return asyncio.open_unix_connection(path)
+
+    return await asyncio.start_server(lambda r, w: _join(r, w, connect), host, port)
 
 
 async def unix_to_tcp(path: str, host: str, port: int, mode: int = 0o600) -> asyncio.Server:

@@ -89,7 +89,8 @@ class IsolatedSpawner(LocalProcessSpawner):
         self._namespace = ""
         if self._door is not None:
             self._door.close()
-        self._door = await forward.tcp_to_unix("127.0.0.1", port, str(course.server_socket(self.user.name)))
+        self._door = await forward.tcp_to_unix("127.0.0.1", port, str(course.server_socket(self.user.name)),
+                                               owner=account.pw_uid)
         return ip, port
 
     async def poll(self):

@@ -88,7 +88,8 @@ def coursehub(hub_dir: Path, *args: str, timeout: float = 600) -> str:
                           capture_output=True, text=True, timeout=timeout,
                           env=dict(os.environ, PYTHONPATH=str(REPO)))
     if done.returncode != 0:
-        raise RuntimeError(f"python -m coursehub {' '.join(args)} failed ({done.returncode}):\n{done.stdout}{done.stderr}")
+        raise RuntimeError(f"python -m coursehub {' '.join(args)} failed ({done.returncode}):\n"
+                           f"{done.stdout}{done.stderr}")
     return done.stdout + done.stderr
 
 
