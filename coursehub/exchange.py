@@ -45,8 +45,13 @@ def write_settings(course) -> Path:
 
 
 def write_student_settings(home: Path, user: str) -> None:
-    """A student's ~/.jupyter: the instructor's nbgrader extensions switched off."""
+    """A student's ~/.jupyter: the instructor's nbgrader extensions switched off, and no prompt
+    about Jupyter's news (the server's namespace has no network to fetch them)."""
     jupyter = home / ".jupyter"
+    notification = jupyter / "lab" / "user-settings" / "@jupyterlab" / "apputils-extension"
+    notification.mkdir(parents=True, exist_ok=True)
+    (notification / "notification.jupyterlab-settings").write_text(
+        json.dumps({"fetchNews": "false", "checkForUpdates": False}, indent=2))
     (jupyter / "labconfig").mkdir(parents=True, exist_ok=True)
     (jupyter / "labconfig" / "page_config.json").write_text(
         json.dumps({"disabledExtensions": {name: True for name in INSTRUCTOR_LAB_EXTENSIONS}}, indent=2))

@@ -36,6 +36,7 @@ pytestmark = [pytest.mark.hub, pytest.mark.browser, pytest.mark.slow, pytest.mar
               pytest.mark.skipif(why_no_hub() is not None, reason=str(why_no_hub()))]
 
 ASSIGNMENT = "brightness"
+SCREENSHOTS = Path(__file__).resolve().parents[1] / "artifacts" / "browser"
 #: The wrong submission: the brightest pixel instead of the average.
 WRONG_AVERAGE = [(SUM, "return int(image.max())")]
 
@@ -195,11 +196,14 @@ def test_students_submit_in_the_assignments_panel_and_each_fetches_only_their_fe
         page.wait_for_function(
             "() => [...document.querySelectorAll('#submitted_assignments_list .list_item')]"
             ".some(row => row.innerText.includes('feedback'))", timeout=60_000)
+        SCREENSHOTS.mkdir(parents=True, exist_ok=True)
+        page.screenshot(path=str(SCREENSHOTS / f"hub_assignments_{'first' if user == alice else 'second'}.png"))
         feedback = sorted((Path(f"/home/{user}") / ASSIGNMENT / "feedback").glob(f"*/{ASSIGNMENT}.html"))
         assert len(feedback) == 1, f"{user} fetched {feedback}"
         relative = feedback[0].relative_to(f"/home/{user}").as_posix()
         page.goto(f"{hub.url}/user/{user}/files/{relative}", wait_until="domcontentloaded")
         text = page.inner_text("body")
+        page.screenshot(path=str(SCREENSHOTS / f"hub_feedback_{'first' if user == alice else 'second'}.png"))
         # nbgrader's feedback page of the student's own submission: their score, not the other's.
         assert f"{ASSIGNMENT} (Score: {scores[user][0]:.1f} / {scores[user][1]:.1f})" in text, text[:500]
         assert f"(Score: {scores[other][0]:.1f} / {scores[other][1]:.1f})" not in text, text[:500]
