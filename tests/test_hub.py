@@ -2,8 +2,8 @@
 127.0.0.1, PAM logins, each server in namespaces of its own.
 
 Both students' kernels run talkers on `chatter` with the same ROS_DOMAIN_ID and discovery range
-and hear only themselves, and cannot read each other's home, the gradebook or the reference
-solutions (while the instructor releases brightness). In headless Chromium the students log in,
+and hear only themselves, and cannot read each other's home, the gradebook, the exchange's
+submissions or the reference solutions. In headless Chromium the students log in,
 fetch brightness from the Assignments panel and submit (one the reference solution, one a wrong
 average); the instructor's commands collect, grade in the sandbox and release feedback; the
 formgrader shows the grader's scores; each student fetches their own feedback and cannot reach
@@ -148,8 +148,12 @@ def _hand_in(hub, user, edits):
 
 def test_talkers_in_two_students_kernels_on_one_domain_never_hear_each_other(hub, sessions):
     alice, bob = hub.students
-    private = {alice: [f"/home/{bob}", str(hub.course_dir / "gradebook.db")],
-               bob: [f"/home/{alice}", str(hub.course_dir / "gradebook.db")]}
+    from autograder.config import COURSE_ID
+
+    hub.released.result()  # nbgrader made the exchange's inbound/ (students may write, not list)
+    inbound = str(hub.hub_dir / "exchange" / COURSE_ID / "inbound")
+    private = {alice: [f"/home/{bob}", str(hub.course_dir / "gradebook.db"), inbound],
+               bob: [f"/home/{alice}", str(hub.course_dir / "gradebook.db"), inbound]}
     hidden = str(Path(__file__).resolve().parent.parent / "assignments")
     with concurrent.futures.ThreadPoolExecutor(2) as pool:
         said = dict(zip((alice, bob), pool.map(
