@@ -2,6 +2,8 @@
 #   make setup   create .venv/ from environment.txt and install course_lib into it
 #   make lab     set up, then start JupyterLab on the course (prints the URL; no browser needed)
 #   make test    set up, then run the whole test suite (unit tests, notebooks, browser tests)
+#   make hub     set up, then run the course's JupyterHub for a class (root; course from
+#                `python -m coursehub create-course`, see README)
 
 PYTHON ?= python3
 VENV   := .venv
@@ -26,7 +28,10 @@ VENV_FLAGS := --system-site-packages
 REQUIREMENTS := $(VENV)/requirements-without-ros.txt
 endif
 
-.PHONY: setup lab test browser-deps clean
+CHP_VERSION := 5.3.0
+HUB_DIR ?= /srv/ros2cv-hub
+
+.PHONY: setup lab test browser-deps hub-deps hub clean
 
 setup: $(VENV)/.setup-done
 
@@ -74,7 +79,26 @@ browser-deps:
 	    || echo "Could not install chromium: browser tests will be skipped"; \
 	else echo "chromium is not installed and this user cannot apt-get it: browser tests will be skipped"; fi
 
-test: setup browser-deps
+# The hub's proxy (configurable-http-proxy, from npm) goes into the venv, not into the system.
+# Students' servers run as their own uids and cannot write __pycache__ into the venv or the
+# repository: compiled here once, a server starts in about half the time.
+hub-deps: $(VENV)/chp/.installed-$(CHP_VERSION) $(VENV)/.bytecode-done
+
+$(VENV)/chp/.installed-$(CHP_VERSION):
+	@if command -v npm >/dev/null 2>&1; then \
+	  npm install --silent --no-audit --no-fund --prefix $(VENV)/chp configurable-http-proxy@$(CHP_VERSION) && touch $@; \
+	else echo "npm is not installed: the hub needs Node.js and npm for configurable-http-proxy (apt-get install nodejs npm); the hub test will be skipped"; fi
+
+$(VENV)/.bytecode-done: $(VENV)/.setup-done
+	$(PY) -m compileall -q -j 2 $(VENV)/lib course_lib coursehub autograder > /dev/null || true
+	@touch $@
+
+# The course's JupyterHub on http://127.0.0.1:8000 (the port given to create-course).
+hub: setup hub-deps
+	@if [ "$$(id -u)" != 0 ]; then echo "make hub runs the servers as the students' Linux accounts: run it as root"; exit 1; fi
+	$(PY) -m coursehub --hub-dir $(HUB_DIR) start
+
+test: setup browser-deps hub-deps
 	$(PY) -m pytest -n $(TEST_WORKERS) --dist loadfile $(PYTEST_ARGS)
 
 clean:

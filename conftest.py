@@ -41,7 +41,7 @@ def domain_id():
 
 #: The test files that run longest (whole grading runs), started first: with `--dist loadfile`
 #: xdist hands out files in collection order, and a long file started last ends the suite last.
-LONGEST_FIRST = ("test_term.py", "test_autograder_zoo.py", "test_autograder.py", "test_browser.py")
+LONGEST_FIRST = ("test_term.py", "test_hub.py", "test_autograder_zoo.py", "test_autograder.py", "test_browser.py")
 
 
 #: Set to 1 to run the lessons under nbmake even when tests/test_browser.py runs them in Chromium.

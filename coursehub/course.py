@@ -1,0 +1,76 @@
+"""The course's settings on this server (``<hub dir>/course.json``) and where everything lives.
+
+One hub directory holds what the hub keeps (root only, except ``run/``, which students traverse to
+reach their server's socket): course.json, the JupyterHub database and cookie secret, the initial
+passwords, the nbgrader settings every server reads (``jupyter/``) and configurable-http-proxy's
+auth token.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import pwd
+from pathlib import Path
+
+DEFAULT_HUB_DIR = Path("/srv/ros2cv-hub")
+DEFAULT_EXCHANGE = Path("/srv/nbgrader/exchange")  # nbgrader's documented default place
+
+
+@dataclasses.dataclass
+class Course:
+    hub_dir: Path
+    course_id: str
+    group: str             # Linux group of the course's accounts; the hub lets in its members only
+    instructor: str
+    students: list[str]
+    exchange: Path
+    port: int = 8000       # the proxy's public port (the URL students open)
+    hub_port: int = 8081   # the hub's API, on 127.0.0.1 (and, through hub.sock, in every namespace)
+    ip: str = "127.0.0.1"  # the proxy's public address; 0.0.0.0 behind a TLS-terminating front end
+
+    @property
+    def run_dir(self) -> Path:
+        return self.hub_dir / "run"
+
+    @property
+    def hub_socket(self) -> Path:
+        return self.run_dir / "hub.sock"
+
+    def server_socket(self, user: str) -> Path:
+        return self.run_dir / user / "server.sock"
+
+    @property
+    def jupyter_config_dir(self) -> Path:
+        return self.hub_dir / "jupyter"
+
+    @property
+    def course_dir(self) -> Path:
+        """The nbgrader course root (source/ release/ submitted/ ... gradebook.db), the instructor's."""
+        return Path(pwd.getpwnam(self.instructor).pw_dir) / "course"
+
+    @property
+    def passwords(self) -> Path:
+        return self.hub_dir / "passwords.csv"
+
+    def save(self) -> Path:
+        path = self.hub_dir / "course.json"
+        data = {k: str(v) if isinstance(v, Path) else v for k, v in dataclasses.asdict(self).items()}
+        path.write_text(json.dumps(data, indent=2) + "\n")
+        path.chmod(0o600)
+        return path
+
+
+def load(hub_dir=DEFAULT_HUB_DIR) -> Course:
+    """The course of a hub directory.
+
+    Raises:
+        FileNotFoundError: there is none yet; the message names the command that creates it.
+    """
+    path = Path(hub_dir) / "course.json"
+    if not path.is_file():
+        raise FileNotFoundError(f"no course in {hub_dir} (no course.json): create it first with "
+                                f"`python -m coursehub create-course ROSTER.csv --instructor NAME --hub-dir {hub_dir}`")
+    data = json.loads(path.read_text())
+    data["hub_dir"], data["exchange"] = Path(data["hub_dir"]), Path(data["exchange"])
+    return Course(**data)

@@ -1,0 +1,61 @@
+"""nbgrader's exchange on this server, and the nbgrader/JupyterLab settings of each user.
+
+The exchange root is writable by everyone (``chmod ugo+rw``, nbgrader's documented set-up); nbgrader
+itself gives ``<course>/outbound`` (released assignments, readable by all), ``inbound`` (write and
+enter only: a student can submit but not list or read other submissions) and ``feedback`` (files
+named by a hash of the student's own submission) their permissions when the instructor releases.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+from coursehub.accounts import chown_tree
+
+# Students get the Assignments panel and Validate; the instructor's tools are switched off in
+# their lab (nbgrader's installation guide lists the same extensions for a multi-user set-up).
+INSTRUCTOR_LAB_EXTENSIONS = ("@jupyter/nbgrader:formgrader", "@jupyter/nbgrader:course-list",
+                             "@jupyter/nbgrader:create-assignment")
+INSTRUCTOR_SERVER_EXTENSIONS = ("nbgrader.server_extensions.formgrader", "nbgrader.server_extensions.course_list")
+
+
+def create_exchange(root: Path) -> None:
+    root.mkdir(parents=True, exist_ok=True)
+    os.chmod(root, 0o777)  # ugo+rw (and x) as nbgrader's guide sets it; not sticky: nbgrader's own modes rule
+
+
+def write_settings(course) -> Path:
+    """``<hub dir>/jupyter/nbgrader_config.py``, read by every server of the hub (JUPYTER_CONFIG_PATH)
+    and by the instructor's commands: the course id, the exchange, the course's cell timeouts."""
+    folder = course.jupyter_config_dir
+    folder.mkdir(parents=True, exist_ok=True)
+    os.chmod(folder, 0o755)
+    path = folder / "nbgrader_config.py"
+    path.write_text(
+        "# Written by `python -m coursehub create-course`: every server of the hub reads it.\n"
+        "from course_lib.checks.validate import apply_student\n\n"
+        "c = get_config()  # noqa: F821 (provided by nbgrader)\n"
+        f"c.CourseDirectory.course_id = {course.course_id!r}\n"
+        f"c.Exchange.root = {str(course.exchange)!r}\n"
+        "apply_student(c)\n")
+    os.chmod(path, 0o644)
+    return path
+
+
+def write_student_settings(home: Path, user: str) -> None:
+    """A student's ~/.jupyter: the instructor's nbgrader extensions switched off, and no prompt
+    about Jupyter's news (the server's namespace has no network to fetch them)."""
+    jupyter = home / ".jupyter"
+    notification = jupyter / "lab" / "user-settings" / "@jupyterlab" / "apputils-extension"
+    notification.mkdir(parents=True, exist_ok=True)
+    (notification / "notification.jupyterlab-settings").write_text(
+        json.dumps({"fetchNews": "false", "checkForUpdates": False}, indent=2))
+    (jupyter / "labconfig").mkdir(parents=True, exist_ok=True)
+    (jupyter / "labconfig" / "page_config.json").write_text(
+        json.dumps({"disabledExtensions": {name: True for name in INSTRUCTOR_LAB_EXTENSIONS}}, indent=2))
+    (jupyter / "jupyter_server_config.json").write_text(
+        json.dumps({"ServerApp": {"jpserver_extensions": {name: False for name in INSTRUCTOR_SERVER_EXTENSIONS}}},
+                   indent=2))
+    chown_tree(jupyter, user)

@@ -1,0 +1,36 @@
+"""The hub's configuration: JupyterHub reads this file (``python -m coursehub start`` passes it),
+and it reads the course from ``$COURSEHUB_HUB_DIR/course.json``."""
+
+import json
+import os
+import sys
+from pathlib import Path
+
+from coursehub import course as course_settings
+
+c = get_config()  # noqa: F821 (provided by JupyterHub)
+course = course_settings.load(os.environ["COURSEHUB_HUB_DIR"])
+
+c.JupyterHub.ip = course.ip
+c.JupyterHub.port = course.port
+c.JupyterHub.hub_ip = "127.0.0.1"
+c.JupyterHub.hub_port = course.hub_port
+c.ConfigurableHTTPProxy.api_url = f"http://127.0.0.1:{course.port + 1}"
+c.ConfigurableHTTPProxy.command = [str(Path(sys.prefix) / "chp" / "node_modules" / ".bin" / "configurable-http-proxy")]
+c.JupyterHub.db_url = f"sqlite:///{course.hub_dir / 'jupyterhub.sqlite'}"
+c.JupyterHub.cookie_secret_file = str(course.hub_dir / "jupyterhub_cookie_secret")
+c.JupyterHub.pid_file = str(course.hub_dir / "jupyterhub.pid")
+c.JupyterHub.cleanup_servers = True
+c.JupyterHub.cleanup_proxy = True
+
+# PAM: the course's Linux accounts are the logins (coursehub.accounts); only its group gets in.
+c.JupyterHub.authenticator_class = "pam"
+c.PAMAuthenticator.allowed_groups = {course.group}
+
+c.JupyterHub.spawner_class = "coursehub.spawner.IsolatedSpawner"
+c.IsolatedSpawner.hub_dir = str(course.hub_dir)
+c.Spawner.default_url = "/lab"
+c.Spawner.args = ["--ServerApp.terminado_settings=" + json.dumps({"shell_command": ["/bin/bash"]})]
+# Ten students logging in at once on two cores start in about a minute (README: capacity).
+c.Spawner.start_timeout = 180
+c.Spawner.http_timeout = 180

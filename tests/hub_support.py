@@ -1,0 +1,238 @@
+"""Use a course hub as students do, from tests and benchmarks: create it with its admin command,
+start and stop it, log in over HTTP, run code in a student's kernel (Jupyter's kernel websocket),
+and find every process of the course's users.
+
+- ``running_hub``: a course (prefixed accounts) created by ``python -m coursehub create-course``,
+  the hub started by ``python -m coursehub start``; on exit the hub is stopped and the course removed;
+- ``log_in``: a requests session logged in through the hub's login form, with the user's server up;
+- ``run_in_kernel``: start a kernel in a user's server, run code, return what it printed;
+- ``course_processes``: the processes of the course's uids and of their network namespaces.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import concurrent.futures
+import contextlib
+import csv
+import dataclasses
+import json
+import os
+import pwd
+import signal
+import subprocess
+import sys
+import time
+import uuid
+from pathlib import Path
+
+import psutil
+
+REPO = Path(__file__).resolve().parent.parent
+PROXY = Path(sys.prefix) / "chp" / "node_modules" / ".bin" / "configurable-http-proxy"
+
+
+def why_no_hub() -> str | None:
+    """Why a hub cannot run here (the reason names the fix), or None."""
+    if os.geteuid() != 0:
+        return "the hub test creates Linux accounts and namespaces: run `make test` as root"
+    if not PROXY.exists():
+        return f"configurable-http-proxy is not installed at {PROXY}: run `make hub-deps`"
+    return None
+
+
+@dataclasses.dataclass
+class Hub:
+    url: str
+    hub_dir: Path
+    instructor: str
+    students: list[str]
+    passwords: dict
+    process: subprocess.Popen
+    log: Path
+    #: The release of the assignments named to running_hub, done while the hub starts and
+    #: students log in (a concurrent.futures.Future: .result() waits for it).
+    released: object = None
+
+    @property
+    def course_dir(self) -> Path:
+        return Path(pwd.getpwnam(self.instructor).pw_dir) / "course"
+
+    def coursehub(self, *args: str, timeout: float = 600) -> str:
+        """Run ``python -m coursehub --hub-dir HUB_DIR ARGS`` (root); return its output, raise on failure."""
+        return coursehub(self.hub_dir, *args, timeout=timeout)
+
+    def uids(self) -> set[int]:
+        found = set()
+        for user in [self.instructor, *self.students]:
+            with contextlib.suppress(KeyError):
+                found.add(pwd.getpwnam(user).pw_uid)
+        return found
+
+    def stop(self, timeout: float = 60) -> None:
+        """Stop the hub as Ctrl-C does (it stops every server first)."""
+        if self.process.poll() is None:
+            self.process.send_signal(signal.SIGINT)
+            try:
+                self.process.wait(timeout)
+            except subprocess.TimeoutExpired:
+                self.process.kill()
+                self.process.wait(10)
+
+    def log_tail(self, lines: int = 40) -> str:
+        return "\n".join(self.log.read_text(errors="replace").splitlines()[-lines:])
+
+
+def coursehub(hub_dir: Path, *args: str, timeout: float = 600) -> str:
+    done = subprocess.run([sys.executable, "-m", "coursehub", "--hub-dir", str(hub_dir), *args], cwd=REPO,
+                          capture_output=True, text=True, timeout=timeout,
+                          env=dict(os.environ, PYTHONPATH=str(REPO)))
+    if done.returncode != 0:
+        raise RuntimeError(f"python -m coursehub {' '.join(args)} failed ({done.returncode}):\n"
+                           f"{done.stdout}{done.stderr}")
+    return done.stdout + done.stderr
+
+
+def free_port_pair() -> int:
+    """A free port p whose neighbour p + 1 (the proxy's API) is free too."""
+    import socket
+
+    for _ in range(50):
+        with socket.socket() as first:
+            first.bind(("127.0.0.1", 0))
+            port = first.getsockname()[1]
+            with socket.socket() as second:
+                try:
+                    second.bind(("127.0.0.1", port + 1))
+                except OSError:
+                    continue
+            return port
+    raise RuntimeError("no two neighbouring free ports on 127.0.0.1")
+
+
+@contextlib.contextmanager
+def running_hub(prefix: str, students: list[str], hub_dir: Path, scratch: Path, release: list[str] = (),
+                timeout: float = 60):
+    """Create a course (instructor ``<prefix>i``, the students ``<prefix><name>``) and run its hub;
+    the roster and the hub's log go to `scratch`."""
+    import requests
+
+    roster = scratch / f"{prefix}-roster.csv"
+    roster.write_text("id,first_name,last_name\n" + "".join(f"{prefix}{s},{s.title()},Test\n" for s in students))
+    port, hub_port = free_port_pair(), free_port_pair()
+    process, hub = None, None
+    try:
+        coursehub(hub_dir, "create-course", str(roster), "--instructor", f"{prefix}i", "--group", f"{prefix}g",
+                  "--exchange", str(hub_dir / "exchange"), "--port", str(port), "--hub-port", str(hub_port))
+        with open(hub_dir / "passwords.csv", newline="") as handle:
+            passwords = {row["user"]: row["password"] for row in csv.DictReader(handle)}
+        log = scratch / f"{prefix}-hub.log"
+        with open(log, "w") as out:
+            process = subprocess.Popen([sys.executable, "-m", "coursehub", "--hub-dir", str(hub_dir), "start"],
+                                       cwd=REPO, stdout=out, stderr=subprocess.STDOUT,
+                                       env=dict(os.environ, PYTHONPATH=str(REPO)))
+        hub = Hub(f"http://127.0.0.1:{port}", hub_dir, f"{prefix}i", [f"{prefix}{s}" for s in students], passwords,
+                  process, log)
+        deadline = time.monotonic() + timeout
+        while True:
+            with contextlib.suppress(requests.RequestException):
+                if requests.get(f"{hub.url}/hub/api", timeout=5).status_code == 200:
+                    break
+            if process.poll() is not None or time.monotonic() > deadline:
+                raise RuntimeError(f"the hub did not answer at {hub.url} within {timeout:.0f} s:\n{hub.log_tail()}")
+            time.sleep(0.2)
+        with concurrent.futures.ThreadPoolExecutor(1) as releasing:
+            hub.released = releasing.submit(lambda: [coursehub(hub_dir, "release", name) for name in release])
+            yield hub
+    finally:
+        if hub is not None:
+            hub.stop()
+        elif process is not None:
+            process.kill()
+            process.wait(10)
+        if (hub_dir / "course.json").exists():
+            coursehub(hub_dir, "remove-course")
+
+
+def log_in(hub: Hub, user: str, timeout: float = 180):
+    """A requests session logged in as `user` through the login form, once JupyterLab answers; and
+    the seconds from the login form's submit to JupyterLab's page."""
+    import requests
+
+    session = requests.Session()
+    session.get(f"{hub.url}/hub/login", timeout=30)
+    started = time.monotonic()
+    answer = session.post(f"{hub.url}/hub/login", timeout=60, data={
+        "username": user, "password": hub.passwords[user], "_xsrf": session.cookies.get("_xsrf", path="/hub/")})
+    if answer.status_code != 200 or "/hub/login" in answer.url:
+        raise RuntimeError(f"login of {user} failed ({answer.status_code} at {answer.url})")
+    deadline = started + timeout
+    while time.monotonic() < deadline:
+        page = session.get(f"{hub.url}/user/{user}/lab", timeout=60)
+        if page.status_code == 200 and f"/user/{user}/lab" in page.url:
+            return session, time.monotonic() - started
+        time.sleep(0.25)
+    raise TimeoutError(f"{user}'s JupyterLab did not open within {timeout:.0f} s:\n{hub.log_tail()}")
+
+
+def run_in_kernel(hub: Hub, session, user: str, code: str, timeout: float = 120) -> str:
+    """Start a python3 kernel in `user`'s server, run `code`, shut the kernel down; return its printed
+    output. Raises RuntimeError with the traceback when the code raised."""
+    base = f"{hub.url}/user/{user}/api/kernels"
+    headers = {"X-XSRFToken": session.cookies.get("_xsrf", path=f"/user/{user}/") or ""}
+    kernel = session.post(base, json={"name": "python3"}, headers=headers, timeout=60)
+    kernel.raise_for_status()
+    kernel_id = kernel.json()["id"]
+    try:
+        return asyncio.run(_execute(hub, session, f"{base}/{kernel_id}/channels", code, timeout))
+    finally:
+        session.delete(f"{base}/{kernel_id}", headers=headers, timeout=60)
+
+
+async def _execute(hub, session, url: str, code: str, timeout: float) -> str:
+    from tornado.httpclient import HTTPRequest
+    from tornado.websocket import websocket_connect
+
+    cookies = "; ".join(f"{c.name}={c.value}" for c in session.cookies)
+    connection = await websocket_connect(HTTPRequest(url.replace("http://", "ws://"), headers={"Cookie": cookies}))
+    msg_id = uuid.uuid4().hex
+    connection.write_message(json.dumps({
+        "header": {"msg_id": msg_id, "username": "test", "session": uuid.uuid4().hex, "msg_type": "execute_request",
+                   "version": "5.3"},
+        "parent_header": {}, "metadata": {}, "channel": "shell", "buffers": [],
+        "content": {"code": code, "silent": False, "store_history": False, "user_expressions": {},
+                    "allow_stdin": False, "stop_on_error": True}}))
+    printed, error = [], None
+    deadline = time.monotonic() + timeout
+    try:
+        while True:
+            raw = await asyncio.wait_for(connection.read_message(), max(0.1, deadline - time.monotonic()))
+            if raw is None:
+                raise RuntimeError(f"the kernel's websocket closed; printed so far: {''.join(printed)}")
+            message = json.loads(raw)
+            if message.get("parent_header", {}).get("msg_id") != msg_id:
+                continue
+            kind, content = message["msg_type"], message["content"]
+            if kind == "stream":
+                printed.append(content["text"])
+            elif kind == "error":
+                error = "\n".join(content["traceback"])
+            elif kind == "status" and content["execution_state"] == "idle":
+                break
+    finally:
+        connection.close()
+    if error:
+        raise RuntimeError(f"the kernel's code raised:\n{error}\nprinted: {''.join(printed)}")
+    return "".join(printed)
+
+
+def course_processes(hub: Hub, namespaces: set[str] = frozenset()) -> list[psutil.Process]:
+    """The processes of the course's uids, and those in one of `namespaces` (/proc/PID/ns/net)."""
+    uids, found = hub.uids(), []
+    for process in psutil.process_iter(["uids"]):
+        try:
+            if process.info["uids"].real in uids or os.readlink(f"/proc/{process.pid}/ns/net") in namespaces:
+                found.append(process)
+        except (psutil.Error, OSError, TypeError):
+            pass
+    return found
