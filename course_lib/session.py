@@ -14,6 +14,23 @@ The session is safe to re-run cell by cell: ``start()`` twice does nothing the s
 holds replaces the old node instead of running twice. The session stops itself when the
 kernel exits.
 
+Replacing happens when the new node is *created*, not when it is added: two nodes of one name in
+one process confuse ROS (rcl warns "Publisher already registered for node name", and the graph
+loses the new node's topics, which other processes then see under ``_NODE_NAME_UNKNOWN_``). So
+while a session has run in this process, creating an rclpy ``Node`` under a name the session
+holds first removes the old node. After ``stop()``, creating a node raises
+:class:`SessionStopped`, which says to run ``session.start()`` (rclpy's own error would only say
+that ``rclpy.init()`` was not called).
+
+In plain ROS 2 the same is an executor spinning in a thread of its own::
+
+    rclpy.init()
+    executor = rclpy.executors.SingleThreadedExecutor()
+    executor.add_node(node)
+    threading.Thread(target=executor.spin, daemon=True).start()
+    ...
+    executor.shutdown(); node.destroy_node(); rclpy.try_shutdown()
+
 A hidden node, :data:`TOOL_NODE_NAME`, serves the introspection helpers of
 :mod:`course_lib.graph`; it is created on first use and never listed by :func:`nodes`.
 """
@@ -21,6 +38,7 @@ A hidden node, :data:`TOOL_NODE_NAME`, serves the introspection helpers of
 from __future__ import annotations
 
 import atexit
+import functools
 import sys
 import threading
 import time
@@ -64,6 +82,16 @@ _state: _State | None = None
 _errors: list[BaseException] = []
 _reported: set[tuple[str, str]] = set()
 _atexit_registered = False
+_stopped = False  # stop() ran and no start() since: a new node gets SessionStopped
+
+
+class SessionStopped(RuntimeError):
+    """A node was created after session.stop() (a lesson's clean-up cell) shut ROS down."""
+
+    def __init__(self):
+        super().__init__("ROS is not running in this notebook: the clean-up cell (session.stop()) shut "
+                         "it down. Run session.start() (or the notebook's first code cell) and the cells "
+                         "that start the processes this cell needs, then run this cell again.")
 
 
 def time_limit(seconds: float | None) -> float | None:
@@ -112,7 +140,7 @@ def start(domain_id: int | None = None) -> None:
     from rclpy.signals import SignalHandlerOptions
     from rclpy.utilities import get_default_context
 
-    global _state, _atexit_registered
+    global _state, _atexit_registered, _stopped
     if domain_id is not None:
         rosenv.check_domain_id(domain_id)
     with _lock:
@@ -136,6 +164,8 @@ def start(domain_id: int | None = None) -> None:
         state.thread = threading.Thread(target=_spin, args=(state,), name="course_lib.session",
                                         daemon=True)
         _state = state
+        _stopped = False
+        _install_node_hook()
         state.thread.start()
         if not _atexit_registered:
             atexit.register(stop)
@@ -158,7 +188,7 @@ def stop(timeout: float = 2.0) -> None:
     Args:
         timeout: seconds to wait for a running callback to finish.
     """
-    global _state
+    global _state, _stopped
     with _lock:
         if _state is None:
             return
@@ -166,6 +196,7 @@ def stop(timeout: float = 2.0) -> None:
             _teardown(timeout)
         finally:
             _state = None
+            _stopped = True
 
 
 def _teardown(timeout: float) -> None:
@@ -285,6 +316,62 @@ def add_node(node):
         state.nodes[name] = node
         state.executor.add_node(node)
         return node
+
+
+def _install_node_hook() -> None:
+    """Make rclpy's Node.__init__ call _before_node_created first (once per process)."""
+    from rclpy.node import Node
+
+    original = Node.__init__
+    if getattr(original, "_course_lib_session_hook", False):
+        return
+
+    @functools.wraps(original)
+    def __init__(self, node_name, *args, **kwargs):
+        _before_node_created(node_name, kwargs.get("namespace"), kwargs.get("context"),
+                             kwargs.get("cli_args"))
+        original(self, node_name, *args, **kwargs)
+
+    __init__._course_lib_session_hook = True
+    Node.__init__ = __init__
+
+
+def _before_node_created(node_name, namespace, context, cli_args) -> None:
+    """Make room for a node about to be created: remove the session's node of that name.
+
+    Raises:
+        SessionStopped: the node would use the default context, which session.stop() shut down.
+    """
+    from rclpy.utilities import get_default_context
+
+    with _lock:
+        state = _state
+        if state is None:
+            if _stopped and context is None and not get_default_context().ok():
+                raise SessionStopped()
+            return
+        if (context is not None and context is not state.context) or not isinstance(node_name, str):
+            return
+        name = expected_name(node_name, namespace, cli_args)
+        if name in state.nodes:
+            _remove(state, name)
+
+
+def expected_name(node_name: str, namespace: str | None = None, cli_args=None) -> str:
+    """The fully-qualified name a node will get: "/ns/name", after ``__node``/``__ns`` remaps.
+
+    Args:
+        node_name: the name passed to Node().
+        namespace: the namespace passed to Node(); None or "" is the root namespace.
+        cli_args: the node's own arguments, e.g. ["--ros-args", "-r", "__ns:=/robot1"].
+    """
+    for arg in map(str, cli_args or ()):  # "-r __node:=x" or "-r talker:__node:=x"
+        if "__node:=" in arg:
+            node_name = arg.split("__node:=", 1)[1]
+        elif "__ns:=" in arg:
+            namespace = arg.split("__ns:=", 1)[1]
+    namespace = "/" + (namespace or "").strip("/")
+    return namespace.rstrip("/") + "/" + node_name
 
 
 def _alive_name(node) -> str:
