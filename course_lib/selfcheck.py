@@ -63,7 +63,8 @@ def task1_node_name(answer, expected_node: str = "my_node") -> Verdict:
 
 def task2_echo(messages, topic: str = "/chatter", text_prefix: str = "Hello World") -> Verdict:
     """Task 2 (lesson 01): messages echoed from the talker's topic, like `ros2 topic echo --once`."""
-    hint = f"Call graph.topic_echo({topic!r}) while the talker runs and store what it returns in echoed."
+    hint = ("Find the talker's topic (graph.topic_list() lists the topics), echo one message from it "
+            "and store what the echo returns in echoed.")
     if (result := _not_done(messages, hint)) is not None:
         return result
     if not isinstance(messages, (list, tuple)):
@@ -72,6 +73,12 @@ def task2_echo(messages, topic: str = "/chatter", text_prefix: str = "Hello Worl
         return _verdict(False, f"Nothing was echoed: is the talker running and publishing on {topic}? "
                                "Check graph.topic_list() for the topic's name.")
     first = messages[0]
+    if not hasattr(type(first), "get_fields_and_field_types"):
+        where = (" It looks like what the notebook's listener heard (listener.heard): that is the listener's "
+                 "record, not an echo." if isinstance(first, str) else "")
+        return _verdict(False, f"Got {first!r}, a {type(first).__name__}, not a ROS message.{where} Echo the "
+                               "topic yourself with graph.topic_echo: it returns a list of the messages it "
+                               "received.")
     data = getattr(first, "data", None)
     if not isinstance(data, str):
         return _verdict(False, f"Got a {type(first).__name__}, but {topic} carries std_msgs/msg/String: "
@@ -123,6 +130,10 @@ def task3_brightness_on_change(function) -> Verdict:
         (None, 120, 5, True, "nothing was sent yet (last_sent is None), so the first brightness must be "
                              "published: test `last_sent is None` first"),
         (100, 100, 5, False, "the brightness did not change, so nothing should be published"),
+        (0, 0, 5, False, "brightness 0 (a black frame) was sent last, and 0 again needs no message. 0 is "
+                         "a brightness, not 'nothing sent': test `last_sent is None`, not `not last_sent`"),
+        (0, 3, 5, False, "brightness 0 was sent last and a change of 3 is not more than 5. 0 is a "
+                         "brightness, not 'nothing sent': test `last_sent is None`, not `not last_sent`"),
         (100, 103, 5, False, "a change of 3 is not more than 5"),
         (100, 106, 5, True, "a rise of 6 is more than 5 and must be published"),
         (100, 94, 5, True, "a drop of 6 counts too: compare abs(current - last_sent) with threshold"),
@@ -175,6 +186,8 @@ def task4_order_corners(function) -> Verdict:
          "its bottom-right corner is higher than its top-left too, so 'the two highest points are the top' fails)",
          thin, (0, 2, 3, 1)),
         ("points already in order", [[15, 12], [95, 18], [92, 88], [10, 80]], (0, 1, 2, 3)),
+        # Two corners tie on x + y and two on y - x: either tied corner may come first.
+        ("a 3:1 rectangle turned by 45 degrees", [[80, 120], [100, 100], [160, 160], [140, 180]], (1, 3, 2, 0)),
     ]
     names = ("top-left", "top-right", "bottom-right", "bottom-left")
     for name, expected, shuffle in cases:
@@ -185,14 +198,28 @@ def task4_order_corners(function) -> Verdict:
             return problem
         if answer is None:
             return _verdict(False, "Not done yet: order_corners returns None. " + hint)
+        if not isinstance(answer, np.ndarray) or answer.shape != (4, 2):
+            what = (f"an array of shape {answer.shape}" if isinstance(answer, np.ndarray)
+                    else f"a {type(answer).__name__}")
+            return _verdict(False, f"order_corners should return a numpy array of shape (4, 2), which what follows "
+                                   f"indexes as corners[:, 0] and hands to cv2.getPerspectiveTransform; for {name} "
+                                   f"it returned {what}: {answer!r}. Build one with np.array(...).")
         try:
-            answer = np.asarray(answer, dtype=np.float32).reshape(4, 2)
+            answer = answer.astype(np.float32)
         except (TypeError, ValueError):
-            return _verdict(False, f"order_corners should return 4 points, a (4, 2) array; for {name} it "
-                                   f"returned {answer!r}.")
-        if np.allclose(answer, expected, atol=1e-3):
+            return _verdict(False, f"order_corners should return numbers; for {name} it returned {answer!r}.")
+        lowest = expected.sum(axis=1).min()
+        if any(np.allclose(answer, np.roll(expected, -k, axis=0), atol=1e-3)
+               for k in range(4) if expected[k].sum() <= lowest + 1e-3):
             continue
         matches = [next((i for i in range(4) if np.allclose(p, expected[i], atol=1e-3)), None) for p in answer]
+        if None not in matches and len(set(matches)) < 4:
+            twice = next(m for m in matches if matches.count(m) > 1)
+            return _verdict(False, f"For {name}, order_corners returned the point {expected[twice].tolist()} "
+                                   f"{matches.count(twice)} times and left out another one: {answer.tolist()}. "
+                                   "Taking the smallest and largest x + y and y - x picks one point twice when "
+                                   "two corners tie, as here; sort the points by their angle around the centre "
+                                   "instead (np.arctan2), then start at the smallest x + y.")
         if None in matches or sorted(matches) != [0, 1, 2, 3]:
             return _verdict(False, f"For {name}, order_corners returned {answer.tolist()}, which are not the four "
                                    f"points it was given ({given.tolist()}) in a new order: return the same points, "

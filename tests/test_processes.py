@@ -120,6 +120,29 @@ def test_node_in_another_namespace_is_not_mistaken(talker_dir, domain_id):
             talker.wait_for_node("talker", namespace="robot2", timeout=1.0)
 
 
+def test_wait_for_node_warns_when_another_program_runs_a_node_of_that_name(talker_dir, domain_id, capsys):
+    """A camera the previous lesson's kernel left running makes two nodes of one name: the new
+    one's wait_for_node says so plainly; a node that replaced its own earlier copy does not."""
+    from course_lib import session
+
+    session.start(domain_id=domain_id)
+    try:
+        with python_node("course_talker:main", cwd=talker_dir, domain_id=domain_id, name="left_running") as old:
+            old.wait_for_node("talker", timeout=30)
+            with python_node("course_talker:main", cwd=talker_dir, domain_id=domain_id, name="camera") as new:
+                new.wait_for_node("talker", timeout=30)
+                said = capsys.readouterr().out
+                assert "Warning: another node named /talker" in said and "Shut Down Kernel" in said, said
+                old.stop()
+                again = python_node("course_talker:main", cwd=talker_dir, domain_id=domain_id, name="camera")
+                with again:  # a re-run cell: it replaces `new`, whose node leaves the graph
+                    again.wait_for_node("talker", timeout=30)
+                    assert not new.running()
+        assert "Warning" not in capsys.readouterr().out
+    finally:
+        session.stop()
+
+
 def test_module_target_runs_with_arguments(tmp_path):
     """'package.module' runs as python -m with the given arguments."""
     (tmp_path / "echo_args.py").write_text("import sys\nprint('args', sys.argv[1:])\n")

@@ -57,6 +57,19 @@ def test_task2_verdicts():
     assert selfcheck.task2_echo(String(data="Hello World: 7")), "a single message (not a list) is fine too"
 
 
+def test_task2_stub_hint_does_not_give_the_answer_away():
+    """The hint points at how to find the topic, not at the finished call."""
+    hint = str(selfcheck.task2_echo(None))
+    assert "topic_list()" in hint and "/chatter" not in hint and "topic_echo(" not in hint
+
+
+def test_task2_what_the_listener_heard_is_not_an_echo():
+    """listener.heard[0] is the right topic's text but the wrong object: the verdict says so."""
+    verdict = selfcheck.task2_echo("Hello World: 3")
+    assert not verdict and "not a ROS message" in str(verdict) and "listener.heard" in str(verdict)
+    assert "right topic" not in str(verdict)
+
+
 # --- Task 3 (lesson 02): publish brightness only when it changes by more than a threshold -----
 
 def _publish_on_change(last_sent, current, threshold):
@@ -79,6 +92,7 @@ def test_task3_accepts_a_correct_filter():
     (lambda last, current, threshold: last is None or abs(int(current) - int(last)) >= threshold, "use >, not >="),
     (lambda last, current, threshold: last is None or abs(current - last) > threshold, "uint8 arithmetic wraps"),
     (lambda last, current, threshold: 1 / 0, "raised ZeroDivisionError"),
+    (lambda last, current, threshold: not last or abs(int(current) - int(last)) > threshold, "not `not last_sent`"),
 ])
 def test_task3_names_what_is_wrong(wrong, named):
     verdict = selfcheck.task3_brightness_on_change(wrong)
@@ -96,6 +110,15 @@ def _order_by_angle(points):
     return np.roll(points, -int(np.argmin(points.sum(axis=1))), axis=0)
 
 
+def _sum_and_difference(points):
+    """The well-known shortcut: top-left has the smallest x + y, top-right the smallest y - x, ..."""
+    import numpy as np
+
+    points = np.asarray(points, dtype=float)
+    total, difference = points.sum(axis=1), points[:, 1] - points[:, 0]
+    return points[[total.argmin(), difference.argmin(), total.argmax(), difference.argmax()]]
+
+
 def test_task4_stub_and_correct_answer():
     assert "Not done yet" in str(selfcheck.task4_order_corners(None))
     assert "Not done yet" in str(selfcheck.task4_order_corners(lambda points: None))
@@ -106,7 +129,9 @@ def test_task4_stub_and_correct_answer():
     (lambda p: _order_by_angle(p)[[0, 3, 2, 1]], "anticlockwise"),
     (lambda p: __import__("numpy").roll(_order_by_angle(p), 1, axis=0), "starts at the bottom-left"),
     (lambda p: _order_by_angle(p) * 2, "not the four points it was given"),
-    (lambda p: [1, 2, 3], "(4, 2) array"),
+    (lambda p: [1, 2, 3], "numpy array of shape (4, 2)"),
+    (lambda p: [tuple(corner) for corner in _order_by_angle(p)], "numpy array of shape (4, 2)"),
+    (lambda p: _sum_and_difference(p), "picks one point twice"),
 ])
 def test_task4_names_what_is_wrong(wrong, named):
     verdict = selfcheck.task4_order_corners(wrong)
