@@ -188,7 +188,12 @@ def running_jupyterlab(root_dir: Path, state_dir: Path, timeout: float = 120):
         target = settings_dir / name
         target.parent.mkdir(parents=True, exist_ok=True)
         target.write_text(json.dumps(values))
+    from course_lib import student_lab
+
     env = dict(os.environ,
+               # As `make lab` does: nbgrader's student side only (course_lib/student_lab).
+               JUPYTER_CONFIG_PATH=os.pathsep.join(filter(None, [str(student_lab.CONFIG_DIR),
+                                                                  os.environ.get("JUPYTER_CONFIG_PATH")])),
                JUPYTERLAB_SETTINGS_DIR=str(settings_dir),
                JUPYTERLAB_WORKSPACES_DIR=str(state_dir / "workspaces"),
                JUPYTER_RUNTIME_DIR=str(state_dir / "runtime"))

@@ -6,6 +6,7 @@ checker's own small notebooks, which prove that the checker passes a good notebo
 one that raises. Screenshots go to artifacts/browser/<notebook>.png.
 """
 
+import json
 import shutil
 from pathlib import Path
 
@@ -71,6 +72,24 @@ def test_course_notebook_runs_clean_in_jupyterlab(notebook, browser, lab):
     screenshot = SCREENSHOTS / (notebook.removesuffix(".ipynb").replace("/", "__") + ".png")
     run = run_in_lab(browser, lab, f"notebooks/{notebook}", screenshot)
     assert not run.problems(), f"{notebook} in JupyterLab (screenshot {screenshot}):\n" + "\n".join(run.problems())
+
+
+def test_the_students_lab_has_no_instructor_side(lab):
+    """Like `make lab`: no Create Assignment sidebar, formgrader or course list; Validate and the
+    assignment list stay (nbgrader's server extensions and JupyterLab's page config)."""
+    import urllib.error
+    import urllib.request
+
+    page = urllib.request.urlopen(f"{lab.url}/lab?token={lab.token}", timeout=30).read().decode()
+    disabled = json.loads(page.split('id="jupyter-config-data"', 1)[1].split(">", 1)[1].split("</script>", 1)[0])[
+        "disabledExtensions"]
+    assert {"@jupyter/nbgrader:create-assignment", "@jupyter/nbgrader:formgrader",
+            "@jupyter/nbgrader:course-list"} <= set(disabled)
+    assert not any("validate" in name or "assignment-list" in name for name in disabled)
+    with pytest.raises(urllib.error.HTTPError, match="404"):
+        urllib.request.urlopen(f"{lab.url}/formgrader?token={lab.token}", timeout=30)
+    version = urllib.request.urlopen(f"{lab.url}/nbgrader_version?version=x&token={lab.token}", timeout=30)
+    assert "server version is" in version.read().decode()  # the validate/assignment-list extensions answer
 
 
 # --- the checker itself ---------------------------------------------------------------------
