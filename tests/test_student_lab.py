@@ -20,24 +20,19 @@ def test_make_lab_puts_the_student_config_on_the_jupyter_config_path():
     assert student_lab.CONFIG_DIR == ROOT / "course_lib" / "student_lab"
 
 
-def _validator():
-    """nbgrader's Validator configured as the Validate button's server handler configures it
-    (the lab's working directory holds nbgrader_config.py)."""
+def test_validate_on_a_lesson_points_at_its_self_checks(tmp_path):
+    """The lab's nbgrader_config.py, loaded as the Validate button's server handler loads it,
+    makes nbgrader's executor refuse a lesson (no nbgrader cells) with its task still a stub,
+    before any cell runs, instead of answering 'Success'."""
     from nbgrader.apps import NbGrader
-    from nbgrader.validator import Validator
 
     app = NbGrader()
-    app.config_file_paths.append([str(ROOT)])
+    app.config_file_paths.append([str(ROOT)])  # the handler adds the lab's working directory
     app.load_config_file()
-    return Validator(config=app.config)
-
-
-def test_validate_on_a_lesson_points_at_its_self_checks(tmp_path):
-    """A lesson (no nbgrader cells) with its task still a stub is not 'Success'."""
-    lesson = tmp_path / "lesson.ipynb"
-    nbformat.write(nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell("answer = None  # TODO")]), lesson)
+    hook = app.config.Execute.on_notebook_start
+    lesson = nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell("answer = None  # TODO")])
     with pytest.raises(student_lab.NotAnAssignment, match="self-check cell"):
-        _validator().validate(str(lesson))
+        hook(notebook=lesson)
 
 
 def test_assignments_are_told_from_lessons():
