@@ -45,7 +45,7 @@ import time
 import traceback
 from typing import Callable
 
-from course_lib import rosenv
+from course_lib import node_logs, rosenv
 
 #: Name of the session's hidden helper node (a leading "_" hides it from node listings).
 TOOL_NODE_NAME = "_course_tools"
@@ -158,7 +158,10 @@ def start(domain_id: int | None = None) -> None:
             rclpy.try_shutdown()
             # No rclpy signal handlers: in Jupyter, "interrupt kernel" must stop the cell,
             # not shut ROS down under the background executor.
-            rclpy.init(domain_id=domain_id, signal_handler_options=SignalHandlerOptions.NO)
+            # In a Jupyter kernel, log lines are shown under the cell that added their node
+            # (course_lib.node_logs) instead of on the console, which is any cell that runs.
+            rclpy.init(args=node_logs.init_arguments() or None, domain_id=domain_id,
+                       signal_handler_options=SignalHandlerOptions.NO)
             context = get_default_context()
         state = _State(context, SingleThreadedExecutor(context=context))
         state.thread = threading.Thread(target=_spin, args=(state,), name="course_lib.session",
@@ -281,7 +284,8 @@ def add_node(node):
     """Spin ``node`` in the background; a node of the same full name is replaced.
 
     Re-running a cell that creates and adds a node therefore leaves one node, not two: the
-    old one is removed from the executor and destroyed.
+    old one is removed from the executor and destroyed. In a Jupyter kernel the node's log lines
+    appear under this cell (course_lib.node_logs).
 
     Args:
         node: an rclpy Node created after session.start() (or after rclpy.init()).
@@ -315,7 +319,8 @@ def add_node(node):
             _remove(state, name)
         state.nodes[name] = node
         state.executor.add_node(node)
-        return node
+    node_logs.attach(node)
+    return node
 
 
 def _install_node_hook() -> None:
