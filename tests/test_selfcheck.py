@@ -2,7 +2,7 @@
 
 import pytest
 from rclpy.node import Node
-from std_msgs.msg import Int32, String
+from std_msgs.msg import Header, Int32, String
 
 from course_lib import graph, selfcheck, session
 
@@ -149,3 +149,108 @@ def test_task4_catches_taking_the_two_highest_points_as_the_top():
 
     verdict = selfcheck.task4_order_corners(two_highest_are_top)
     assert not verdict and "long rectangle tilted by 30 degrees" in str(verdict)
+
+
+# --- the exercises of lessons 01 (a publisher) and 01b (the MsgTutorial subscriber) -----------
+
+def _announcer(period=0.5, topic="announcements", text="Announcement {}", msg_type=None, publish=True):
+    """A publisher node class for the lesson 01 exercise, right by default, wrong as asked."""
+    from std_msgs.msg import String
+
+    class Announcer(Node):
+        def __init__(self):
+            super().__init__("announcer")
+            self.count = 0
+            self.publisher = self.create_publisher(msg_type or String, topic, 10)
+            if publish:
+                self.create_timer(period, self.announce)
+
+        def announce(self):
+            self.publisher.publish(String(data=text.format(self.count)))
+            self.count += 1
+
+    return Announcer
+
+
+class AnnouncerStub(Node):
+    def __init__(self):
+        super().__init__("announcer")
+        self.count = 0
+        # TODO: a publisher and a timer
+
+
+@pytest.fixture
+def exercise_session(domain_id, monkeypatch):
+    monkeypatch.setattr(graph, "SETTLE_SECONDS", 0)
+    session.start(domain_id=domain_id)
+    yield
+    session.stop()
+
+
+def test_publisher_exercise_passes_a_correct_node(exercise_session):
+    verdict = selfcheck.publisher_exercise(_announcer())
+    assert verdict, verdict
+    assert session.nodes() == []  # the check removes the node it ran
+
+
+@pytest.mark.parametrize("answer, named", [
+    (None, "Not done yet"),
+    (AnnouncerStub, "Not done yet: the node has no publisher"),
+    (_announcer(topic="announcement"), "not on /announcements"),
+    (_announcer(publish=False), "No message arrived"),
+    (_announcer(text="Announcement"), "'Announcement 0', then"),
+    (_announcer(period=0.1), "every 0.5 s"),
+])
+def test_publisher_exercise_names_what_is_wrong(exercise_session, answer, named):
+    verdict = selfcheck.publisher_exercise(answer)
+    assert not verdict and named in str(verdict), verdict
+
+
+def _tutorial_listener(keep, topic="ros_tutorial_msg", msg_type=Header):
+    class TutorialListener(Node):
+        def __init__(self):
+            super().__init__("tutorial_listener")
+            self.received = []
+            self.create_subscription(msg_type, topic, self.on_message, 100)
+
+        def on_message(self, msg):
+            self.received.append(keep(msg))
+
+    return TutorialListener
+
+
+def _stamp(msg):
+    return msg.stamp.sec + msg.stamp.nanosec * 1e-9
+
+
+class ListenerStub(Node):
+    def __init__(self):
+        super().__init__("tutorial_listener")
+        self.received = []
+
+
+@pytest.mark.parametrize("answer, named", [
+    (_tutorial_listener(lambda msg: (_stamp(msg), int(msg.frame_id))), None),
+    (None, "Not done yet"),
+    (ListenerStub, "Not done yet: the node has no subscription"),
+    (_tutorial_listener(lambda msg: (msg.stamp.sec, int(msg.frame_id))), "lost its nanoseconds"),
+    (_tutorial_listener(lambda msg: (int(msg.frame_id), _stamp(msg))), "(stamp, data), not (data, stamp)"),
+    (_tutorial_listener(lambda msg: (_stamp(msg), int(msg.frame_id)), topic="chatter"), "not to /ros_tutorial_msg"),
+    (_tutorial_listener(lambda msg: (_stamp(msg), 0)), "has none of them"),
+])
+def test_subscriber_exercise(exercise_session, answer, named):
+    """Header stands in for MsgTutorial (its counter in frame_id), as in lesson 01b without a build."""
+    verdict = selfcheck.subscriber_exercise(answer, Header)
+    if named is None:
+        assert verdict, verdict
+    else:
+        assert not verdict and named in str(verdict), verdict
+
+
+def test_subscriber_exercise_with_a_data_field(exercise_session):
+    """With a message that has a data field (as MsgTutorial has), data is the counter."""
+    from builtin_interfaces.msg import Time  # noqa: F401 (Header's stamp type)
+    from std_msgs.msg import Int32
+
+    wrong_type = _tutorial_listener(lambda msg: (_stamp(msg), msg.data), msg_type=Int32)
+    assert "sends std_msgs/msg/Header" in str(selfcheck.subscriber_exercise(wrong_type, Header))
