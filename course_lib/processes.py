@@ -449,7 +449,10 @@ class NodeProcess:
     Args:
         command: the program and its arguments, e.g. ``[sys.executable, "-m", "pkg.node"]``.
         name: a label for messages. When given explicitly, starting a NodeProcess stops a
-            running one of the same name first, so re-running a notebook cell replaces its node.
+            running one of the same name first, so re-running a notebook cell replaces its node;
+            and when another program (a notebook whose kernel still runs) runs one of that name
+            in the same domain, start() prints a plain warning that names it
+            (course_lib.process_registry).
         domain_id: ROS_DOMAIN_ID of the child; None keeps the caller's.
         env: variables to set for the child on top of the caller's environment (a value of
             None removes a variable).
@@ -498,6 +501,7 @@ class NodeProcess:
         self.pid: int | None = None
         self.exit_reason: str | None = None
         self.usage: dict | None = None
+        self.warned_duplicate = False  # start() said that another program runs one of this name
         self._supervisor: subprocess.Popen | None = None
         self._control: int | None = None
         self._status: int | None = None
@@ -572,6 +576,8 @@ class NodeProcess:
             event = self._next_event(START_TIMEOUT)
             if event and event.get("event") == "started":
                 self.pid = event["pid"]
+                if self._explicit_name:
+                    self._note_running()
                 return self
             if event and event.get("event") == "error":
                 self._poll(wait=True)
@@ -709,7 +715,7 @@ class NodeProcess:
                 # The graph is filled in by DDS discovery threads; no spinning needed to read it.
                 if any(name == node_name and namespace in (None, ns)
                        for name, ns in watcher.get_node_names_and_namespaces()):
-                    if already_running:
+                    if already_running and not self.warned_duplicate:
                         _warn_if_still_running(already_running, self)
                     return
                 if not self.running():
@@ -813,6 +819,25 @@ class NodeProcess:
             self._remove_dirs()
             with _RUNNING_LOCK:
                 _RUNNING.discard(self)
+            if self._explicit_name:
+                from course_lib import process_registry
+
+                process_registry.forget(self.pid)
+
+    def _note_running(self) -> None:
+        """Record this named process machine-wide, and warn plainly when another program (a
+        notebook whose kernel still runs) runs one of the same name in the same domain."""
+        from course_lib import process_registry
+
+        others = process_registry.started_elsewhere(self.name, self.domain_id)
+        process_registry.record(self.name, self.domain_id, self.pid)
+        if others:
+            self.warned_duplicate = True
+            print(f"Warning: another node process named {self.name!r} runs in ROS domain {self.domain_id}, "
+                  f"started by {process_registry.describe(others[0])}. Both publish on the same topics, so "
+                  "subscribers get their messages mixed (two cameras: frames from both). Stop the other one: "
+                  "run the clean-up cell of that notebook or shut its kernel down (Kernel > Shut Down Kernel, "
+                  "or the Running Terminals and Kernels panel), then run this cell again.", flush=True)
 
     def _disown(self) -> None:
         self._lock = threading.RLock()
