@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import collections
 import threading
+import time
 
 #: Lines kept (and shown) per node; older ones are dropped from the view, not from /rosout.
 MAX_LINES = 200
@@ -29,16 +30,22 @@ EXPLANATION = ("ROS log lines of the nodes this cell added (they also go to /ros
 LEVELS = {10: "DEBUG", 20: "INFO", 30: "WARN", 40: "ERROR", 50: "FATAL"}
 
 _lock = threading.Lock()
-_views: dict[str, "_NodeLog"] = {}  # logger name -> where its lines go
+_views: dict[str, list["_NodeLog"]] = {}  # logger name -> the views of its nodes, oldest first
 _subscribed_node = None  # the tool node that holds the /rosout subscription
 _explained = False
 
 
 class _NodeLog:
-    def __init__(self, widget):
-        self.widget = widget
+    def __init__(self, since: float):
+        self.widget = None  # set by attach(); lines logged before (in __init__) wait here
+        self.since = since  # the node's creation (wall clock): its lines are stamped after it
         self.lines: collections.deque[str] = collections.deque(maxlen=MAX_LINES)
         self.explain = False
+
+    def render(self) -> None:
+        if self.widget is not None and self.lines:
+            shown = ([EXPLANATION] if self.explain else []) + list(self.lines)
+            self.widget.outputs = ({"output_type": "stream", "name": "stdout", "text": "\n".join(shown) + "\n"},)
 
 
 def in_kernel() -> bool:
@@ -56,10 +63,31 @@ def init_arguments() -> list[str]:
     return ["--ros-args", "--disable-stdout-logs"] if in_kernel() else []
 
 
-def attach(node) -> None:
-    """Show the log lines of ``node`` under the current cell from now on (inside a kernel).
+def logger_name(full_name: str) -> str:
+    """The logger name of a node: "/robot1/talker" logs as "robot1.talker"."""
+    return full_name.strip("/").replace("/", ".")
 
-    A node added again under the same name (a re-run cell) moves its lines to the new cell.
+
+def expect(full_name: str, since: float) -> None:
+    """A node of this name is being created now: lines stamped from ``since`` on are its own,
+    also those its __init__ logs before attach() (an older node of the same name keeps its lines)."""
+    if in_kernel():
+        with _lock:
+            _add_view(logger_name(full_name), since)
+
+
+def _add_view(name: str, since: float) -> "_NodeLog":
+    view = _NodeLog(since)
+    _views[name] = [v for v in _views.get(name, []) if v.since < since][-3:] + [view]
+    return view
+
+
+def attach(node, since: float | None = None) -> None:
+    """Show the log lines of ``node`` under the current cell (inside a kernel).
+
+    Args:
+        node: a node the session spins.
+        since: the time given to expect() when the node was created; None: from now on.
     """
     if not in_kernel() or node.get_name().startswith("_") or \
             threading.current_thread() is not threading.main_thread():
@@ -67,18 +95,23 @@ def attach(node) -> None:
     import ipywidgets
     from IPython.display import display
 
-    _subscribe()
-    view = _NodeLog(ipywidgets.Output(layout={"max_height": "20em", "overflow": "auto"}))
+    name = node.get_logger().name
+    widget = ipywidgets.Output(layout={"max_height": "20em", "overflow": "auto"})
     with _lock:
-        _views[node.get_logger().name] = view
-    display(view.widget)
+        view = next((v for v in _views.get(name, ()) if since is not None and v.since == since), None)
+        if view is None:
+            view = _add_view(name, time.time())
+        view.widget = widget
+        view.render()
+    display(widget)
+    _subscribe()
 
 
 def text(name: str) -> str:
-    """The kept log lines of the node whose logger (or plain node name) is ``name``."""
+    """The kept log lines of the newest node whose logger (or plain node name) is ``name``."""
     with _lock:
-        view = _views.get(name) or _views.get(name.strip("/").replace("/", "."))
-        return "\n".join(view.lines) if view is not None else ""
+        views = _views.get(name) or _views.get(name.strip("/").replace("/", "."))
+        return "\n".join(views[-1].lines) if views else ""
 
 
 def _subscribe() -> None:
@@ -106,14 +139,18 @@ def format_record(record) -> str:
     return f"[{level}] [{record.stamp.sec}.{record.stamp.nanosec:09d}] [{record.name}]: {record.msg}"
 
 
+def _stamp(record) -> float:
+    return record.stamp.sec + record.stamp.nanosec * 1e-9
+
+
 def _on_record(record) -> None:
     global _explained
     with _lock:
-        view = _views.get(record.name)
-        if view is None:
+        views = [v for v in _views.get(record.name, ()) if v.since <= _stamp(record)]
+        if not views:
             return
+        view = views[-1]
         if not _explained:
             view.explain = _explained = True
         view.lines.append(format_record(record))
-        shown = ([EXPLANATION] if view.explain else []) + list(view.lines)
-    view.widget.outputs = ({"output_type": "stream", "name": "stdout", "text": "\n".join(shown) + "\n"},)
+        view.render()

@@ -71,6 +71,7 @@ class _State:
         self.thread: threading.Thread | None = None
         self.nodes: dict[str, object] = {}  # fully-qualified name -> node, in order added
         self.tool = None
+        self.created_at: dict[str, float] = {}  # fully-qualified name -> time.time() of its last creation
         self.stopping = threading.Event()
         # Held by the background thread while it waits or runs a callback, so that a node is
         # destroyed only between two rounds of the executor.
@@ -319,7 +320,8 @@ def add_node(node):
             _remove(state, name)
         state.nodes[name] = node
         state.executor.add_node(node)
-    node_logs.attach(node)
+        since = state.created_at.pop(name, None)
+    node_logs.attach(node, since)
     return node
 
 
@@ -358,6 +360,8 @@ def _before_node_created(node_name, namespace, context, cli_args) -> None:
         if (context is not None and context is not state.context) or not isinstance(node_name, str):
             return
         name = expected_name(node_name, namespace, cli_args)
+        state.created_at[name] = time.time()
+        node_logs.expect(name, state.created_at[name])  # lines stamped from now on are the new node's
         if name in state.nodes:
             _remove(state, name)
 

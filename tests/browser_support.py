@@ -362,6 +362,7 @@ class NotebookRun:
         stderr_outputs: number of outputs rendered as stderr (warnings, logs and errors alike).
         seconds: time from clicking Run All Cells until the kernel was idle again.
         screenshot: where the full-page screenshot was saved (None when not asked for).
+        outputs: the text each code cell's output area shows (widgets' text included).
     """
 
     path: str
@@ -374,6 +375,7 @@ class NotebookRun:
     stderr_outputs: int
     seconds: float
     screenshot: Path | None = None
+    outputs: list[str] = dataclasses.field(default_factory=list)
 
     @property
     def unexecuted(self) -> list[str]:
@@ -396,6 +398,7 @@ _PAGE_STATE_JS = """
   const panel = document.querySelector(notebookSelector);
   const codeCells = [...panel.querySelectorAll('.jp-Notebook .jp-CodeCell')];
   const prompts = codeCells.map(c => (c.querySelector('.jp-InputArea-prompt') || {}).innerText || '');
+  const outputs = codeCells.map(c => (c.querySelector('.jp-Cell-outputArea') || {}).innerText || '');
   const images = [];
   codeCells.forEach((c, i) => c.querySelectorAll('.jp-OutputArea img').forEach(img =>
       images.push({cell: i, ok: img.complete && img.naturalWidth > 0})));
@@ -415,7 +418,7 @@ _PAGE_STATE_JS = """
       if (imageMimes.some(m => m in data)) imageOutputs += 1;
     }
   }
-  return {prompts, images, errors, imageOutputs, stderr};
+  return {prompts, images, errors, imageOutputs, stderr, outputs};
 }
 """
 
@@ -468,7 +471,8 @@ def run_notebook(page, path: str, code_cells: int, timeout: float, screenshot: P
     run = NotebookRun(
         path=path, code_cells=code_cells, prompts=state["prompts"], errors=state["errors"],
         images=len(state["images"]), broken_images=[f"cell {i['cell']}" for i in state["images"] if not i["ok"]],
-        image_outputs=state["imageOutputs"], stderr_outputs=state["stderr"], seconds=seconds)
+        image_outputs=state["imageOutputs"], stderr_outputs=state["stderr"], seconds=seconds,
+        outputs=state["outputs"])
     if screenshot is not None:
         save_full_notebook_screenshot(page, screenshot)
         run.screenshot = screenshot

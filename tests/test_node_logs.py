@@ -17,6 +17,7 @@ class Hello(Node):
         super().__init__("hello")
         self.count = 0
         self.create_timer(0.05, self.tick)
+        self.get_logger().info("created")
 
     def tick(self):
         self.get_logger().info(f"hi {self.count}")
@@ -26,6 +27,7 @@ hello = session.add_node(Hello())
 session.spin_for(0.5)""",
     "session.spin_for(0.5)\nprint('the next cell')",
     "print(node_logs.text('hello').splitlines()[0])",
+    "hello = session.add_node(Hello())  # the first cell, re-run",
 ]
 
 
@@ -38,13 +40,19 @@ def test_log_lines_stay_with_the_cell_that_added_the_node(domain_id, monkeypatch
     outputs = [cell.outputs for cell in notebook.cells]
     assert not any(output.get("name") == "stderr" for cell in outputs for output in cell), outputs
     assert outputs[1] == [nbformat.v4.new_output("stream", name="stdout", text="the next cell\n")]
-    assert "[INFO]" in outputs[2][0].text and "[hello]: hi 0" in outputs[2][0].text
+    assert outputs[2][0].text.startswith("[INFO] [") and "[hello]: created" in outputs[2][0].text
     widgets = notebook.metadata["widgets"]["application/vnd.jupyter.widget-state+json"]["state"]
     shown = [model["state"]["outputs"] for model in widgets.values() if model["model_name"] == "OutputModel"]
-    assert len(shown) == 1 and shown[0][0]["text"].startswith(node_logs.EXPLANATION)
+    assert len(shown) == 2 and shown[0][0]["text"].startswith(node_logs.EXPLANATION)
     assert "[hello]: hi 3" in shown[0][0]["text"]
-    displayed = [output for output in outputs[0] if output.output_type == "display_data"]
-    assert len(displayed) == 1  # the widget sits in the cell that added the node
+    first = [output for output in outputs[0] if output.output_type == "display_data"]
+    again = [output for output in outputs[3] if output.output_type == "display_data"]
+    assert len(first) == len(again) == 1  # each widget sits in the cell that added its node
+    texts = {model_id: model["state"]["outputs"][0]["text"] for model_id, model in widgets.items()
+             if model["model_name"] == "OutputModel"}
+    for displayed in (first[0], again[0]):
+        text = texts[displayed.data["application/vnd.jupyter.widget-view+json"]["model_id"]]
+        assert text.count("[hello]: created") == 1, texts  # the re-run's __init__ line is its own
 
 
 def test_outside_a_kernel_the_console_keeps_the_lines():
