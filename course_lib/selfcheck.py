@@ -237,12 +237,14 @@ def task4_order_corners(function) -> Verdict:
                           "bottom-left, for tilted and perspective shapes too.")
 
 
-def _exercise_node(node_or_class, class_name: str):
+def _exercise_node(node_or_class, class_name: str, hint: str):
     """(node added to the session, None) or (None, a Verdict) for a student's Node class or instance."""
     from rclpy.node import Node
 
     from course_lib import session
 
+    if (result := _not_done(node_or_class, hint)) is not None:
+        return None, result
     if isinstance(node_or_class, type) and issubclass(node_or_class, Node):
         try:
             node = node_or_class()
@@ -274,9 +276,7 @@ def publisher_exercise(node_or_class, topic: str = "/announcements", prefix: str
 
     hint = (f"Pass your node class; in __init__ create a publisher of String on {topic.lstrip('/')!r} and a "
             f"timer of {period} s whose callback publishes '{prefix}0', '{prefix}1', ...")
-    if (result := _not_done(node_or_class, hint)) is not None:
-        return result
-    node, problem = _exercise_node(node_or_class, "Announcer")
+    node, problem = _exercise_node(node_or_class, "Announcer", hint)
     if problem is not None:
         return problem
     tool = session.tool_node()
@@ -336,9 +336,7 @@ def subscriber_exercise(node_or_class, msg_type, topic: str = "/ros_tutorial_msg
 
     hint = (f"Pass your node class; in __init__ set self.received = [] and subscribe to {topic.lstrip('/')!r}; "
             "the callback appends (stamp in seconds, data) for each message.")
-    if (result := _not_done(node_or_class, hint)) is not None:
-        return result
-    node, problem = _exercise_node(node_or_class, "TutorialListener")
+    node, problem = _exercise_node(node_or_class, "TutorialListener", hint)
     if problem is not None:
         return problem
     fields = msg_type.get_fields_and_field_types()
