@@ -63,8 +63,10 @@ ALLOW_ROOT := $(if $(filter 0,$(shell id -u)),--allow-root)
 # venv's bin/ goes first on PATH, so they find its commands (`ros2` on the pip install, python,
 # colcon) as in an activated venv. Terminals run $SHELL without -l: a login shell would read
 # /etc/profile, which sets PATH anew.
+# JUPYTER_CONFIG_PATH: a student's lab shows nbgrader's student side only (course_lib/student_lab).
 lab: setup
 	eval "$$($(PY) -m course_lib env)" && PATH="$(CURDIR)/$(VENV)/bin:$$PATH" VIRTUAL_ENV="$(CURDIR)/$(VENV)" \
+	JUPYTER_CONFIG_PATH="$(CURDIR)/course_lib/student_lab$${JUPYTER_CONFIG_PATH:+:$$JUPYTER_CONFIG_PATH}" \
 	exec $(VENV)/bin/jupyter lab --no-browser --ip=127.0.0.1 --port=$(LAB_PORT) $(ALLOW_ROOT) \
 	  --ServerApp.root_dir="$(CURDIR)" --LabApp.default_url=/lab/tree/notebooks \
 	  --ServerApp.terminado_settings='{"shell_command": ["'"$${SHELL:-/bin/bash}"'"]}'

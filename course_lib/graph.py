@@ -711,6 +711,35 @@ def topic_info(topic: str, verbose: bool = True, timeout: float = 2.0) -> TopicI
         subscriptions=[_endpoint(s) for s in subscriptions] if verbose else [])
 
 
+class NoPublisher(LookupError):
+    """Nothing publishes on a topic that a cell is about to wait on."""
+
+
+def wait_for_publisher(topic: str, timeout: float = 3.0, hint: str = "") -> int:
+    """Wait until some node publishes on ``topic``; say plainly when none does.
+
+    ``ros2 topic info TOPIC`` shows the same count. Call it before waiting for messages, so
+    that "0 messages received" is not mistaken for a bug in the subscriber.
+
+    Args:
+        topic: the topic name.
+        timeout: seconds to wait for a publisher to appear.
+        hint: what to run to start the publisher, added to the error.
+
+    Returns:
+        How many publishers there are.
+
+    Raises:
+        NoPublisher: no publisher appeared within timeout seconds.
+    """
+    node = _graph_node()
+    name = node.resolve_topic_name(topic)
+    if _wait_until(lambda: node.count_publishers(name) > 0, timeout):
+        return node.count_publishers(name)
+    raise NoPublisher(f"No node publishes on {name} (ros2 topic info {name}: Publisher count: 0), so nothing "
+                      f"can arrive there.{' ' + hint if hint else ''}")
+
+
 def _format_duration(seconds: float) -> str:
     return "Infinite" if math.isinf(seconds) else f"{round(seconds * 1e9)} nanoseconds"
 

@@ -449,7 +449,10 @@ class NodeProcess:
     Args:
         command: the program and its arguments, e.g. ``[sys.executable, "-m", "pkg.node"]``.
         name: a label for messages. When given explicitly, starting a NodeProcess stops a
-            running one of the same name first, so re-running a notebook cell replaces its node.
+            running one of the same name first, so re-running a notebook cell replaces its node;
+            and when another program (a notebook whose kernel still runs) runs one of that name
+            in the same domain, start() prints a plain warning that names it
+            (course_lib.process_registry).
         domain_id: ROS_DOMAIN_ID of the child; None keeps the caller's.
         env: variables to set for the child on top of the caller's environment (a value of
             None removes a variable).
@@ -498,6 +501,7 @@ class NodeProcess:
         self.pid: int | None = None
         self.exit_reason: str | None = None
         self.usage: dict | None = None
+        self.warned_duplicate = False  # start() said that another program runs one of this name
         self._supervisor: subprocess.Popen | None = None
         self._control: int | None = None
         self._status: int | None = None
@@ -572,6 +576,8 @@ class NodeProcess:
             event = self._next_event(START_TIMEOUT)
             if event and event.get("event") == "started":
                 self.pid = event["pid"]
+                if self._explicit_name:
+                    self._note_running()
                 return self
             if event and event.get("event") == "error":
                 self._poll(wait=True)
@@ -696,6 +702,7 @@ class NodeProcess:
         elif namespace is not None:
             namespace = "/" + namespace.strip("/")
         wanted = node_name if namespace is None else f"{namespace.rstrip('/')}/{node_name}"
+        already_running = _in_session_graph(node_name, namespace, self.domain_id)
         context = Context()
         rclpy.init(context=context, domain_id=self.domain_id)
         watcher = None
@@ -708,6 +715,8 @@ class NodeProcess:
                 # The graph is filled in by DDS discovery threads; no spinning needed to read it.
                 if any(name == node_name and namespace in (None, ns)
                        for name, ns in watcher.get_node_names_and_namespaces()):
+                    if already_running and not self.warned_duplicate:
+                        _warn_if_still_running(already_running, self)
                     return
                 if not self.running():
                     raise RuntimeError(f"{self.name} ended ({self.describe_exit()}) before node {wanted!r} "
@@ -810,6 +819,25 @@ class NodeProcess:
             self._remove_dirs()
             with _RUNNING_LOCK:
                 _RUNNING.discard(self)
+            if self._explicit_name:
+                from course_lib import process_registry
+
+                process_registry.forget(self.pid)
+
+    def _note_running(self) -> None:
+        """Record this named process machine-wide, and warn plainly when another program (a
+        notebook whose kernel still runs) runs one of the same name in the same domain."""
+        from course_lib import process_registry
+
+        others = process_registry.started_elsewhere(self.name, self.domain_id)
+        process_registry.record(self.name, self.domain_id, self.pid)
+        if others:
+            self.warned_duplicate = True
+            print(f"Warning: another node process named {self.name!r} runs in ROS domain {self.domain_id}, "
+                  f"started by {process_registry.describe(others[0])}. Both publish on the same topics, so "
+                  "subscribers get their messages mixed (two cameras: frames from both). Stop the other one: "
+                  "run the clean-up cell of that notebook or shut its kernel down (Kernel > Shut Down Kernel, "
+                  "or the Running Terminals and Kernels panel), then run this cell again.", flush=True)
 
     def _disown(self) -> None:
         self._lock = threading.RLock()
@@ -847,6 +875,54 @@ class NodeProcess:
             if directory is not None:
                 shutil.rmtree(directory, ignore_errors=True)
         self._home_dir = None
+
+
+#: Seconds a node of the same name that ran before a new node process started may take to
+#: leave the graph (a re-run cell stopped it a moment ago) before wait_for_node warns.
+DUPLICATE_GRACE = 2.0
+
+
+def _in_session_graph(node_name: str, namespace: str | None, domain_id: int) -> dict[str, str]:
+    """The nodes of this name that the notebook's ROS session sees (none when no session runs
+    on this domain), as {id of the node's /rosout publisher: full node name}. Node names are not
+    unique; the publisher id tells one node from another of the same name."""
+    from course_lib import graph, session
+
+    if not session.is_running() or session.tool_node().context.get_domain_id() != domain_id:
+        return {}
+    graph.node_list()  # the first query waits for discovery
+    return {str(endpoint.endpoint_gid): full for endpoint, full in _rosout_publishers(session.tool_node())
+            if full.rsplit("/", 1)[-1] == node_name
+            and (namespace is None or full == f"{namespace.rstrip('/')}/{node_name}")}
+
+
+def _rosout_publishers(node):
+    """(endpoint, full node name) of every /rosout publisher: one per node with a logger."""
+    for endpoint in node.get_publishers_info_by_topic("/rosout"):
+        yield endpoint, f"{endpoint.node_namespace.rstrip('/')}/{endpoint.node_name}"
+
+
+def _warn_if_still_running(earlier: dict[str, str], process: "NodeProcess") -> None:
+    """Print a plain warning when a node of the same name ran before this process started and
+    still runs next to its node, e.g. a camera that the previous lesson's kernel left running:
+    two cameras on one topic mix their frames."""
+    from course_lib import session
+
+    deadline = time.monotonic() + DUPLICATE_GRACE
+    while True:
+        still = {str(endpoint.endpoint_gid) for endpoint, _ in _rosout_publishers(session.tool_node())} & set(earlier)
+        if not still:
+            return  # it has left: a re-run cell replaced it a moment ago
+        if time.monotonic() >= deadline:
+            break
+        time.sleep(0.1)
+    full = earlier[next(iter(still))]
+    print(f"Warning: another node named {full} runs in ROS domain {process.domain_id}: it was already running "
+          f"before {process.name} started, from another program, most likely another notebook whose kernel "
+          "still runs (an earlier lesson left without its clean-up cell) or a terminal. Both publish on the "
+          "same topics, so subscribers get their messages mixed (two cameras: frames from both). Stop the "
+          "other one: run the clean-up cell of that notebook or shut its kernel down (Kernel > Shut Down "
+          "Kernel, or the Running Terminals and Kernels panel), then run this cell again.", flush=True)
 
 
 def _relay_echo(fd: int, on_output: Callable[[str, bytes], None]) -> None:

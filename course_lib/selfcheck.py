@@ -63,7 +63,8 @@ def task1_node_name(answer, expected_node: str = "my_node") -> Verdict:
 
 def task2_echo(messages, topic: str = "/chatter", text_prefix: str = "Hello World") -> Verdict:
     """Task 2 (lesson 01): messages echoed from the talker's topic, like `ros2 topic echo --once`."""
-    hint = f"Call graph.topic_echo({topic!r}) while the talker runs and store what it returns in echoed."
+    hint = ("Find the talker's topic (graph.topic_list() lists the topics), echo one message from it "
+            "and store what the echo returns in echoed.")
     if (result := _not_done(messages, hint)) is not None:
         return result
     if not isinstance(messages, (list, tuple)):
@@ -72,6 +73,12 @@ def task2_echo(messages, topic: str = "/chatter", text_prefix: str = "Hello Worl
         return _verdict(False, f"Nothing was echoed: is the talker running and publishing on {topic}? "
                                "Check graph.topic_list() for the topic's name.")
     first = messages[0]
+    if not hasattr(type(first), "get_fields_and_field_types"):
+        where = (" It looks like what the notebook's listener heard (listener.heard): that is the listener's "
+                 "record, not an echo." if isinstance(first, str) else "")
+        return _verdict(False, f"Got {first!r}, a {type(first).__name__}, not a ROS message.{where} Echo the "
+                               "topic yourself with graph.topic_echo: it returns a list of the messages it "
+                               "received.")
     data = getattr(first, "data", None)
     if not isinstance(data, str):
         return _verdict(False, f"Got a {type(first).__name__}, but {topic} carries std_msgs/msg/String: "
@@ -123,6 +130,10 @@ def task3_brightness_on_change(function) -> Verdict:
         (None, 120, 5, True, "nothing was sent yet (last_sent is None), so the first brightness must be "
                              "published: test `last_sent is None` first"),
         (100, 100, 5, False, "the brightness did not change, so nothing should be published"),
+        (0, 0, 5, False, "brightness 0 (a black frame) was sent last, and 0 again needs no message. 0 is "
+                         "a brightness, not 'nothing sent': test `last_sent is None`, not `not last_sent`"),
+        (0, 3, 5, False, "brightness 0 was sent last and a change of 3 is not more than 5. 0 is a "
+                         "brightness, not 'nothing sent': test `last_sent is None`, not `not last_sent`"),
         (100, 103, 5, False, "a change of 3 is not more than 5"),
         (100, 106, 5, True, "a rise of 6 is more than 5 and must be published"),
         (100, 94, 5, True, "a drop of 6 counts too: compare abs(current - last_sent) with threshold"),
@@ -175,6 +186,8 @@ def task4_order_corners(function) -> Verdict:
          "its bottom-right corner is higher than its top-left too, so 'the two highest points are the top' fails)",
          thin, (0, 2, 3, 1)),
         ("points already in order", [[15, 12], [95, 18], [92, 88], [10, 80]], (0, 1, 2, 3)),
+        # Two corners tie on x + y and two on y - x: either tied corner may come first.
+        ("a 3:1 rectangle turned by 45 degrees", [[80, 120], [100, 100], [160, 160], [140, 180]], (1, 3, 2, 0)),
     ]
     names = ("top-left", "top-right", "bottom-right", "bottom-left")
     for name, expected, shuffle in cases:
@@ -185,14 +198,28 @@ def task4_order_corners(function) -> Verdict:
             return problem
         if answer is None:
             return _verdict(False, "Not done yet: order_corners returns None. " + hint)
+        if not isinstance(answer, np.ndarray) or answer.shape != (4, 2):
+            what = (f"an array of shape {answer.shape}" if isinstance(answer, np.ndarray)
+                    else f"a {type(answer).__name__}")
+            return _verdict(False, f"order_corners should return a numpy array of shape (4, 2), which what follows "
+                                   f"indexes as corners[:, 0] and hands to cv2.getPerspectiveTransform; for {name} "
+                                   f"it returned {what}: {answer!r}. Build one with np.array(...).")
         try:
-            answer = np.asarray(answer, dtype=np.float32).reshape(4, 2)
+            answer = answer.astype(np.float32)
         except (TypeError, ValueError):
-            return _verdict(False, f"order_corners should return 4 points, a (4, 2) array; for {name} it "
-                                   f"returned {answer!r}.")
-        if np.allclose(answer, expected, atol=1e-3):
+            return _verdict(False, f"order_corners should return numbers; for {name} it returned {answer!r}.")
+        lowest = expected.sum(axis=1).min()
+        if any(np.allclose(answer, np.roll(expected, -k, axis=0), atol=1e-3)
+               for k in range(4) if expected[k].sum() <= lowest + 1e-3):
             continue
         matches = [next((i for i in range(4) if np.allclose(p, expected[i], atol=1e-3)), None) for p in answer]
+        if None not in matches and len(set(matches)) < 4:
+            twice = next(m for m in matches if matches.count(m) > 1)
+            return _verdict(False, f"For {name}, order_corners returned the point {expected[twice].tolist()} "
+                                   f"{matches.count(twice)} times and left out another one: {answer.tolist()}. "
+                                   "Taking the smallest and largest x + y and y - x picks one point twice when "
+                                   "two corners tie, as here; sort the points by their angle around the centre "
+                                   "instead (np.arctan2), then start at the smallest x + y.")
         if None in matches or sorted(matches) != [0, 1, 2, 3]:
             return _verdict(False, f"For {name}, order_corners returned {answer.tolist()}, which are not the four "
                                    f"points it was given ({given.tolist()}) in a new order: return the same points, "
@@ -208,3 +235,177 @@ def task4_order_corners(function) -> Verdict:
                                f"{', '.join(names[m] for m in matches)}; expected {', '.join(names)}.")
     return _verdict(True, "order_corners puts four corners in the order top-left, top-right, bottom-right, "
                           "bottom-left, for tilted and perspective shapes too.")
+
+
+def _exercise_node(node_or_class, class_name: str, hint: str):
+    """(node added to the session, None) or (None, a Verdict) for a student's Node class or instance."""
+    from rclpy.node import Node
+
+    from course_lib import session
+
+    if (result := _not_done(node_or_class, hint)) is not None:
+        return None, result
+    if isinstance(node_or_class, type) and issubclass(node_or_class, Node):
+        try:
+            node = node_or_class()
+        except Exception as error:  # a check never raises on a wrong answer
+            return None, _verdict(False, f"Creating {node_or_class.__name__}() raised {type(error).__name__}: {error}")
+    elif isinstance(node_or_class, Node):
+        node = node_or_class
+    else:
+        return None, _verdict(False, f"Pass the node class itself ({class_name}, without brackets), not a "
+                                     f"{type(node_or_class).__name__}.")
+    return session.add_node(node), None
+
+
+def _message_type_name(cls) -> str:
+    module = cls.__module__.split(".")
+    return f"{module[0]}/{module[1]}/{cls.__name__}" if len(module) > 1 else cls.__name__
+
+
+def publisher_exercise(node_or_class, topic: str = "/announcements", prefix: str = "Announcement ",
+                       period: float = 0.5) -> Verdict:
+    """Exercise (lesson 01): a node that publishes std_msgs/String "Announcement N" (N = 0, 1, ...)
+    on /announcements every 0.5 s. The check runs the node briefly and listens to it."""
+    import statistics
+    import time
+
+    from std_msgs.msg import String
+
+    from course_lib import session
+
+    hint = (f"Pass your node class; in __init__ create a publisher of String on {topic.lstrip('/')!r} and a "
+            f"timer of {period} s whose callback publishes '{prefix}0', '{prefix}1', ...")
+    node, problem = _exercise_node(node_or_class, "Announcer", hint)
+    if problem is not None:
+        return problem
+    tool = session.tool_node()
+    heard: list[tuple[float, str]] = []
+    listener = None
+    try:
+        publishers = [p for p in node.publishers if p.topic_name != "/parameter_events"]
+        if not publishers:
+            return _verdict(False, "Not done yet: the node has no publisher. In __init__: self.publisher = "
+                                   f"self.create_publisher(String, {topic.lstrip('/')!r}, 10).")
+        mine = [p for p in publishers if p.topic_name == topic]
+        if not mine:
+            names = ", ".join(p.topic_name for p in publishers)
+            return _verdict(False, f"The node publishes on {names}, not on {topic}: check the topic name you pass "
+                                   "to create_publisher.")
+        if mine[0].msg_type is not String:
+            return _verdict(False, f"The publisher sends {_message_type_name(mine[0].msg_type)}; the exercise asks "
+                                   "for std_msgs/msg/String (from std_msgs.msg import String).")
+        listener = tool.create_subscription(String, topic, lambda msg: heard.append((time.monotonic(), msg.data)), 10)
+        session.wait_for(lambda: len(heard) >= 3, timeout=3 * period + 1.0)
+        if not heard:
+            return _verdict(False, f"No message arrived on {topic} in {3 * period + 1:g} s. Does __init__ create a "
+                                   f"timer (self.create_timer({period}, self.announce)), and does its callback call "
+                                   "self.publisher.publish(String(data=...))?")
+        texts = [text for _, text in heard]
+        numbers = [text[len(prefix):] for text in texts if text.startswith(prefix)]
+        if len(numbers) != len(texts) or not all(n.isdigit() for n in numbers):
+            return _verdict(False, f"The node sent {texts[0]!r}; the exercise asks for '{prefix}0', then "
+                                   f"'{prefix}1', and so on (an f-string: f'{prefix}{{self.count}}').")
+        counts = [int(n) for n in numbers]
+        if any(b != a + 1 for a, b in zip(counts, counts[1:])):
+            return _verdict(False, f"The numbers go {counts}: count up by one per message (self.count += 1 after "
+                                   "publishing, with self.count = 0 in __init__).")
+        if len(heard) >= 2:
+            gap = statistics.median(b - a for (a, _), (b, _) in zip(heard, heard[1:]))
+            if not 0.5 * period <= gap <= 1.6 * period:
+                return _verdict(False, f"Messages come every {gap:.2f} s; the exercise asks for every {period} s: "
+                                       f"self.create_timer({period}, ...).")
+        return _verdict(True, f"The node publishes {texts[0]!r}, {texts[1] if len(texts) > 1 else '...'!r} ... on "
+                              f"{topic}, every {period} s. In a terminal: ros2 topic echo {topic}.")
+    finally:
+        if listener is not None:
+            tool.destroy_subscription(listener)
+        try:
+            session.remove_node(node)
+        except ValueError:  # the student's code removed it already
+            pass
+
+
+def subscriber_exercise(node_or_class, msg_type, topic: str = "/ros_tutorial_msg") -> Verdict:
+    """Exercise (lesson 01b): a node subscribed to ros_tutorial_msg (MsgTutorial, depth 100) that
+    appends (stamp in seconds, data) to self.received for every message. The check sends it three
+    messages of its own, marked by negative data, and looks at what the node kept."""
+    from rclpy.qos import QoSProfile
+
+    from course_lib import session
+
+    hint = (f"Pass your node class; in __init__ set self.received = [] and subscribe to {topic.lstrip('/')!r}; "
+            "the callback appends (stamp in seconds, data) for each message.")
+    node, problem = _exercise_node(node_or_class, "TutorialListener", hint)
+    if problem is not None:
+        return problem
+    fields = msg_type.get_fields_and_field_types()
+    sent = []
+    for i in range(3):
+        msg = msg_type()
+        msg.stamp.sec, msg.stamp.nanosec = 1000 + i, 250_000_000
+        value = -1001 - i
+        if "data" in fields:
+            msg.data = value
+        else:  # std_msgs/Header, the stand-in where MsgTutorial could not be built: counter in frame_id
+            msg.frame_id = str(value)
+        sent.append((msg, (1000.25 + i, value)))
+    tool = session.tool_node()
+    publisher = None
+    try:
+        subscriptions = [s for s in node.subscriptions]
+        if not subscriptions:
+            return _verdict(False, "Not done yet: the node has no subscription. In __init__: "
+                                   f"self.create_subscription({msg_type.__name__}, {topic.lstrip('/')!r}, "
+                                   "self.on_message, 100).")
+        mine = [s for s in subscriptions if s.topic_name == topic]
+        if not mine:
+            names = ", ".join(s.topic_name for s in subscriptions)
+            return _verdict(False, f"The node subscribes to {names}, not to {topic}: check the topic name.")
+        if mine[0].msg_type is not msg_type:
+            return _verdict(False, f"The subscription takes {_message_type_name(mine[0].msg_type)}; the publisher "
+                                   f"sends {_message_type_name(msg_type)}, so nothing would ever arrive.")
+        if not isinstance(getattr(node, "received", None), list):
+            return _verdict(False, "Keep what arrives in a list self.received, created empty in __init__ "
+                                   "(self.received = []).")
+        publisher = tool.create_publisher(msg_type, topic, QoSProfile(depth=100))
+        session.wait_for(lambda: publisher.get_subscription_count() > 0, timeout=3.0)
+        for msg, _ in sent:
+            publisher.publish(msg)
+        expected = [pair for _, pair in sent]
+        marks = {value for _, value in expected}
+
+        def kept():
+            return [entry for entry in list(node.received)
+                    if isinstance(entry, (tuple, list)) and any(v in marks for v in entry if isinstance(v, int))]
+
+        session.wait_for(lambda: len(kept()) >= 3, timeout=2.0)
+        got = kept()
+        if not got:
+            shown = f": it holds {node.received[-1]!r}" if node.received else " and stays empty"
+            return _verdict(False, f"The check sent three messages (data -1001, -1002, -1003), but self.received "
+                                   f"has none of them{shown}. The callback should append (stamp in seconds, data) "
+                                   "for every message.")
+        first, want = got[0], expected[0]
+        if len(first) != 2:
+            return _verdict(False, f"For a message stamped {want[0]} with data {want[1]} the node kept {first!r}; "
+                                   "keep a pair (stamp in seconds, data).")
+        if first[0] == want[1]:
+            return _verdict(False, f"The node kept {tuple(first)!r}: the pair goes (stamp, data), not (data, stamp).")
+        if first[0] == int(want[0]):
+            return _verdict(False, f"The node kept {tuple(first)!r}: the stamp lost its nanoseconds ({want[0]} was "
+                                   "sent). Use msg.stamp.sec + msg.stamp.nanosec * 1e-9.")
+        if len(got) < 3:
+            return _verdict(False, f"Of three messages sent, {len(got)} reached self.received: append every one.")
+        if not all(len(a) == 2 and abs(a[0] - b[0]) < 1e-6 and a[1] == b[1] for a, b in zip(got, expected)):
+            return _verdict(False, f"For the messages {expected} (stamp, data) the node kept "
+                                   f"{[tuple(e) for e in got]}.")
+        return _verdict(True, f"The node kept {[tuple(e) for e in got]} for the three messages the check sent: "
+                              "stamp and data, in order.")
+    finally:
+        if publisher is not None:
+            tool.destroy_publisher(publisher)
+        try:
+            session.remove_node(node)
+        except ValueError:
+            pass

@@ -14,6 +14,23 @@ The session is safe to re-run cell by cell: ``start()`` twice does nothing the s
 holds replaces the old node instead of running twice. The session stops itself when the
 kernel exits.
 
+Replacing happens when the new node is *created*, not when it is added: two nodes of one name in
+one process confuse ROS (rcl warns "Publisher already registered for node name", and the graph
+loses the new node's topics, which other processes then see under ``_NODE_NAME_UNKNOWN_``). So
+while a session has run in this process, creating an rclpy ``Node`` under a name the session
+holds first removes the old node. After ``stop()``, creating a node raises
+:class:`SessionStopped`, which says to run ``session.start()`` (rclpy's own error would only say
+that ``rclpy.init()`` was not called).
+
+In plain ROS 2 the same is an executor spinning in a thread of its own::
+
+    rclpy.init()
+    executor = rclpy.executors.SingleThreadedExecutor()
+    executor.add_node(node)
+    threading.Thread(target=executor.spin, daemon=True).start()
+    ...
+    executor.shutdown(); node.destroy_node(); rclpy.try_shutdown()
+
 A hidden node, :data:`TOOL_NODE_NAME`, serves the introspection helpers of
 :mod:`course_lib.graph`; it is created on first use and never listed by :func:`nodes`.
 """
@@ -21,13 +38,14 @@ A hidden node, :data:`TOOL_NODE_NAME`, serves the introspection helpers of
 from __future__ import annotations
 
 import atexit
+import functools
 import sys
 import threading
 import time
 import traceback
 from typing import Callable
 
-from course_lib import rosenv
+from course_lib import node_logs, rosenv
 
 #: Name of the session's hidden helper node (a leading "_" hides it from node listings).
 TOOL_NODE_NAME = "_course_tools"
@@ -53,6 +71,7 @@ class _State:
         self.thread: threading.Thread | None = None
         self.nodes: dict[str, object] = {}  # fully-qualified name -> node, in order added
         self.tool = None
+        self.created_at: dict[str, float] = {}  # fully-qualified name -> time.time() of its last creation
         self.stopping = threading.Event()
         # Held by the background thread while it waits or runs a callback, so that a node is
         # destroyed only between two rounds of the executor.
@@ -64,6 +83,16 @@ _state: _State | None = None
 _errors: list[BaseException] = []
 _reported: set[tuple[str, str]] = set()
 _atexit_registered = False
+_stopped = False  # stop() ran and no start() since: a new node gets SessionStopped
+
+
+class SessionStopped(RuntimeError):
+    """A node was created after session.stop() (a lesson's clean-up cell) shut ROS down."""
+
+    def __init__(self):
+        super().__init__("ROS is not running in this notebook: the clean-up cell (session.stop()) shut "
+                         "it down. Run session.start() (or the notebook's first code cell) and the cells "
+                         "that start the processes this cell needs, then run this cell again.")
 
 
 def time_limit(seconds: float | None) -> float | None:
@@ -112,7 +141,7 @@ def start(domain_id: int | None = None) -> None:
     from rclpy.signals import SignalHandlerOptions
     from rclpy.utilities import get_default_context
 
-    global _state, _atexit_registered
+    global _state, _atexit_registered, _stopped
     if domain_id is not None:
         rosenv.check_domain_id(domain_id)
     with _lock:
@@ -130,12 +159,17 @@ def start(domain_id: int | None = None) -> None:
             rclpy.try_shutdown()
             # No rclpy signal handlers: in Jupyter, "interrupt kernel" must stop the cell,
             # not shut ROS down under the background executor.
-            rclpy.init(domain_id=domain_id, signal_handler_options=SignalHandlerOptions.NO)
+            # In a Jupyter kernel, log lines are shown under the cell that added their node
+            # (course_lib.node_logs) instead of on the console, which is any cell that runs.
+            rclpy.init(args=node_logs.init_arguments() or None, domain_id=domain_id,
+                       signal_handler_options=SignalHandlerOptions.NO)
             context = get_default_context()
         state = _State(context, SingleThreadedExecutor(context=context))
         state.thread = threading.Thread(target=_spin, args=(state,), name="course_lib.session",
                                         daemon=True)
         _state = state
+        _stopped = False
+        _install_node_hook()
         state.thread.start()
         if not _atexit_registered:
             atexit.register(stop)
@@ -158,7 +192,7 @@ def stop(timeout: float = 2.0) -> None:
     Args:
         timeout: seconds to wait for a running callback to finish.
     """
-    global _state
+    global _state, _stopped
     with _lock:
         if _state is None:
             return
@@ -166,6 +200,7 @@ def stop(timeout: float = 2.0) -> None:
             _teardown(timeout)
         finally:
             _state = None
+            _stopped = True
 
 
 def _teardown(timeout: float) -> None:
@@ -250,7 +285,8 @@ def add_node(node):
     """Spin ``node`` in the background; a node of the same full name is replaced.
 
     Re-running a cell that creates and adds a node therefore leaves one node, not two: the
-    old one is removed from the executor and destroyed.
+    old one is removed from the executor and destroyed. In a Jupyter kernel the node's log lines
+    appear under this cell (course_lib.node_logs).
 
     Args:
         node: an rclpy Node created after session.start() (or after rclpy.init()).
@@ -284,7 +320,67 @@ def add_node(node):
             _remove(state, name)
         state.nodes[name] = node
         state.executor.add_node(node)
-        return node
+        since = state.created_at.pop(name, None)
+    node_logs.attach(node, since)
+    return node
+
+
+def _install_node_hook() -> None:
+    """Make rclpy's Node.__init__ call _before_node_created first (once per process)."""
+    from rclpy.node import Node
+
+    original = Node.__init__
+    if getattr(original, "_course_lib_session_hook", False):
+        return
+
+    @functools.wraps(original)
+    def __init__(self, node_name, *args, **kwargs):
+        _before_node_created(node_name, kwargs.get("namespace"), kwargs.get("context"),
+                             kwargs.get("cli_args"))
+        original(self, node_name, *args, **kwargs)
+
+    __init__._course_lib_session_hook = True
+    Node.__init__ = __init__
+
+
+def _before_node_created(node_name, namespace, context, cli_args) -> None:
+    """Make room for a node about to be created: remove the session's node of that name.
+
+    Raises:
+        SessionStopped: the node would use the default context, which session.stop() shut down.
+    """
+    from rclpy.utilities import get_default_context
+
+    with _lock:
+        state = _state
+        if state is None:
+            if _stopped and context is None and not get_default_context().ok():
+                raise SessionStopped()
+            return
+        if (context is not None and context is not state.context) or not isinstance(node_name, str):
+            return
+        name = expected_name(node_name, namespace, cli_args)
+        state.created_at[name] = time.time()
+        node_logs.expect(name, state.created_at[name])  # lines stamped from now on are the new node's
+        if name in state.nodes:
+            _remove(state, name)
+
+
+def expected_name(node_name: str, namespace: str | None = None, cli_args=None) -> str:
+    """The fully-qualified name a node will get: "/ns/name", after ``__node``/``__ns`` remaps.
+
+    Args:
+        node_name: the name passed to Node().
+        namespace: the namespace passed to Node(); None or "" is the root namespace.
+        cli_args: the node's own arguments, e.g. ["--ros-args", "-r", "__ns:=/robot1"].
+    """
+    for arg in map(str, cli_args or ()):  # "-r __node:=x" or "-r talker:__node:=x"
+        if "__node:=" in arg:
+            node_name = arg.split("__node:=", 1)[1]
+        elif "__ns:=" in arg:
+            namespace = arg.split("__ns:=", 1)[1]
+    namespace = "/" + (namespace or "").strip("/")
+    return namespace.rstrip("/") + "/" + node_name
 
 
 def _alive_name(node) -> str:

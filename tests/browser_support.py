@@ -188,7 +188,12 @@ def running_jupyterlab(root_dir: Path, state_dir: Path, timeout: float = 120):
         target = settings_dir / name
         target.parent.mkdir(parents=True, exist_ok=True)
         target.write_text(json.dumps(values))
+    from course_lib import student_lab
+
     env = dict(os.environ,
+               # As `make lab` does: nbgrader's student side only (course_lib/student_lab).
+               JUPYTER_CONFIG_PATH=os.pathsep.join(filter(None, [str(student_lab.CONFIG_DIR),
+                                                                  os.environ.get("JUPYTER_CONFIG_PATH")])),
                JUPYTERLAB_SETTINGS_DIR=str(settings_dir),
                JUPYTERLAB_WORKSPACES_DIR=str(state_dir / "workspaces"),
                JUPYTER_RUNTIME_DIR=str(state_dir / "runtime"))
@@ -357,6 +362,7 @@ class NotebookRun:
         stderr_outputs: number of outputs rendered as stderr (warnings, logs and errors alike).
         seconds: time from clicking Run All Cells until the kernel was idle again.
         screenshot: where the full-page screenshot was saved (None when not asked for).
+        outputs: the text each code cell's output area shows (widgets' text included).
     """
 
     path: str
@@ -369,6 +375,7 @@ class NotebookRun:
     stderr_outputs: int
     seconds: float
     screenshot: Path | None = None
+    outputs: list[str] = dataclasses.field(default_factory=list)
 
     @property
     def unexecuted(self) -> list[str]:
@@ -391,6 +398,7 @@ _PAGE_STATE_JS = """
   const panel = document.querySelector(notebookSelector);
   const codeCells = [...panel.querySelectorAll('.jp-Notebook .jp-CodeCell')];
   const prompts = codeCells.map(c => (c.querySelector('.jp-InputArea-prompt') || {}).innerText || '');
+  const outputs = codeCells.map(c => (c.querySelector('.jp-Cell-outputArea') || {}).innerText || '');
   const images = [];
   codeCells.forEach((c, i) => c.querySelectorAll('.jp-OutputArea img').forEach(img =>
       images.push({cell: i, ok: img.complete && img.naturalWidth > 0})));
@@ -410,7 +418,7 @@ _PAGE_STATE_JS = """
       if (imageMimes.some(m => m in data)) imageOutputs += 1;
     }
   }
-  return {prompts, images, errors, imageOutputs, stderr};
+  return {prompts, images, errors, imageOutputs, stderr, outputs};
 }
 """
 
@@ -463,7 +471,8 @@ def run_notebook(page, path: str, code_cells: int, timeout: float, screenshot: P
     run = NotebookRun(
         path=path, code_cells=code_cells, prompts=state["prompts"], errors=state["errors"],
         images=len(state["images"]), broken_images=[f"cell {i['cell']}" for i in state["images"] if not i["ok"]],
-        image_outputs=state["imageOutputs"], stderr_outputs=state["stderr"], seconds=seconds)
+        image_outputs=state["imageOutputs"], stderr_outputs=state["stderr"], seconds=seconds,
+        outputs=state["outputs"])
     if screenshot is not None:
         save_full_notebook_screenshot(page, screenshot)
         run.screenshot = screenshot

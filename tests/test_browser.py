@@ -6,6 +6,7 @@ checker's own small notebooks, which prove that the checker passes a good notebo
 one that raises. Screenshots go to artifacts/browser/<notebook>.png.
 """
 
+import json
 import shutil
 from pathlib import Path
 
@@ -34,6 +35,34 @@ CHECKER_NOTEBOOKS = {
     "broken_image.ipynb": ["from IPython.display import Image\nImage(data=b'these bytes are no PNG', format='png')"],
 }
 
+# A node cell run three times in one kernel (a student re-running it), then the graph.
+NODE_CELL = "listener = session.add_node(Listener())"
+RERUN_NOTEBOOK = [
+    """from rclpy.node import Node
+from std_msgs.msg import String
+from course_lib import graph, session
+graph.SETTLE_SECONDS = 0  # only this kernel's nodes matter: no wait for other processes
+session.start()
+
+class Listener(Node):
+    def __init__(self):
+        super().__init__("listener")
+        self.create_subscription(String, "chatter", lambda msg: None, 10)
+        self.get_logger().info(f"listening ({id(self)})")""",
+    NODE_CELL, NODE_CELL, NODE_CELL,
+    'print([endpoint.node for endpoint in graph.topic_info("/chatter").subscriptions], graph.node_list())',
+]
+
+
+def lesson_line(notebook: str, start: str) -> str:
+    """The one source line of a lesson that starts with `start` (a test then runs it as the lesson does)."""
+    import nbformat
+
+    lines = [line for cell in nbformat.read(NOTEBOOKS / notebook, as_version=4).cells if cell.cell_type == "code"
+             for line in cell.source.splitlines() if line.startswith(start)]
+    assert len(lines) == 1, f"{notebook} has {len(lines)} lines starting with {start!r}"
+    return lines[0]
+
 
 @pytest.fixture(scope="module")
 def lab(tmp_path_factory):
@@ -46,6 +75,14 @@ def lab(tmp_path_factory):
     (root / "checker").mkdir()
     for name, sources in CHECKER_NOTEBOOKS.items():
         write_notebook(root / "checker" / name, sources)
+    write_notebook(root / "checker" / "rerun_node.ipynb", RERUN_NOTEBOOK)
+    # Lesson 02's camera, started as lesson 02 starts it; and lesson 03's, as lesson 03 does.
+    write_notebook(root / "checker" / "lesson02_left_running.ipynb", [
+        "from course_lib import processes", lesson_line("02_images_and_brightness.ipynb", "CAMERA_ARGS = "),
+        lesson_line("02_images_and_brightness.ipynb", 'camera = processes.python_node("course_lib.camera:main", '
+                                                      '*CAMERA_ARGS, name=')])
+    write_notebook(root / "checker" / "lesson03_camera.ipynb", [
+        "from course_lib import processes", lesson_line("03_aruco_and_homography.ipynb", "camera = processes.python_node(")])
     with running_jupyterlab(root, tmp_path_factory.mktemp("lab-state")) as server:
         print(f"\nJupyterLab answered after {server.startup_seconds:.1f} s")
         yield server
@@ -71,6 +108,56 @@ def test_course_notebook_runs_clean_in_jupyterlab(notebook, browser, lab):
     screenshot = SCREENSHOTS / (notebook.removesuffix(".ipynb").replace("/", "__") + ".png")
     run = run_in_lab(browser, lab, f"notebooks/{notebook}", screenshot)
     assert not run.problems(), f"{notebook} in JupyterLab (screenshot {screenshot}):\n" + "\n".join(run.problems())
+
+
+def test_the_students_lab_has_no_instructor_side(lab):
+    """Like `make lab`: no Create Assignment sidebar, formgrader or course list; Validate and the
+    assignment list stay (nbgrader's server extensions and JupyterLab's page config)."""
+    import urllib.error
+    import urllib.request
+
+    page = urllib.request.urlopen(f"{lab.url}/lab?token={lab.token}", timeout=30).read().decode()
+    disabled = json.loads(page.split('id="jupyter-config-data"', 1)[1].split(">", 1)[1].split("</script>", 1)[0])[
+        "disabledExtensions"]
+    assert {"@jupyter/nbgrader:create-assignment", "@jupyter/nbgrader:formgrader",
+            "@jupyter/nbgrader:course-list"} <= set(disabled)
+    assert not any("validate" in name or "assignment-list" in name for name in disabled)
+    with pytest.raises(urllib.error.HTTPError, match="404"):
+        urllib.request.urlopen(f"{lab.url}/formgrader?token={lab.token}", timeout=30)
+    version = urllib.request.urlopen(f"{lab.url}/nbgrader_version?version=x&token={lab.token}", timeout=30)
+    assert "server version is" in version.read().decode()  # the validate/assignment-list extensions answer
+
+
+@pytest.mark.timeout(RUN_TIMEOUT)
+def test_rerunning_a_node_cell_replaces_the_node_without_warnings(browser, lab):
+    """A node cell run three times: no stderr output (no "Publisher already registered"), the graph
+    right at once (one /listener, its subscription under its name), each run's log line in the
+    box under its own cell."""
+    path = "checker/rerun_node.ipynb"
+    run = run_in_lab(browser, lab, path, SCREENSHOTS / "checker" / "rerun_node.png")
+    assert run.problems() == [] and run.stderr_outputs == 0, run
+    assert run.outputs[4].strip() == "['/listener'] ['/listener']", run.outputs
+    for cell in (1, 2, 3):
+        assert run.outputs[cell].count("[listener]: listening (") == 1, run.outputs
+    assert "ROS log lines of the nodes this cell added" in run.outputs[1]
+
+
+@pytest.mark.timeout(RUN_TIMEOUT)
+def test_a_camera_left_running_by_lesson_02_is_named_when_lesson_03_starts_its_own(browser, lab):
+    """Lesson 02 left without its clean-up cell (its kernel keeps running): lesson 03's camera
+    cell says plainly that lesson 02's camera still runs and how to stop it."""
+    left = "checker/lesson02_left_running.ipynb"
+    page = open_notebook(browser, lab, left)
+    try:
+        first = run_notebook(page, left, 3, RUN_TIMEOUT)
+        assert first.problems() == [], first.problems()
+        second = run_in_lab(browser, lab, "checker/lesson03_camera.ipynb")
+    finally:
+        lab.shut_down_kernels_of(left)
+        page.close()
+    said = second.outputs[1]
+    assert "another node process named 'camera'" in said and "lesson02_left_running.ipynb" in said, said
+    assert "Shut Down Kernel" in said
 
 
 # --- the checker itself ---------------------------------------------------------------------

@@ -311,3 +311,15 @@ def test_message_class_reads_both_name_forms_and_names_the_missing_package():
         graph.message_class("nope_msgs/msg/Thing")
     with pytest.raises(ValueError, match="package/msg/Type"):
         graph.message_class("String")
+
+
+def test_wait_for_publisher_says_plainly_that_nothing_publishes(local_session):
+    """Before waiting for frames: no publisher is an error that names the topic and the fix
+    (after a kernel restart the camera is gone), not '0 frames received' later."""
+    from std_msgs.msg import String
+
+    with pytest.raises(graph.NoPublisher, match=r"No node publishes on /camera/image_raw .* run the camera cell"):
+        graph.wait_for_publisher("/camera/image_raw", timeout=0.2, hint="run the camera cell")
+    node = session.add_node(Node("camera_stand_in"))
+    node.create_publisher(String, "/camera/image_raw", 10)
+    assert graph.wait_for_publisher("/camera/image_raw", timeout=5) == 1

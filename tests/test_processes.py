@@ -120,6 +120,60 @@ def test_node_in_another_namespace_is_not_mistaken(talker_dir, domain_id):
             talker.wait_for_node("talker", namespace="robot2", timeout=1.0)
 
 
+def test_wait_for_node_warns_when_another_program_runs_a_node_of_that_name(talker_dir, domain_id, capsys):
+    """A camera the previous lesson's kernel left running makes two nodes of one name: the new
+    one's wait_for_node says so plainly; a node that replaced its own earlier copy does not."""
+    from course_lib import session
+
+    session.start(domain_id=domain_id)
+    try:
+        with python_node("course_talker:main", cwd=talker_dir, domain_id=domain_id, name="left_running") as old:
+            old.wait_for_node("talker", timeout=30)
+            with python_node("course_talker:main", cwd=talker_dir, domain_id=domain_id, name="camera") as new:
+                new.wait_for_node("talker", timeout=30)
+                said = capsys.readouterr().out
+                assert "Warning: another node named /talker" in said and "Shut Down Kernel" in said, said
+                old.stop()
+                again = python_node("course_talker:main", cwd=talker_dir, domain_id=domain_id, name="camera")
+                with again:  # a re-run cell: it replaces `new`, whose node leaves the graph
+                    again.wait_for_node("talker", timeout=30)
+                    assert not new.running()
+        assert "Warning" not in capsys.readouterr().out
+    finally:
+        session.stop()
+
+
+LEFT_RUNNING = """
+import sys, time
+from course_lib.processes import NodeProcess
+NodeProcess([sys.executable, "-c", "import time; time.sleep(60)", sys.argv[1]], name="camera").start()
+print("started", flush=True)
+time.sleep(60)
+"""
+
+
+def test_start_names_the_notebook_that_still_runs_a_process_of_that_name(token, domain_id, capsys):
+    """Lesson 02's kernel, left running, still runs its "camera": lesson 03's camera says so at once,
+    naming the notebook; in another domain, or once that kernel is gone, nothing is said."""
+    env = dict(os.environ, ROS_DOMAIN_ID=str(domain_id), JPY_SESSION_NAME="/home/me/notebooks/02_images.ipynb")
+    other_kernel = subprocess.Popen([sys.executable, "-c", LEFT_RUNNING, token], env=env, stdout=subprocess.PIPE,
+                                    text=True)
+    try:
+        assert other_kernel.stdout.readline() == "started\n"
+        with NodeProcess(sleeper(token), name="camera", domain_id=domain_id) as camera:
+            said = capsys.readouterr().out
+            assert "another node process named 'camera'" in said and "notebook 02_images.ipynb" in said, said
+            assert camera.warned_duplicate
+        with NodeProcess(sleeper(token), name="camera", domain_id=domain_id + 1 if domain_id < 101 else 1):
+            assert "Warning" not in capsys.readouterr().out
+    finally:
+        other_kernel.kill()
+        other_kernel.wait()
+    assert wait_until(lambda: not processes_with(token), timeout=10)  # its camera died with it
+    with NodeProcess(sleeper(token), name="camera", domain_id=domain_id):
+        assert "Warning" not in capsys.readouterr().out
+
+
 def test_module_target_runs_with_arguments(tmp_path):
     """'package.module' runs as python -m with the given arguments."""
     (tmp_path / "echo_args.py").write_text("import sys\nprint('args', sys.argv[1:])\n")

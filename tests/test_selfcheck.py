@@ -2,7 +2,7 @@
 
 import pytest
 from rclpy.node import Node
-from std_msgs.msg import Int32, String
+from std_msgs.msg import Header, Int32, String
 
 from course_lib import graph, selfcheck, session
 
@@ -57,6 +57,19 @@ def test_task2_verdicts():
     assert selfcheck.task2_echo(String(data="Hello World: 7")), "a single message (not a list) is fine too"
 
 
+def test_task2_stub_hint_does_not_give_the_answer_away():
+    """The hint points at how to find the topic, not at the finished call."""
+    hint = str(selfcheck.task2_echo(None))
+    assert "topic_list()" in hint and "/chatter" not in hint and "topic_echo(" not in hint
+
+
+def test_task2_what_the_listener_heard_is_not_an_echo():
+    """listener.heard[0] is the right topic's text but the wrong object: the verdict says so."""
+    verdict = selfcheck.task2_echo("Hello World: 3")
+    assert not verdict and "not a ROS message" in str(verdict) and "listener.heard" in str(verdict)
+    assert "right topic" not in str(verdict)
+
+
 # --- Task 3 (lesson 02): publish brightness only when it changes by more than a threshold -----
 
 def _publish_on_change(last_sent, current, threshold):
@@ -79,6 +92,7 @@ def test_task3_accepts_a_correct_filter():
     (lambda last, current, threshold: last is None or abs(int(current) - int(last)) >= threshold, "use >, not >="),
     (lambda last, current, threshold: last is None or abs(current - last) > threshold, "uint8 arithmetic wraps"),
     (lambda last, current, threshold: 1 / 0, "raised ZeroDivisionError"),
+    (lambda last, current, threshold: not last or abs(int(current) - int(last)) > threshold, "not `not last_sent`"),
 ])
 def test_task3_names_what_is_wrong(wrong, named):
     verdict = selfcheck.task3_brightness_on_change(wrong)
@@ -96,6 +110,15 @@ def _order_by_angle(points):
     return np.roll(points, -int(np.argmin(points.sum(axis=1))), axis=0)
 
 
+def _sum_and_difference(points):
+    """The well-known shortcut: top-left has the smallest x + y, top-right the smallest y - x, ..."""
+    import numpy as np
+
+    points = np.asarray(points, dtype=float)
+    total, difference = points.sum(axis=1), points[:, 1] - points[:, 0]
+    return points[[total.argmin(), difference.argmin(), total.argmax(), difference.argmax()]]
+
+
 def test_task4_stub_and_correct_answer():
     assert "Not done yet" in str(selfcheck.task4_order_corners(None))
     assert "Not done yet" in str(selfcheck.task4_order_corners(lambda points: None))
@@ -106,7 +129,9 @@ def test_task4_stub_and_correct_answer():
     (lambda p: _order_by_angle(p)[[0, 3, 2, 1]], "anticlockwise"),
     (lambda p: __import__("numpy").roll(_order_by_angle(p), 1, axis=0), "starts at the bottom-left"),
     (lambda p: _order_by_angle(p) * 2, "not the four points it was given"),
-    (lambda p: [1, 2, 3], "(4, 2) array"),
+    (lambda p: [1, 2, 3], "numpy array of shape (4, 2)"),
+    (lambda p: [tuple(corner) for corner in _order_by_angle(p)], "numpy array of shape (4, 2)"),
+    (lambda p: _sum_and_difference(p), "picks one point twice"),
 ])
 def test_task4_names_what_is_wrong(wrong, named):
     verdict = selfcheck.task4_order_corners(wrong)
@@ -124,3 +149,108 @@ def test_task4_catches_taking_the_two_highest_points_as_the_top():
 
     verdict = selfcheck.task4_order_corners(two_highest_are_top)
     assert not verdict and "long rectangle tilted by 30 degrees" in str(verdict)
+
+
+# --- the exercises of lessons 01 (a publisher) and 01b (the MsgTutorial subscriber) -----------
+
+def _announcer(period=0.5, topic="announcements", text="Announcement {}", msg_type=None, publish=True):
+    """A publisher node class for the lesson 01 exercise, right by default, wrong as asked."""
+    from std_msgs.msg import String
+
+    class Announcer(Node):
+        def __init__(self):
+            super().__init__("announcer")
+            self.count = 0
+            self.publisher = self.create_publisher(msg_type or String, topic, 10)
+            if publish:
+                self.create_timer(period, self.announce)
+
+        def announce(self):
+            self.publisher.publish(String(data=text.format(self.count)))
+            self.count += 1
+
+    return Announcer
+
+
+class AnnouncerStub(Node):
+    def __init__(self):
+        super().__init__("announcer")
+        self.count = 0
+        # TODO: a publisher and a timer
+
+
+@pytest.fixture
+def exercise_session(domain_id, monkeypatch):
+    monkeypatch.setattr(graph, "SETTLE_SECONDS", 0)
+    session.start(domain_id=domain_id)
+    yield
+    session.stop()
+
+
+def test_publisher_exercise_passes_a_correct_node(exercise_session):
+    verdict = selfcheck.publisher_exercise(_announcer())
+    assert verdict, verdict
+    assert session.nodes() == []  # the check removes the node it ran
+
+
+@pytest.mark.parametrize("answer, named", [
+    (None, "Not done yet"),
+    (AnnouncerStub, "Not done yet: the node has no publisher"),
+    (_announcer(topic="announcement"), "not on /announcements"),
+    (_announcer(publish=False), "No message arrived"),
+    (_announcer(text="Announcement"), "'Announcement 0', then"),
+    (_announcer(period=0.1), "every 0.5 s"),
+])
+def test_publisher_exercise_names_what_is_wrong(exercise_session, answer, named):
+    verdict = selfcheck.publisher_exercise(answer)
+    assert not verdict and named in str(verdict), verdict
+
+
+def _tutorial_listener(keep, topic="ros_tutorial_msg", msg_type=Header):
+    class TutorialListener(Node):
+        def __init__(self):
+            super().__init__("tutorial_listener")
+            self.received = []
+            self.create_subscription(msg_type, topic, self.on_message, 100)
+
+        def on_message(self, msg):
+            self.received.append(keep(msg))
+
+    return TutorialListener
+
+
+def _stamp(msg):
+    return msg.stamp.sec + msg.stamp.nanosec * 1e-9
+
+
+class ListenerStub(Node):
+    def __init__(self):
+        super().__init__("tutorial_listener")
+        self.received = []
+
+
+@pytest.mark.parametrize("answer, named", [
+    (_tutorial_listener(lambda msg: (_stamp(msg), int(msg.frame_id))), None),
+    (None, "Not done yet"),
+    (ListenerStub, "Not done yet: the node has no subscription"),
+    (_tutorial_listener(lambda msg: (msg.stamp.sec, int(msg.frame_id))), "lost its nanoseconds"),
+    (_tutorial_listener(lambda msg: (int(msg.frame_id), _stamp(msg))), "(stamp, data), not (data, stamp)"),
+    (_tutorial_listener(lambda msg: (_stamp(msg), int(msg.frame_id)), topic="chatter"), "not to /ros_tutorial_msg"),
+    (_tutorial_listener(lambda msg: (_stamp(msg), 0)), "has none of them"),
+])
+def test_subscriber_exercise(exercise_session, answer, named):
+    """Header stands in for MsgTutorial (its counter in frame_id), as in lesson 01b without a build."""
+    verdict = selfcheck.subscriber_exercise(answer, Header)
+    if named is None:
+        assert verdict, verdict
+    else:
+        assert not verdict and named in str(verdict), verdict
+
+
+def test_subscriber_exercise_with_a_data_field(exercise_session):
+    """With a message that has a data field (as MsgTutorial has), data is the counter."""
+    from builtin_interfaces.msg import Time  # noqa: F401 (Header's stamp type)
+    from std_msgs.msg import Int32
+
+    wrong_type = _tutorial_listener(lambda msg: (_stamp(msg), msg.data), msg_type=Int32)
+    assert "sends std_msgs/msg/Header" in str(selfcheck.subscriber_exercise(wrong_type, Header))

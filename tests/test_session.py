@@ -88,6 +88,65 @@ def test_readding_a_node_replaces_the_old_one(domain_id, quick_graph):
     assert old.ticks == ticks_of_old
 
 
+def test_recreating_a_node_replaces_it_without_warning_and_keeps_the_graph_right(domain_id, quick_graph, capfd):
+    """Re-running `listener = session.add_node(Listener())`: the old node goes before the new one
+    exists, so rcl does not warn "Publisher already registered" and the graph names the new
+    node's subscription (not _NODE_NAME_UNKNOWN_)."""
+    from std_msgs.msg import String
+
+    class Listener(Node):
+        def __init__(self):
+            super().__init__("listener")
+            self.create_subscription(String, "chatter", lambda msg: None, 10)
+
+    session.start(domain_id=domain_id)
+    old = session.add_node(Listener())
+    new = session.add_node(Listener())
+    with pytest.raises(Exception):  # the old node was destroyed when the new one was created
+        old.get_fully_qualified_name()
+    assert session.nodes() == [new]
+    subscribers = [endpoint.node for endpoint in graph.topic_info("/chatter").subscriptions]
+    assert subscribers == ["/listener"]
+    assert "already registered" not in capfd.readouterr().err
+
+
+def test_a_node_created_after_stop_says_to_start_the_session(domain_id):
+    """After the clean-up cell, re-running a node cell names session.start(), not rclpy.init()."""
+    session.start(domain_id=domain_id)
+    session.stop()
+    with pytest.raises(session.SessionStopped, match=r"Run session.start\(\)"):
+        Counter()
+    session.start(domain_id=domain_id)
+    assert session.add_node(Counter()).get_name() == "counter"
+
+
+def test_a_node_in_a_context_of_its_own_is_left_alone(domain_id):
+    """A node made with context=... (e.g. a helper's watcher) neither replaces a session node
+    nor needs the session."""
+    from rclpy.context import Context
+
+    session.start(domain_id=domain_id)
+    held = session.add_node(Counter())
+    context = Context()
+    rclpy.init(context=context, domain_id=domain_id)
+    try:
+        Node("counter", context=context).destroy_node()
+        assert session.nodes() == [held] and held.get_name() == "counter"
+    finally:
+        context.try_shutdown()
+
+
+@pytest.mark.parametrize("args, expected", [
+    (("talker",), "/talker"),
+    (("talker", "robot1"), "/robot1/talker"),
+    (("talker", "/robot1/"), "/robot1/talker"),
+    (("talker", None, ["--ros-args", "-r", "__node:=news", "-r", "__ns:=/r2"]), "/r2/news"),
+    (("talker", None, ["--ros-args", "-r", "talker:__node:=news"]), "/news"),
+])
+def test_expected_name(args, expected):
+    assert session.expected_name(*args) == expected
+
+
 def test_adding_the_same_node_twice_keeps_it(domain_id):
     """add_node() of a node the session already spins returns it and changes nothing."""
     session.start(domain_id=domain_id)
