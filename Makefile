@@ -1,7 +1,8 @@
 # One command to set up, one to start the lab, one to test. All are idempotent.
 #   make setup   create .venv/ from environment.txt and install course_lib into it
 #   make lab     set up, then start JupyterLab on the course (prints the URL; no browser needed)
-#   make test    set up, then run the whole test suite (unit tests, notebooks, browser tests)
+#   make test    set up, lint (ruff, notebooks too), then run the whole test suite (unit tests,
+#                notebooks, browser tests)
 #   make hub     set up, then run the course's JupyterHub for a class (root; course from
 #                `python -m coursehub create-course`, see README)
 
@@ -101,6 +102,7 @@ hub: setup hub-deps
 	$(PY) -m coursehub --hub-dir $(HUB_DIR) start
 
 test: setup browser-deps hub-deps
+	$(PY) -m ruff check .
 	$(PY) -m pytest -n $(TEST_WORKERS) --dist loadfile $(PYTEST_ARGS)
 
 clean:

@@ -3,7 +3,6 @@ on a lesson does not say "Success". (tests/test_browser.py checks the running la
 
 import json
 import subprocess
-import sys
 from pathlib import Path
 
 import nbformat
