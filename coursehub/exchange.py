@@ -14,12 +14,6 @@ from pathlib import Path
 
 from coursehub.accounts import chown_tree
 
-# Students get the Assignments panel and Validate; the instructor's tools are switched off in
-# their lab (nbgrader's installation guide lists the same extensions for a multi-user set-up).
-INSTRUCTOR_LAB_EXTENSIONS = ("@jupyter/nbgrader:formgrader", "@jupyter/nbgrader:course-list",
-                             "@jupyter/nbgrader:create-assignment")
-INSTRUCTOR_SERVER_EXTENSIONS = ("nbgrader.server_extensions.formgrader", "nbgrader.server_extensions.course_list")
-
 
 def create_exchange(root: Path) -> None:
     root.mkdir(parents=True, exist_ok=True)
@@ -45,17 +39,12 @@ def write_settings(course) -> Path:
 
 
 def write_student_settings(home: Path, user: str) -> None:
-    """A student's ~/.jupyter: the instructor's nbgrader extensions switched off, and no prompt
-    about Jupyter's news (the server's namespace has no network to fetch them)."""
+    """A student's ~/.jupyter: no prompt about Jupyter's news (the server's namespace has no network
+    to fetch them). The instructor's nbgrader extensions are off through course_lib/student_lab on
+    the student's JUPYTER_CONFIG_PATH (coursehub.sandbox.user_environment), as in `make lab`."""
     jupyter = home / ".jupyter"
     notification = jupyter / "lab" / "user-settings" / "@jupyterlab" / "apputils-extension"
     notification.mkdir(parents=True, exist_ok=True)
     (notification / "notification.jupyterlab-settings").write_text(
         json.dumps({"fetchNews": "false", "checkForUpdates": False}, indent=2))
-    (jupyter / "labconfig").mkdir(parents=True, exist_ok=True)
-    (jupyter / "labconfig" / "page_config.json").write_text(
-        json.dumps({"disabledExtensions": {name: True for name in INSTRUCTOR_LAB_EXTENSIONS}}, indent=2))
-    (jupyter / "jupyter_server_config.json").write_text(
-        json.dumps({"ServerApp": {"jpserver_extensions": {name: False for name in INSTRUCTOR_SERVER_EXTENSIONS}}},
-                   indent=2))
     chown_tree(jupyter, user)
