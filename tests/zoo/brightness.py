@@ -138,8 +138,10 @@ def entries(course_dir: str) -> dict[str, dict]:
         "cheater": dict(edits=[(SUM, STEAL_ANSWER), cheater], values=0, node=None, reason="returned 0, expected"),
         "import_loop": dict(edits=[(IMPORTS, IMPORTS + "while True:\n    pass\n")], values=0, node=0,
                             reason="did not finish within"),
-        "callback_loop": dict(edits=[(CALLBACK, "        while True:\n            pass")], values=4, node=None,
-                              reason="no value on /brightness"),
+        # A callback that never returns: the endpoints' points only; what needs answers is named
+        # as following from the unanswered frames (run through the checks: no kernel involved).
+        "callback_loop": dict(level="check", edits=[(CALLBACK, "        while True:\n            pass")], values=None,
+                              node=2.0, reason="no value on /brightness"),
         # Crashes in the student's function also crash the kernel when the notebook's own demo
         # cell calls it: nbgrader cannot finish the notebook, the grade is 0 with the reason.
         "segfault": dict(edits=[(SUM, "import ctypes; ctypes.string_at(0)")], values=0, node=0,
