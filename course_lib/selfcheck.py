@@ -208,3 +208,59 @@ def task4_order_corners(function) -> Verdict:
                                f"{', '.join(names[m] for m in matches)}; expected {', '.join(names)}.")
     return _verdict(True, "order_corners puts four corners in the order top-left, top-right, bottom-right, "
                           "bottom-left, for tilted and perspective shapes too.")
+
+
+def _launch_nodes(path) -> list[dict]:
+    """What each node of a launch file would start with, without starting it."""
+    from pathlib import Path
+
+    from course_lib.launch.actions import run_launch_file
+
+    context = run_launch_file(path)
+    try:
+        nodes = []
+        for node in context.nodes:
+            command = list(node.command)
+            ros_args = command[command.index("--ros-args") + 1:] if "--ros-args" in command else []
+            remaps, params = [], []
+            for flag, value in zip(ros_args, ros_args[1:]):
+                if flag == "-r" and not value.startswith("__"):
+                    remaps.append(value)
+                elif flag == "--params-file":
+                    params.append(Path(value).read_text())
+            nodes.append({"executable": "/".join(Path(command[0]).parts[-2:]), "output": node.output,
+                          "name": node.node_name, "namespace": node.namespace, "remaps": sorted(remaps),
+                          "parameter files": params})
+        return nodes
+    finally:
+        context.remove_files()
+
+
+def task_launch_yaml(yaml_file, xml_file) -> Verdict:
+    """Lesson 02b: a YAML launch file starts the same nodes as the XML one (command lines, output)."""
+    from course_lib.launch import LaunchFileError
+
+    hint = ("Write the YAML file as a list under `launch:`, one `- node:` per <node> tag, with the keys pkg, "
+            "exec, output, and lists `param:` and `remap:`.")
+    try:
+        wanted = _launch_nodes(xml_file)
+    except (LaunchFileError, LookupError, OSError) as error:
+        return _verdict(False, f"The XML launch file does not run ({error}); build the workspace and call "
+                               "workspace.use_workspace(WS) first.")
+    try:
+        given = _launch_nodes(yaml_file)
+    except (LaunchFileError, LookupError, OSError) as error:
+        return _verdict(False, f"Your YAML launch file cannot run: {error}")
+    if not given:
+        return _verdict(False, "Not done yet: your launch file starts no node. " + hint)
+    if len(given) != len(wanted):
+        return _verdict(False, f"Your launch file starts {len(given)} node(s); the XML file starts {len(wanted)}.")
+    for index, (mine, theirs) in enumerate(zip(given, wanted), start=1):
+        if mine["executable"] != theirs["executable"]:
+            return _verdict(False, f"Node {index} runs {mine['executable']}; the XML file's node {index} runs "
+                                   f"{theirs['executable']} (pkg and exec, in the same order).")
+        for key in ("output", "name", "namespace", "remaps", "parameter files"):
+            if mine[key] != theirs[key]:
+                return _verdict(False, f"Node {index} ({theirs['executable']}): {key} is {mine[key]!r}, the XML "
+                                       f"file gives {theirs[key]!r}.")
+    return _verdict(True, f"Your YAML launch file starts the same {len(given)} nodes as the XML one.")
