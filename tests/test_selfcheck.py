@@ -124,3 +124,72 @@ def test_task4_catches_taking_the_two_highest_points_as_the_top():
 
     verdict = selfcheck.task4_order_corners(two_highest_are_top)
     assert not verdict and "long rectangle tilted by 30 degrees" in str(verdict)
+
+
+# ---- lesson 02b: the launch file in YAML ------------------------------------------------------
+
+def lesson_file(notebook: str, relative: str) -> str:
+    """The text a lesson's %%writefile cell writes to a path ending in `relative`."""
+    import json
+    from pathlib import Path
+
+    cells = json.loads((Path(__file__).resolve().parents[1] / "notebooks" / notebook).read_text())["cells"]
+    for cell in cells:
+        source = "".join(cell["source"])
+        first, _, body = source.partition("\n")
+        if first.startswith("%%writefile") and first.endswith(relative):
+            return body
+    raise LookupError(f"{notebook} writes no {relative}")
+
+
+LAUNCH_YAML = """\
+launch:
+- node:
+    pkg: image_stats
+    exec: camera
+    output: screen
+    param:
+    - {from: $(find-pkg-share image_stats)/config/dark_fraction.yaml}
+    remap:
+    - {from: image, to: /camera/image_raw}
+- node:
+    pkg: image_stats
+    exec: dark_fraction
+    output: screen
+    param:
+    - {from: $(find-pkg-share image_stats)/config/dark_fraction.yaml}
+    remap:
+    - {from: image, to: /camera/image_raw}
+"""
+
+
+@pytest.fixture
+def image_stats_launch(tmp_path, monkeypatch):
+    """The lesson's XML launch file, and image_stats installed (ament index, executables, share files)."""
+    import os
+
+    from launch_demo import make_prefix
+
+    prefix = make_prefix(tmp_path / "install", "image_stats", {"camera": "#!/bin/sh\n", "dark_fraction": "#!/bin/sh\n"},
+                         {"config/dark_fraction.yaml": lesson_file("02b_packages_launch_parameters.ipynb",
+                                                                   "config/dark_fraction.yaml")})
+    monkeypatch.setenv("AMENT_PREFIX_PATH", f"{prefix}{os.pathsep}{os.environ.get('AMENT_PREFIX_PATH', '')}")
+    xml = tmp_path / "dark.launch.xml"
+    xml.write_text(lesson_file("02b_packages_launch_parameters.ipynb", "launch/dark.launch.xml"))
+    return xml
+
+
+@pytest.mark.parametrize("answer, expected", [
+    (lesson_file("02b_packages_launch_parameters.ipynb", "launch/dark.launch.yaml"), "Not done yet"),
+    (LAUNCH_YAML.replace("    remap:\n    - {from: image, to: /camera/image_raw}\n", "", 1), "remaps is []"),
+    (LAUNCH_YAML.replace("    output: screen\n", "", 1), "output is 'log'"),
+    (LAUNCH_YAML.replace("exec: dark_fraction", "exec: camera"), "Node 2 runs image_stats/camera"),
+    (LAUNCH_YAML.replace("remap:\n    - {from", "remap:\n      {from"), "cannot run"),
+    (LAUNCH_YAML, "✔"),
+])
+def test_launch_yaml_check_fails_the_stub_and_wrong_files_and_passes_the_xml_twin(image_stats_launch, tmp_path,
+                                                                                   answer, expected):
+    yaml_file = tmp_path / "dark.launch.yaml"
+    yaml_file.write_text(answer)
+    verdict = selfcheck.task_launch_yaml(yaml_file, image_stats_launch)
+    assert bool(verdict) == (expected == "✔") and expected in str(verdict), str(verdict)
