@@ -264,3 +264,75 @@ def task_launch_yaml(yaml_file, xml_file) -> Verdict:
                 return _verdict(False, f"Node {index} ({theirs['executable']}): {key} is {mine[key]!r}, the XML "
                                        f"file gives {theirs[key]!r}.")
     return _verdict(True, f"Your YAML launch file starts the same {len(given)} nodes as the XML one.")
+
+
+def _board_views():
+    """(name, {marker id: corners}, {picture: corners}) of the board seen upright, turned and in perspective."""
+    import numpy as np
+
+    from course_lib import scenes
+
+    board = scenes.default_board()
+    bw, bh = board.size
+    views = []
+    for name, degrees, tilt in (("an upright board", 0, 0.0), ("a board turned by 120 degrees", 120, 0.0),
+                                ("a board seen in perspective", -25, 0.0006)):
+        a = np.radians(degrees)
+        H = np.array([[np.cos(a), -np.sin(a), 320], [np.sin(a), np.cos(a), 240], [tilt, 0, 1]]) @ \
+            np.array([[0.5, 0, -0.25 * bw], [0, 0.5, -0.25 * bh], [0, 0, 1]])
+
+        def project(points, H=H):
+            p = np.column_stack([points, np.ones(len(points))]) @ H.T
+            return (p[:, :2] / p[:, 2:]).astype(np.float32)
+
+        markers = {i: project(board.marker_square(i)) for ids in scenes.PICTURES.values() for i in ids}
+        pictures = {picture: project(board.picture_slot(picture)) for picture in scenes.PICTURES}
+        views.append((name, markers, pictures))
+    return views
+
+
+def task_picture_corners(function) -> Verdict:
+    """Lesson 03: picture_corners_of(markers, picture) takes each framing marker's corner that touches the picture."""
+    import numpy as np
+
+    from course_lib import scenes
+
+    hint = ("Write picture_corners_of(markers, picture): for each marker of scenes.PICTURES[picture] (top-left, "
+            "top-right, bottom-right, bottom-left), take the one of its four corners that touches the picture, and "
+            "return the four points as a (4, 2) array.")
+    if (result := _not_done(function, hint)) is not None:
+        return result
+    if not callable(function):
+        return _verdict(False, f"Pass the function itself (picture_corners_of), not a {type(function).__name__}.")
+    places = ("top-left", "top-right", "bottom-right", "bottom-left")
+    for view, markers, pictures in _board_views():
+        for picture, expected in pictures.items():
+            answer, problem = _call(function, {i: c.copy() for i, c in markers.items()}, picture)
+            if problem is not None:
+                return problem
+            if answer is None:
+                return _verdict(False, "Not done yet: picture_corners_of returns None. " + hint)
+            try:
+                answer = np.asarray(answer, dtype=np.float32).reshape(4, 2)
+            except (TypeError, ValueError):
+                return _verdict(False, f"picture_corners_of should return 4 points, a (4, 2) array; for the "
+                                       f"{picture} it returned {answer!r}.")
+            for place, marker_id, point, want in zip(places, scenes.PICTURES[picture], answer, expected):
+                if np.allclose(point, want, atol=1e-2):
+                    continue
+                which = [(i, k) for i, corners in markers.items() for k in range(4)
+                         if np.allclose(point, corners[k], atol=1e-2)]
+                if which and which[0][0] != marker_id:
+                    return _verdict(False, f"For the {picture}'s {place} corner ({view}) you took a corner of marker "
+                                           f"{which[0][0]}; that corner lies on marker {marker_id} "
+                                           f"(scenes.PICTURES[{picture!r}] lists the markers top-left first).")
+                if which:
+                    return _verdict(False, f"For the {picture}'s {place} corner ({view}) you took corner "
+                                           f"{which[0][1]} of marker {marker_id}, which does not touch the picture: "
+                                           "take the corner of the marker that points at the picture (OpenCV "
+                                           "numbers a marker's corners 0 top-left, 1 top-right, 2 bottom-right, "
+                                           "3 bottom-left of the upright marker, whatever way it is turned).")
+                return _verdict(False, f"For the {picture}'s {place} corner ({view}) you returned {point.tolist()}, "
+                                       "which is no corner of a marker: return marker corners as they are.")
+    return _verdict(True, "picture_corners_of takes the right corner of each marker, also for turned and tilted "
+                          "boards.")

@@ -153,5 +153,5 @@ def test_launch_file_and_parameter_commands(built):
             check(command, run_shell(command, ws, env))
     finally:
         demo.stop()
-    log = demo.log()
+    log = demo.log
     assert "[dark_fraction-2]" in log and "now counting pixels darker than 100" in log, log

@@ -193,3 +193,29 @@ def test_launch_yaml_check_fails_the_stub_and_wrong_files_and_passes_the_xml_twi
     yaml_file.write_text(answer)
     verdict = selfcheck.task_launch_yaml(yaml_file, image_stats_launch)
     assert bool(verdict) == (expected == "✔") and expected in str(verdict), str(verdict)
+
+
+# ---- lesson 03: the cat/dog corner mapping ----------------------------------------------------
+
+def corners_using(marker_corner):
+    """A picture_corners_of that takes corner marker_corner[k] of the k-th marker of the picture."""
+    import numpy as np
+
+    from course_lib import scenes
+
+    def picture_corners_of(markers, picture):
+        return np.array([markers[m][c] for m, c in zip(scenes.PICTURES[picture], marker_corner)])
+    return picture_corners_of
+
+
+@pytest.mark.parametrize("answer, expected", [
+    (lambda markers, picture: None, "Not done yet"),
+    (corners_using((0, 0, 0, 0)), "you took corner 0 of marker 1, which does not touch the picture"),
+    (lambda markers, picture: corners_using((2, 3, 0, 1))(markers, "dog" if picture == "cat" else "cat"),
+     "you took a corner of marker 5; that corner lies on marker 1"),
+    (lambda markers, picture: [[0, 0]] * 4, "no corner of a marker"),
+    (corners_using((2, 3, 0, 1)), "✔"),
+])
+def test_picture_corner_check_fails_the_stub_and_wrong_corners_and_passes_the_convention(answer, expected):
+    verdict = selfcheck.task_picture_corners(answer)
+    assert bool(verdict) == (expected == "✔") and expected in str(verdict), str(verdict)
