@@ -335,7 +335,7 @@ def crop_pictures(frame_bgr: np.ndarray, size=(320, 240)) -> dict:
         # with the dark areas thinned (a maximum filter; at twice the size for a finer step), and
         # move the corners found back out by the amount thinned.
         grey = frame_bgr if frame_bgr.ndim == 2 else cv2.cvtColor(frame_bgr, cv2.COLOR_BGR2GRAY)
-        for scale, kernel in ((1, 3), (2, 3), (2, 5), (1, 5)):
+        for scale, kernel in ((1, 3), (2, 5)):
             bigger = cv2.resize(grey, None, fx=scale, fy=scale) if scale > 1 else grey
             lighter = cv2.dilate(bigger, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (kernel, kernel)))
             for i, c in detect(lighter).items():

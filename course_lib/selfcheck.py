@@ -146,6 +146,22 @@ def task3_brightness_on_change(function) -> Verdict:
                           "up or down, and no other.")
 
 
+def _four_points(function, args, function_name: str, hint: str, case: str):
+    """Call function(*args) and read its answer as four points: (float32 (4, 2) array, None) or (None, Verdict)."""
+    import numpy as np
+
+    answer, problem = _call(function, *args)
+    if problem is not None:
+        return None, problem
+    if answer is None:
+        return None, _verdict(False, f"Not done yet: {function_name} returns None. " + hint)
+    try:
+        return np.asarray(answer, dtype=np.float32).reshape(4, 2), None
+    except (TypeError, ValueError):
+        return None, _verdict(False, f"{function_name} should return 4 points, a (4, 2) array; for {case} it "
+                                     f"returned {answer!r}.")
+
+
 def task4_order_corners(function) -> Verdict:
     """Task 4 (lesson 03): order_corners(points) returns four points as top-left, top-right, bottom-right, bottom-left."""
     import math
@@ -180,16 +196,9 @@ def task4_order_corners(function) -> Verdict:
     for name, expected, shuffle in cases:
         expected = np.asarray(expected, dtype=np.float32)
         given = expected[list(shuffle)]
-        answer, problem = _call(function, given.copy())
+        answer, problem = _four_points(function, (given.copy(),), "order_corners", hint, name)
         if problem is not None:
             return problem
-        if answer is None:
-            return _verdict(False, "Not done yet: order_corners returns None. " + hint)
-        try:
-            answer = np.asarray(answer, dtype=np.float32).reshape(4, 2)
-        except (TypeError, ValueError):
-            return _verdict(False, f"order_corners should return 4 points, a (4, 2) array; for {name} it "
-                                   f"returned {answer!r}.")
         if np.allclose(answer, expected, atol=1e-3):
             continue
         matches = [next((i for i in range(4) if np.allclose(p, expected[i], atol=1e-3)), None) for p in answer]
@@ -307,16 +316,10 @@ def task_picture_corners(function) -> Verdict:
     places = ("top-left", "top-right", "bottom-right", "bottom-left")
     for view, markers, pictures in _board_views():
         for picture, expected in pictures.items():
-            answer, problem = _call(function, {i: c.copy() for i, c in markers.items()}, picture)
+            answer, problem = _four_points(function, ({i: c.copy() for i, c in markers.items()}, picture),
+                                           "picture_corners_of", hint, f"the {picture}")
             if problem is not None:
                 return problem
-            if answer is None:
-                return _verdict(False, "Not done yet: picture_corners_of returns None. " + hint)
-            try:
-                answer = np.asarray(answer, dtype=np.float32).reshape(4, 2)
-            except (TypeError, ValueError):
-                return _verdict(False, f"picture_corners_of should return 4 points, a (4, 2) array; for the "
-                                       f"{picture} it returned {answer!r}.")
             for place, marker_id, point, want in zip(places, scenes.PICTURES[picture], answer, expected):
                 if np.allclose(point, want, atol=1e-2):
                     continue

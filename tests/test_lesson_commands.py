@@ -53,6 +53,16 @@ COMMANDS_02B = {
 }
 
 
+LESSON_00 = "00_setup_and_workspace.ipynb"
+
+#: Lesson 00's commands, in order, with the pattern their output must contain.
+COMMANDS_00 = {
+    "ros2 --help | head -n 12": r"^usage: ros2 ",
+    "ros2 pkg executables my_package": r"^my_package my_node\n$",
+    "ros2 node list": r"^/my_node$",
+}
+
+
 def shown_commands(notebook: str) -> list[str]:
     """The `!` lines of the code cells and the lines of the ```bash blocks, in order; repeats get #2, #3..."""
     commands = []
@@ -88,8 +98,8 @@ def run_shell(command: str, ws: Path, env: dict) -> str:
     return done.stdout + done.stderr  # what the terminal shows (ros2 param set prints a refusal to stderr)
 
 
-def check(command: str, output: str) -> None:
-    pattern = COMMANDS_02B[command]
+def check(command: str, output: str, commands: dict = COMMANDS_02B) -> None:
+    pattern = commands[command]
     assert re.search(pattern, output, re.M), f"`{command}` printed:\n{output}"
 
 
@@ -115,6 +125,8 @@ def built(tmp_path_factory):
 
 def test_every_command_shown_is_checked():
     assert shown_commands(LESSON) == list(COMMANDS_02B)
+    assert shown_commands(LESSON_00) == list(COMMANDS_00)
+    assert shown_commands("03_aruco_and_homography.ipynb") == []
 
 
 def test_create_and_build_commands(built):
@@ -155,3 +167,19 @@ def test_launch_file_and_parameter_commands(built):
         demo.stop()
     log = demo.log
     assert "[dark_fraction-2]" in log and "now counting pixels darker than 100" in log, log
+
+
+def test_lesson_00_commands(tmp_path):
+    """The lesson's package built as the lesson builds it, its node running: the ! lines print what it shows."""
+    ws = tmp_path / "ros2_ws"
+    workspace.create_package(ws, "my_package", dependencies=["rclpy"], node_name="my_node")
+    (ws / "src/my_package/my_package/my_node.py").write_text(lesson_files(LESSON_00)["ros2_ws/src/my_package/my_package/my_node.py"])
+    workspace.build(ws, ["my_package"])
+    env = workspace.workspace_environment(ws)
+    node = workspace.run(ws, "my_package", "my_node")
+    try:
+        node.wait_for_node("my_node", timeout=30)
+        for command in COMMANDS_00:
+            check(command, run_shell(command, ws, env), COMMANDS_00)
+    finally:
+        node.stop()

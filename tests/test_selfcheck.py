@@ -142,25 +142,17 @@ def lesson_file(notebook: str, relative: str) -> str:
     raise LookupError(f"{notebook} writes no {relative}")
 
 
-LAUNCH_YAML = """\
-launch:
+LAUNCH_NODE = """\
 - node:
     pkg: image_stats
-    exec: camera
+    exec: {}
     output: screen
     param:
-    - {from: $(find-pkg-share image_stats)/config/dark_fraction.yaml}
+    - {{from: $(find-pkg-share image_stats)/config/dark_fraction.yaml}}
     remap:
-    - {from: image, to: /camera/image_raw}
-- node:
-    pkg: image_stats
-    exec: dark_fraction
-    output: screen
-    param:
-    - {from: $(find-pkg-share image_stats)/config/dark_fraction.yaml}
-    remap:
-    - {from: image, to: /camera/image_raw}
+    - {{from: image, to: /camera/image_raw}}
 """
+LAUNCH_YAML = "launch:\n" + LAUNCH_NODE.format("camera") + LAUNCH_NODE.format("dark_fraction")
 
 
 @pytest.fixture

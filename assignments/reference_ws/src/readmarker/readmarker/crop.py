@@ -64,7 +64,7 @@ _BOARD_IDS = tuple(i for ids in scenes.PICTURES.values() for i in ids)
 
 #: (scale, kernel) of the second looks: lighten the frame with a kernel x kernel maximum filter
 #: at that scale, which thins every dark area by kernel // 2 / scale pixels.
-ERODE_PASSES = ((1, 3), (2, 3), (2, 5), (1, 5))
+ERODE_PASSES = ((1, 3), (2, 5))
 
 
 def find_board_markers(frame, detector=None, erode_passes=ERODE_PASSES, paint_pictures=True):
