@@ -347,11 +347,11 @@ def crop_pictures(frame_bgr: np.ndarray, size=(320, 240)) -> dict:
         if 2 <= len(known) < len(board_ids):
             # Two markers give the board's homography: paint the pictures white and look again.
             board = scenes.default_board()
-            H, _ = cv2.findHomography(np.concatenate([board.marker_square(i) for i in known]).astype(np.float32) - 0.5,
+            H, _ = cv2.findHomography(np.concatenate([board.marker_square(i) for i in known]).astype(np.float32),
                                       np.concatenate([found[i] for i in known]).astype(np.float32))
             painted = grey.copy()
             for name in scenes.PICTURES if H is not None else ():
-                slot = cv2.perspectiveTransform((board.picture_slot(name) - 0.5)[None].astype(np.float32), H)[0]
+                slot = cv2.perspectiveTransform(board.picture_slot(name)[None].astype(np.float32), H)[0]
                 cv2.fillConvexPoly(painted, np.round(slot * 16).astype(np.int32), 255, cv2.LINE_AA, shift=4)
             for i, c in (detect(painted) if H is not None else {}).items():
                 if i in board_ids and i not in found:

@@ -113,14 +113,14 @@ def find_board_markers(frame, detector=None, erode_passes=ERODE_PASSES, paint_pi
 
 def _markers_beside_painted_pictures(grey, found, known, detector):
     board = scenes.default_board()  # only its geometry (board units) is used, the same for any pictures
-    square = np.concatenate([board.marker_square(i) for i in known]) - 0.5
+    square = np.concatenate([board.marker_square(i) for i in known])
     seen = np.concatenate([found[i] for i in known])
     homography, _ = cv2.findHomography(square.astype(np.float32), seen.astype(np.float32))
     if homography is None:
         return {}
     painted = grey.copy()
     for name in scenes.PICTURES:
-        slot = cv2.perspectiveTransform((board.picture_slot(name) - 0.5)[None].astype(np.float32), homography)[0]
+        slot = cv2.perspectiveTransform(board.picture_slot(name)[None].astype(np.float32), homography)[0]
         cv2.fillConvexPoly(painted, np.round(slot * 16).astype(np.int32), 255, cv2.LINE_AA, shift=4)
     new = {i: c for i, c in find_markers(painted, detector).items() if i in _BOARD_IDS and i not in found}
     if not new:
