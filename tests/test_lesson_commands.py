@@ -36,7 +36,7 @@ COMMANDS_02B = {
     "cd {WS} && colcon build --symlink-install --packages-select image_stats 2>&1 | tail -n 3":
         r"Summary: 1 package finished",
     "ros2 pkg executables image_stats": r"^image_stats camera\nimage_stats dark_fraction\n$",
-    "ros2 run image_stats camera --ros-args -r image:=/camera/image_raw": None,
+    "ros2 run image_stats camera --ros-args -r image:=/camera/image_raw -p rate:=10.0": None,
     "ros2 run image_stats dark_fraction --ros-args -r /image:=/camera/image_raw": None,
     "ros2 topic list -t": r"/camera/image_raw \[sensor_msgs/msg/Image\]\n/dark_fraction \[std_msgs/msg/Float32\]\n"
                           r"/dark_fraction/frames \[std_msgs/msg/UInt32\]",
@@ -143,7 +143,7 @@ def start(command: str, env: dict) -> processes.NodeProcess:
 
 def test_ros2_run_with_remapping_and_topic_echo(built):
     ws, env, _ = built
-    camera = start("ros2 run image_stats camera --ros-args -r image:=/camera/image_raw", env)
+    camera = start("ros2 run image_stats camera --ros-args -r image:=/camera/image_raw -p rate:=10.0", env)
     node = start("ros2 run image_stats dark_fraction --ros-args -r /image:=/camera/image_raw", env)
     try:
         node.wait_for_node("dark_fraction", timeout=30)
