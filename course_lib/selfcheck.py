@@ -157,6 +157,32 @@ def task3_brightness_on_change(function) -> Verdict:
                           "up or down, and no other.")
 
 
+def _four_points(function, args, function_name: str, hint: str, case: str, array_only: bool = False):
+    """Call function(*args) and read its answer as four points: (float32 (4, 2) array, None) or (None, Verdict).
+    With `array_only`, a list of points is refused (what follows needs the array the task asks for)."""
+    import numpy as np
+
+    answer, problem = _call(function, *args)
+    if problem is not None:
+        return None, problem
+    if answer is None:
+        return None, _verdict(False, f"Not done yet: {function_name} returns None. " + hint)
+    if not array_only and not isinstance(answer, np.ndarray):
+        try:
+            answer = np.asarray(answer, dtype=np.float32)
+        except (TypeError, ValueError):
+            pass
+    if not isinstance(answer, np.ndarray) or answer.shape != (4, 2):
+        what = f"an array of shape {answer.shape}" if isinstance(answer, np.ndarray) else f"a {type(answer).__name__}"
+        return None, _verdict(False, f"{function_name} should return a numpy array of shape (4, 2), which what "
+                                     f"follows indexes as corners[:, 0] and hands to cv2.getPerspectiveTransform; "
+                                     f"for {case} it returned {what}: {answer!r}. Build one with np.array(...).")
+    try:
+        return answer.astype(np.float32), None
+    except (TypeError, ValueError):
+        return None, _verdict(False, f"{function_name} should return numbers; for {case} it returned {answer!r}.")
+
+
 def task4_order_corners(function) -> Verdict:
     """Task 4 (lesson 03): order_corners(points) returns four points as top-left, top-right, bottom-right, bottom-left."""
     import math
@@ -193,21 +219,9 @@ def task4_order_corners(function) -> Verdict:
     for name, expected, shuffle in cases:
         expected = np.asarray(expected, dtype=np.float32)
         given = expected[list(shuffle)]
-        answer, problem = _call(function, given.copy())
+        answer, problem = _four_points(function, (given.copy(),), "order_corners", hint, name, array_only=True)
         if problem is not None:
             return problem
-        if answer is None:
-            return _verdict(False, "Not done yet: order_corners returns None. " + hint)
-        if not isinstance(answer, np.ndarray) or answer.shape != (4, 2):
-            what = (f"an array of shape {answer.shape}" if isinstance(answer, np.ndarray)
-                    else f"a {type(answer).__name__}")
-            return _verdict(False, f"order_corners should return a numpy array of shape (4, 2), which what follows "
-                                   f"indexes as corners[:, 0] and hands to cv2.getPerspectiveTransform; for {name} "
-                                   f"it returned {what}: {answer!r}. Build one with np.array(...).")
-        try:
-            answer = answer.astype(np.float32)
-        except (TypeError, ValueError):
-            return _verdict(False, f"order_corners should return numbers; for {name} it returned {answer!r}.")
         lowest = expected.sum(axis=1).min()
         if any(np.allclose(answer, np.roll(expected, -k, axis=0), atol=1e-3)
                for k in range(4) if expected[k].sum() <= lowest + 1e-3):
@@ -409,3 +423,125 @@ def subscriber_exercise(node_or_class, msg_type, topic: str = "/ros_tutorial_msg
             session.remove_node(node)
         except ValueError:
             pass
+
+
+def _launch_nodes(path) -> list[dict]:
+    """What each node of a launch file would start with, without starting it."""
+    from pathlib import Path
+
+    from course_lib.launch.actions import run_launch_file
+
+    context = run_launch_file(path)
+    try:
+        nodes = []
+        for node in context.nodes:
+            command = list(node.command)
+            ros_args = command[command.index("--ros-args") + 1:] if "--ros-args" in command else []
+            remaps, params = [], []
+            for flag, value in zip(ros_args, ros_args[1:]):
+                if flag == "-r" and not value.startswith("__"):
+                    remaps.append(value)
+                elif flag == "--params-file":
+                    params.append(Path(value).read_text())
+            nodes.append({"executable": "/".join(Path(command[0]).parts[-2:]), "output": node.output,
+                          "name": node.node_name, "namespace": node.namespace, "remaps": sorted(remaps),
+                          "parameter files": params})
+        return nodes
+    finally:
+        context.remove_files()
+
+
+def task_launch_yaml(yaml_file, xml_file) -> Verdict:
+    """Lesson 02b: a YAML launch file starts the same nodes as the XML one (command lines, output)."""
+    from course_lib.launch import LaunchFileError
+
+    hint = ("Write the YAML file as a list under `launch:`, one `- node:` per <node> tag, with the keys pkg, "
+            "exec, output, and lists `param:` and `remap:`.")
+    try:
+        wanted = _launch_nodes(xml_file)
+    except (LaunchFileError, LookupError, OSError) as error:
+        return _verdict(False, f"The XML launch file does not run ({error}); build the workspace and call "
+                               "workspace.use_workspace(WS) first.")
+    try:
+        given = _launch_nodes(yaml_file)
+    except (LaunchFileError, LookupError, OSError) as error:
+        return _verdict(False, f"Your YAML launch file cannot run: {error}")
+    if not given:
+        return _verdict(False, "Not done yet: your launch file starts no node. " + hint)
+    if len(given) != len(wanted):
+        return _verdict(False, f"Your launch file starts {len(given)} node(s); the XML file starts {len(wanted)}.")
+    for index, (mine, theirs) in enumerate(zip(given, wanted), start=1):
+        if mine["executable"] != theirs["executable"]:
+            return _verdict(False, f"Node {index} runs {mine['executable']}; the XML file's node {index} runs "
+                                   f"{theirs['executable']} (pkg and exec, in the same order).")
+        for key in ("output", "name", "namespace", "remaps", "parameter files"):
+            if mine[key] != theirs[key]:
+                return _verdict(False, f"Node {index} ({theirs['executable']}): {key} is {mine[key]!r}, the XML "
+                                       f"file gives {theirs[key]!r}.")
+    return _verdict(True, f"Your YAML launch file starts the same {len(given)} nodes as the XML one.")
+
+
+def _board_views():
+    """(name, {marker id: corners}, {picture: corners}) of the board seen upright, turned and in perspective."""
+    import numpy as np
+
+    from course_lib import scenes
+
+    board = scenes.default_board()
+    bw, bh = board.size
+    views = []
+    for name, degrees, tilt in (("an upright board", 0, 0.0), ("a board turned by 120 degrees", 120, 0.0),
+                                ("a board seen in perspective", -25, 0.0006)):
+        a = np.radians(degrees)
+        H = np.array([[np.cos(a), -np.sin(a), 320], [np.sin(a), np.cos(a), 240], [tilt, 0, 1]]) @ \
+            np.array([[0.5, 0, -0.25 * bw], [0, 0.5, -0.25 * bh], [0, 0, 1]])
+
+        def project(points, H=H):
+            p = np.column_stack([points, np.ones(len(points))]) @ H.T
+            return (p[:, :2] / p[:, 2:]).astype(np.float32)
+
+        markers = {i: project(board.marker_square(i)) for ids in scenes.PICTURES.values() for i in ids}
+        pictures = {picture: project(board.picture_slot(picture)) for picture in scenes.PICTURES}
+        views.append((name, markers, pictures))
+    return views
+
+
+def task_picture_corners(function) -> Verdict:
+    """Lesson 03: picture_corners_of(markers, picture) takes each framing marker's corner that touches the picture."""
+    import numpy as np
+
+    from course_lib import scenes
+
+    hint = ("Write picture_corners_of(markers, picture): for each marker of scenes.PICTURES[picture] (top-left, "
+            "top-right, bottom-right, bottom-left), take the one of its four corners that touches the picture, and "
+            "return the four points as a (4, 2) array.")
+    if (result := _not_done(function, hint)) is not None:
+        return result
+    if not callable(function):
+        return _verdict(False, f"Pass the function itself (picture_corners_of), not a {type(function).__name__}.")
+    places = ("top-left", "top-right", "bottom-right", "bottom-left")
+    for view, markers, pictures in _board_views():
+        for picture, expected in pictures.items():
+            answer, problem = _four_points(function, ({i: c.copy() for i, c in markers.items()}, picture),
+                                           "picture_corners_of", hint, f"the {picture}")
+            if problem is not None:
+                return problem
+            for place, marker_id, point, want in zip(places, scenes.PICTURES[picture], answer, expected):
+                if np.allclose(point, want, atol=1e-2):
+                    continue
+                which = [(i, k) for i, corners in markers.items() for k in range(4)
+                         if np.allclose(point, corners[k], atol=1e-2)]
+                if which and which[0][0] != marker_id:
+                    return _verdict(False, f"For the {picture}'s {place} corner ({view}) you took a corner of marker "
+                                           f"{which[0][0]}; that corner lies on marker {marker_id} "
+                                           f"(scenes.PICTURES[{picture!r}] lists the markers top-left first).")
+                if which:
+                    return _verdict(False, f"For the {picture}'s {place} corner ({view}) you took corner "
+                                           f"{which[0][1]} of marker {marker_id}, which does not touch the picture: "
+                                           "take the corner of the marker that points at the picture (OpenCV "
+                                           "numbers a marker's corners 0 top-left, 1 top-right, 2 bottom-right, "
+                                           "3 bottom-left of the upright marker, whatever way it is turned).")
+                return _verdict(False, f"For the {picture}'s {place} corner ({view}) you returned {point.tolist()}, "
+                                       "which is no corner of a marker: return marker corners as they are.")
+    return _verdict(True, "picture_corners_of takes the right corner of each marker, also for turned and tilted "
+                          "boards.")

@@ -254,3 +254,90 @@ def test_subscriber_exercise_with_a_data_field(exercise_session):
 
     wrong_type = _tutorial_listener(lambda msg: (_stamp(msg), msg.data), msg_type=Int32)
     assert "sends std_msgs/msg/Header" in str(selfcheck.subscriber_exercise(wrong_type, Header))
+
+
+# ---- lesson 02b: the launch file in YAML ------------------------------------------------------
+
+def lesson_file(notebook: str, relative: str) -> str:
+    """The text a lesson's %%writefile cell writes to a path ending in `relative`."""
+    import json
+    from pathlib import Path
+
+    cells = json.loads((Path(__file__).resolve().parents[1] / "notebooks" / notebook).read_text())["cells"]
+    for cell in cells:
+        source = "".join(cell["source"])
+        first, _, body = source.partition("\n")
+        if first.startswith("%%writefile") and first.endswith(relative):
+            return body
+    raise LookupError(f"{notebook} writes no {relative}")
+
+
+LAUNCH_NODE = """\
+- node:
+    pkg: image_stats
+    exec: {}
+    output: screen
+    param:
+    - {{from: $(find-pkg-share image_stats)/config/dark_fraction.yaml}}
+    remap:
+    - {{from: image, to: /camera/image_raw}}
+"""
+LAUNCH_YAML = "launch:\n" + LAUNCH_NODE.format("camera") + LAUNCH_NODE.format("dark_fraction")
+
+
+@pytest.fixture
+def image_stats_launch(tmp_path, monkeypatch):
+    """The lesson's XML launch file, and image_stats installed (ament index, executables, share files)."""
+    import os
+
+    from launch_demo import make_prefix
+
+    prefix = make_prefix(tmp_path / "install", "image_stats", {"camera": "#!/bin/sh\n", "dark_fraction": "#!/bin/sh\n"},
+                         {"config/dark_fraction.yaml": lesson_file("02b_packages_launch_parameters.ipynb",
+                                                                   "config/dark_fraction.yaml")})
+    monkeypatch.setenv("AMENT_PREFIX_PATH", f"{prefix}{os.pathsep}{os.environ.get('AMENT_PREFIX_PATH', '')}")
+    xml = tmp_path / "dark.launch.xml"
+    xml.write_text(lesson_file("02b_packages_launch_parameters.ipynb", "launch/dark.launch.xml"))
+    return xml
+
+
+@pytest.mark.parametrize("answer, expected", [
+    (lesson_file("02b_packages_launch_parameters.ipynb", "launch/dark.launch.yaml"), "Not done yet"),
+    (LAUNCH_YAML.replace("    remap:\n    - {from: image, to: /camera/image_raw}\n", "", 1), "remaps is []"),
+    (LAUNCH_YAML.replace("    output: screen\n", "", 1), "output is 'log'"),
+    (LAUNCH_YAML.replace("exec: dark_fraction", "exec: camera"), "Node 2 runs image_stats/camera"),
+    (LAUNCH_YAML.replace("remap:\n    - {from", "remap:\n      {from"), "cannot run"),
+    (LAUNCH_YAML, "✔"),
+])
+def test_launch_yaml_check_fails_the_stub_and_wrong_files_and_passes_the_xml_twin(image_stats_launch, tmp_path,
+                                                                                   answer, expected):
+    yaml_file = tmp_path / "dark.launch.yaml"
+    yaml_file.write_text(answer)
+    verdict = selfcheck.task_launch_yaml(yaml_file, image_stats_launch)
+    assert bool(verdict) == (expected == "✔") and expected in str(verdict), str(verdict)
+
+
+# ---- lesson 03: the cat/dog corner mapping ----------------------------------------------------
+
+def corners_using(marker_corner):
+    """A picture_corners_of that takes corner marker_corner[k] of the k-th marker of the picture."""
+    import numpy as np
+
+    from course_lib import scenes
+
+    def picture_corners_of(markers, picture):
+        return np.array([markers[m][c] for m, c in zip(scenes.PICTURES[picture], marker_corner)])
+    return picture_corners_of
+
+
+@pytest.mark.parametrize("answer, expected", [
+    (lambda markers, picture: None, "Not done yet"),
+    (corners_using((0, 0, 0, 0)), "you took corner 0 of marker 1, which does not touch the picture"),
+    (lambda markers, picture: corners_using((2, 3, 0, 1))(markers, "dog" if picture == "cat" else "cat"),
+     "you took a corner of marker 5; that corner lies on marker 1"),
+    (lambda markers, picture: [[0, 0]] * 4, "no corner of a marker"),
+    (corners_using((2, 3, 0, 1)), "✔"),
+])
+def test_picture_corner_check_fails_the_stub_and_wrong_corners_and_passes_the_convention(answer, expected):
+    verdict = selfcheck.task_picture_corners(answer)
+    assert bool(verdict) == (expected == "✔") and expected in str(verdict), str(verdict)
