@@ -101,9 +101,12 @@ THROUGHPUT_RATE = 30.0
 #: 6 million bytes, ~5 ms of the 33 ms between frames), so a loaded grading machine, where DDS
 #: drops large best-effort frames and the nodes compete for the processor, costs both alike; a
 #: per-byte Python loop (seconds per frame) falls far short.
-THROUGHPUT_SHARE = 0.5
+THROUGHPUT_SHARE = 0.4
+#: Bursts at most: a node that falls short gets one more burst, its better one counts (a busy
+#: grading machine's scheduler favours one process or the other for a second or two).
+THROUGHPUT_BURSTS = 2
 #: Below this many answers from the yardstick node, the machine was too busy to measure.
-THROUGHPUT_MIN_REFERENCE = 6
+THROUGHPUT_MIN_REFERENCE = 20
 YARDSTICK_NODE_NAME = "brightness_yardstick"
 YARDSTICK_ANSWERS = "/grader/yardstick_answers"
 #: The name the remapping test gives the student's node, and its topics.
@@ -380,13 +383,20 @@ def _throughput(ctx, probe, publisher, replies, yardstick_replies, images: list)
         ctx.item(True, f"{label}: not measured, the grader's yardstick node did not start in time; "
                        "not held against you", weight=2.0)
         return
-    _burst(probe, publisher, replies, yardstick_replies, [image_msgs.image_to_msg(i, "bgr8") for i in images])
-    right = sum(1 for value in replies if value in expected)
-    reference = len(yardstick_replies)
-    if reference < THROUGHPUT_MIN_REFERENCE:
+    frames = [image_msgs.image_to_msg(i, "bgr8") for i in images]
+    measured = []  # (right answers, yardstick answers) of each burst
+    for _ in range(THROUGHPUT_BURSTS):
+        _burst(probe, publisher, replies, yardstick_replies, frames)
+        right, reference = sum(1 for value in replies if value in expected), len(yardstick_replies)
+        if reference >= THROUGHPUT_MIN_REFERENCE:
+            measured.append((right, reference))
+            if right >= THROUGHPUT_SHARE * reference:
+                break
+    if not measured:
         ctx.item(True, f"{label}: not measured, the grading machine was too busy (the grader's yardstick node got "
                        f"{reference} of {count} frames); not held against you", weight=2.0)
         return
+    right, reference = max(measured, key=lambda m: m[0] / m[1])
     message = (f"{label}: your node answered {right} of {count} frames right while the grader's yardstick node, "
                f"which does one numpy sum per frame, answered {reference} of the same frames (needs {THROUGHPUT_SHARE:.0%} of that)")
     if right >= THROUGHPUT_SHARE * reference:
