@@ -32,6 +32,7 @@ LEVELS = {10: "DEBUG", 20: "INFO", 30: "WARN", 40: "ERROR", 50: "FATAL"}
 _lock = threading.Lock()
 _views: dict[str, list["_NodeLog"]] = {}  # logger name -> the views of its nodes, oldest first
 _subscribed_node = None  # the tool node that holds the /rosout subscription
+_subscription = None  # that subscription
 _explained = False
 
 
@@ -130,7 +131,27 @@ def _subscribe() -> None:
     # As /rosout's publishers offer it: reliable, and the last lines kept for a late reader.
     qos = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE,
                      durability=DurabilityPolicy.TRANSIENT_LOCAL)
-    tool.create_subscription(Log, "/rosout", _on_record, qos)
+    global _subscription
+    _subscription = tool.create_subscription(Log, "/rosout", _on_record, qos)
+
+
+def deliver(timeout: float = 2.0) -> None:
+    """Call before destroying a node: waits (at most `timeout` s) until the /rosout reader has
+    matched every /rosout writer the graph shows, then briefly for their kept lines. A writer
+    hands its last lines to a late reader only while it exists, so a node replaced right after it
+    logged (a cell run twice in quick succession) would otherwise lose its lines from the view."""
+    subscription, tool = _subscription, _subscribed_node
+    if subscription is None or tool is None or not in_kernel():
+        return
+    deadline = time.monotonic() + timeout
+    try:
+        while subscription.get_publisher_count() < tool.count_publishers("/rosout"):
+            if time.monotonic() > deadline:
+                return
+            time.sleep(0.02)
+    except Exception:  # the session is shutting down: nothing to wait for
+        return
+    time.sleep(0.1)  # the matched writers send what they kept
 
 
 def format_record(record) -> str:

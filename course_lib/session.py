@@ -394,6 +394,7 @@ def _alive_name(node) -> str:
 
 
 def _remove(state: _State, name: str) -> None:
+    node_logs.deliver()  # the node's last log lines reach its cell before it goes
     node = state.nodes.pop(name)
     state.executor.remove_node(node)  # wakes the executor, which then lets go of spin_lock
     if threading.current_thread() is state.thread:  # a callback removes a node: lock is ours
