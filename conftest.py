@@ -48,18 +48,23 @@ LONGEST_FIRST = ("test_term.py", "test_hub.py", "test_autograder_zoo.py", "test_
 NBMAKE_LESSONS_ENV = "COURSE_TEST_NBMAKE_LESSONS"
 
 
-def _lessons_run_in_chromium(config, items) -> bool:
+def _lessons_run_in_chromium(items) -> bool:
     """True when this run's browser test runs every lesson top to bottom in JupyterLab (Chromium
     on PATH, the test collected): that run checks all nbmake checks (every code cell ran, no
     error) and more (what JupyterLab shows), so nbmake's run of the same lessons is skipped."""
-    import shutil
-
-    if os.environ.get(NBMAKE_LESSONS_ENV) == "1" or shutil.which("chromium") is None:
+    if os.environ.get(NBMAKE_LESSONS_ENV) == "1" or not any(
+            item.name.startswith("test_course_notebook_runs_clean_in_jupyterlab[") for item in items):
         return False
-    return any(item.name.startswith("test_course_notebook_runs_clean_in_jupyterlab[") for item in items)
+    from browser_support import ChromiumUnavailable, find_chromium  # tests/ is on the path: its tests were collected
+
+    try:
+        find_chromium()
+    except ChromiumUnavailable:
+        return False
+    return True
 
 
-def pytest_collection_modifyitems(config, items):
+def pytest_collection_modifyitems(items):
     """Move the items of LONGEST_FIRST to the front, in that order (the rest keep theirs); skip
     nbmake's lesson runs when the browser test runs the lessons (see _lessons_run_in_chromium)."""
     def rank(item):
@@ -67,7 +72,7 @@ def pytest_collection_modifyitems(config, items):
         return LONGEST_FIRST.index(name) if name in LONGEST_FIRST else len(LONGEST_FIRST)
 
     items.sort(key=rank)
-    if _lessons_run_in_chromium(config, items):
+    if _lessons_run_in_chromium(items):
         run_in_lab = {item.name.split("[", 1)[1].rstrip("]") for item in items
                       if item.name.startswith("test_course_notebook_runs_clean_in_jupyterlab[")}
         skip = pytest.mark.skip(reason=f"runs top to bottom in JupyterLab (tests/test_browser.py); "

@@ -183,9 +183,7 @@ def selfcheck(assignment: str, name: str) -> None:
 
     if rosenv.under_grading():
         return
-    result = execute(assignment, name, SELFCHECK_SEED, mode="selfcheck")
-    print(verdict_text(result, graded=False))
-    _display_images(result)
+    result = run_check(assignment, name, SELFCHECK_SEED)
     if result.points < result.max_points:
         lines = [line.strip() for line in result.verdict_lines() if line.lstrip().startswith(("✘", "↳", "!"))]
         sys.stderr.write(f"Self-check {name}: {_fmt(result.points)} of {_fmt(result.max_points)} points. "
@@ -211,7 +209,7 @@ def grade(assignment: str, name: str) -> float:
         print(f"[graded] {get_check(assignment, name).description}\n"
               "  The autograder runs this check outside the notebook; its verdict replaces this text.")
         return 0.0
-    return run_check(assignment, name, fresh_seed(), graded=True)
+    return round(run_check(assignment, name, fresh_seed(), graded=True).points, 3)
 
 
 def fresh_seed() -> int:
@@ -220,12 +218,12 @@ def fresh_seed() -> int:
     return int(seed) if seed else secrets.randbelow(2**31)
 
 
-def run_check(assignment: str, name: str, seed: int, graded: bool = False, workdir=None) -> float:
-    """Run one check in a separate process, print its verdict, display its pictures, return points."""
+def run_check(assignment: str, name: str, seed: int, graded: bool = False, workdir=None) -> Result:
+    """Run one check in a separate process, print its verdict, display its pictures, return its Result."""
     result = execute(assignment, name, seed, workdir=workdir, mode="graded" if graded else "selfcheck")
     print(verdict_text(result, graded))
     _display_images(result)
-    return round(result.points, 3)
+    return result
 
 
 def verdict_text(result: Result, graded: bool) -> str:
