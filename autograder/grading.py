@@ -53,7 +53,7 @@ import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
-from autograder import config, gradebook, intake, kernel
+from autograder import config, gradebook, intake, kernel, packages
 from course_lib.checks import harness
 
 REPO = Path(__file__).resolve().parent.parent
@@ -167,7 +167,7 @@ def submission_digest(sub: Submission, course: Path) -> str:
     digest = hashlib.sha256()
     _tree_digest([sub.path, course / "source" / sub.assignment], digest)
     here, checks = Path(__file__).resolve().parent, Path(harness.__file__).resolve().parent
-    code = [here / "kernel.py", here / "config.py", here / "answers" / f"{sub.assignment}.py",
+    code = [here / "kernel.py", here / "config.py", here / "packages.py", here / "answers" / f"{sub.assignment}.py",
             checks / "harness.py", checks / "student.py", checks / "answers.py", checks / f"{sub.assignment}.py"]
     _tree_digest([path for path in code if path.exists()], digest)
     return digest.hexdigest()
@@ -397,6 +397,9 @@ def grade_submission(sub: Submission, course: Path, domain_id: int) -> GradeResu
             # As root the kernel ran in a subfolder of its own uid (autograder.kernel), where the
             # notebook wrote the student's module.
             workdir = autograded / kernel.WORK_SUBDIR if result.kernel_uid is not None else autograded
+            if packages.needed(sub.assignment, workdir):
+                env = {**env, **packages.build_for_checks(course, work, workdir, result.kernel_uid, domain_id, env,
+                                                          hide, _run_sandboxed)}
             _grade_outside(sub, result, work, autograded, workdir, domain_id, env, hide)
             _scrub_paths(autograded, work)
         if any(c["auto_score"] is None for c in result.cells):

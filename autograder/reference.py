@@ -47,3 +47,39 @@ def write_module(nb: nbformat.NotebookNode, folder: Path, edits=()) -> Path:
 def write_reference_module(assignment: str, folder: Path, edits=()) -> Path:
     """Write the reference solution's module of an assignment into `folder`; return its path."""
     return write_module(source_notebook(assignment), folder, edits)
+
+
+#: The reference packages (assignments/reference_ws/src/<package>): the only copy of each solution.
+REFERENCE_SRC = SOURCE.parent / "reference_ws" / "src"
+
+
+def reference_files(assignment: str) -> dict[str, str]:
+    """{path relative to the notebook's folder (ros2_ws/src/...): text} of an assignment's
+    reference packages, solution markers removed, their tests and caches left out."""
+    from course_lib.checks import packages
+
+    files = {}
+    for package in packages.PACKAGES[assignment]:
+        folder = REFERENCE_SRC / package
+        for path in sorted(p for p in folder.rglob("*") if p.is_file()):
+            relative = path.relative_to(folder)
+            if relative.parts[0] in ("test", "__pycache__") or path.suffix == ".pyc" or "__pycache__" in relative.parts:
+                continue
+            files[f"{packages.WORKSPACE}/src/{package}/{relative.as_posix()}"] = solution_source(path.read_text())
+    return files
+
+
+def write_reference_workspace(assignment: str, folder: Path, edits=()) -> Path:
+    """Write the reference packages of an assignment into folder/ros2_ws/src, with each (old, new)
+    edit applied to the first file that holds `old`; return folder/ros2_ws."""
+    files = reference_files(assignment)
+    for old, new in edits:
+        target = next((name for name, text in files.items() if old in text), None)
+        if target is None:
+            raise ValueError(f"edit {old!r} is in no file of the {assignment} reference packages")
+        files[target] = files[target].replace(old, new, 1)
+    for name, text in files.items():
+        path = Path(folder) / name
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(text)
+    return Path(folder) / "ros2_ws"
