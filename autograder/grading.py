@@ -398,7 +398,7 @@ def grade_submission(sub: Submission, course: Path, domain_id: int) -> GradeResu
             # notebook wrote the student's module.
             workdir = autograded / kernel.WORK_SUBDIR if result.kernel_uid is not None else autograded
             if packages.needed(sub.assignment, workdir):
-                env = {**env, **packages.build_for_checks(course, work, workdir, result.kernel_uid, domain_id, env,
+                env = {**env, **packages.build_for_checks(sub.assignment, course, work, workdir, result.kernel_uid, domain_id, env,
                                                           hide, _run_sandboxed)}
             _grade_outside(sub, result, work, autograded, workdir, domain_id, env, hide)
             _scrub_paths(autograded, work)

@@ -59,6 +59,8 @@ class BuildReport:
         cached: interface packages taken from the cache (not built again).
         built_interfaces: interface packages built now (and put in the cache).
         seconds: wall time of the whole build.
+        reference_underlays: install prefixes of the assignment's reference interface packages,
+            built by the grader (the checks' own nodes use these, never code the student built).
     """
 
     ok: bool
@@ -68,6 +70,7 @@ class BuildReport:
     cached: list[str] = dataclasses.field(default_factory=list)
     built_interfaces: list[str] = dataclasses.field(default_factory=list)
     seconds: float = 0.0
+    reference_underlays: list[str] = dataclasses.field(default_factory=list)
 
     def write(self, path: Path) -> Path:
         path.write_text(json.dumps(dataclasses.asdict(self), indent=1))
@@ -322,8 +325,8 @@ def cache_of(course: Path) -> InterfaceCache:
     return InterfaceCache(Path(course) / "autograder" / ".interface-cache")
 
 
-def build_for_checks(course: Path, work: Path, workdir: Path, uid: int | None, domain_id: int, grader_env: dict,
-                     hide: list[Path], run_sandboxed) -> dict:
+def build_for_checks(assignment: str, course: Path, work: Path, workdir: Path, uid: int | None, domain_id: int,
+                     grader_env: dict, hide: list[Path], run_sandboxed) -> dict:
     """Build the submission's workspace (``workdir/ros2_ws``) in the sandbox as the student's uid,
     write the report into the grader's `work` folder, and return the variables that tell the
     checks where it is ({REPORT_ENV: path}).
@@ -356,7 +359,9 @@ def build_for_checks(course: Path, work: Path, workdir: Path, uid: int | None, d
                              {**env, **sandbox, "HOME": str(home), "PYTHONDONTWRITEBYTECODE": "1"}, cwd, limits)
         return (None if proc.exit_reason == "wall_seconds" else proc.returncode), proc.log
 
-    report = build_workspace(Path(workdir) / WORKSPACE, cache_of(course), scratch, run, give)
+    cache = cache_of(course)
+    report = build_workspace(Path(workdir) / WORKSPACE, cache, scratch, run, give)
+    report.reference_underlays = [str(p) for p in reference_interfaces(assignment, cache, scratch)]
     path = report.write(work / "build-report.json")
     return {REPORT_ENV: str(path)}
 
@@ -367,3 +372,45 @@ def needed(assignment: str, workdir: Path) -> bool:
     from course_lib.checks import packages as checked
 
     return assignment in checked.PACKAGES or (Path(workdir) / WORKSPACE).exists()
+
+
+def run_here(command, cwd, env, wall_seconds):
+    """A build runner without a sandbox (the grader's own reference packages, and tests)."""
+    import subprocess
+
+    try:
+        done = subprocess.run(command, cwd=cwd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                              stdin=subprocess.DEVNULL, text=True, errors="replace", timeout=wall_seconds)
+    except subprocess.TimeoutExpired as error:
+        return None, (error.stdout or "") if isinstance(error.stdout, str) else ""
+    return done.returncode, done.stdout
+
+
+def reference_interfaces(assignment: str, cache: InterfaceCache, scratch: Path) -> list[Path]:
+    """The assignment's reference interface packages (assignments/reference_ws/src), built by the
+    grader itself (cached like the students' under keys of their own) and copied into `scratch`:
+    the checks' probes load these, so no code a student built runs in a check process.
+
+    Raises:
+        RuntimeError: a reference package does not build (the course's fault, not the student's).
+    """
+    from autograder.reference import REFERENCE_SRC
+    from course_lib.checks import packages as checked
+
+    found = []
+    env = workspace.build_environment()
+    for name in checked.PACKAGES.get(assignment, {}):
+        folder = REFERENCE_SRC / name
+        if not is_interface_package(folder):
+            continue
+        key = content_key(folder, ["reference"])
+        install, failure = cache.lookup(key)
+        if install is None:
+            install, failure = _build_interface(name, folder, key, cache, scratch, env, run_here, None)
+        if install is None:
+            raise RuntimeError(f"the reference package {name} does not build:\n{failure}")
+        copy = scratch / "reference" / key / "install"
+        if not copy.exists():
+            shutil.copytree(install, copy, symlinks=True)
+        found.append(copy)
+    return found

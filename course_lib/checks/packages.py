@@ -179,3 +179,49 @@ def dependency_items(ctx, package: str, weight: float = 1.0) -> None:
                  weight=weight)
     else:
         ctx.item(True, f"{package}/package.xml declares every ROS package its code imports", weight=weight)
+
+
+# ---- messages ----------------------------------------------------------------------------------
+
+def use_interfaces(ctx) -> None:
+    """Make the assignment's message packages importable in this check process: at grading the
+    reference interface packages the grader built (never code the student built: the check runs
+    as the grader), in a self-check the student's own workspace."""
+    from course_lib import workspace
+
+    report = os.environ.get(REPORT_ENV)
+    try:
+        if report:
+            for install in json.loads(Path(report).read_text()).get("reference_underlays", []):
+                workspace.use_workspace(Path(install).parent)
+        else:
+            workspace.use_workspace(require_build(ctx))
+    except (FileNotFoundError, RuntimeError) as error:
+        raise harness.StudentError(f"the messages of your workspace cannot be loaded: {error}") from None
+
+
+def message_fields(path: Path) -> list[tuple[str, str]]:
+    """The (type, name) fields of a .msg file, comments, blank lines and constants left out."""
+    fields = []
+    for line in Path(path).read_text(errors="replace").splitlines():
+        line = line.split("#", 1)[0].strip()
+        parts = line.split()
+        if len(parts) >= 2 and "=" not in line:
+            fields.append((parts[0], parts[1]))
+    return fields
+
+
+def message_item(ctx, package: str, message: str, expected: list[tuple[str, str]]) -> bool:
+    """One item: the student's msg/<message>.msg of `package` has exactly the contract's fields."""
+    path = package_dir(ctx, package) / "msg" / f"{message}.msg"
+    if not path.is_file():
+        return ctx.item(False, f"{package}/msg/{message}.msg does not exist: write it with the notebook's cell")
+    fields = message_fields(path)
+    # builtin_interfaces/Time and builtin_interfaces/msg/Time name the same type.
+    found = [(kind.replace("/msg/", "/"), name) for kind, name in fields]
+    wanted = ", ".join(f"{kind} {name}" for kind, name in expected)
+    if found == expected:
+        return ctx.item(True, f"{package}/msg/{message}.msg has the fields {wanted}")
+    have = ", ".join(f"{kind} {name}" for kind, name in fields) or "no fields"
+    return ctx.item(False, f"{package}/msg/{message}.msg has {have}; the contract says {wanted} "
+                           "(a node that uses other fields cannot talk to the grader's)")
