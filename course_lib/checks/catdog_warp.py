@@ -9,9 +9,15 @@ corners that touch it, scenes.CORNER_OF_MARKER):
   key only when all four of that picture's markers are found; each crop is a BGR uint8 image of
   ``size`` (width, height), the picture's top-left corner at pixel (0, 0), upright, not mirrored.
 - ``MarkerReader()``: node ``marker_reader``; subscribes ``image`` (sensor_msgs/Image, any QoS);
-  for each frame publishes the crops it finds on ``cropped_img/cat`` and ``cropped_img/dog``
-  (sensor_msgs/CompressedImage, e.g. images.image_to_compressed(crop, "png")).
+  for each frame publishes each crop it finds on ``cropped_img`` as a
+  ``catdog_interfaces/msg/CroppedPicture``: ``int32 picture`` (CAT = 1, DOG = 2) and
+  ``sensor_msgs/CompressedImage image`` (e.g. images.image_to_compressed(crop, "png")).
 - ``main(args=None)`` runs the node until Ctrl-C.
+
+The packages (``ros2_ws/src``): ``catdog_interfaces`` (the message), ``webcam`` (executable
+``image_publisher``) and ``readmarker`` (``readmarker/crop.py`` with crop_pictures,
+``readmarker/marker_reader.py`` with the node, executable ``marker_reader``, and
+``launch/catdog_warp.launch.xml`` starting both nodes).
 
 Crops are compared with the ground truth of the generated scene (Scene.expected_crops) by
 scenes.crop_similarity, passing at scenes.SAME_CROP_THRESHOLD; colours are checked separately
@@ -24,10 +30,13 @@ import time
 
 import numpy as np
 
-from course_lib.checks import harness
+from course_lib.checks import harness, packages
 from course_lib.checks.harness import check
 
 ASSIGNMENT = "catdog_warp"
+#: The message of a crop: which picture (CAT = 1, DOG = 2) and the crop.
+MESSAGE_FIELDS = [("int32", "picture"), ("sensor_msgs/CompressedImage", "image")]
+PICTURE_NUMBERS = {"cat": 1, "dog": 2}
 SIZE = (320, 240)
 #: Largest difference of the per-channel means of a crop and its expected crop (grey levels).
 COLOUR_TOLERANCE = 20.0
@@ -186,20 +195,27 @@ def noisy(ctx: harness.Context) -> None:
 
 @check(points=3, timeout=90)
 def node(ctx: harness.Context) -> None:
-    """MarkerReader: node marker_reader turns frames on image into crops on cropped_img/cat and cropped_img/dog."""
+    """marker_reader: node marker_reader turns frames on image into CroppedPicture messages on cropped_img."""
     from course_lib import images, scenes
     from rclpy.qos import QoSProfile, ReliabilityPolicy
-    from sensor_msgs.msg import CompressedImage, Image
+    from sensor_msgs.msg import Image
 
-    proc = ctx.start_node()
+    proc = packages.run(ctx, "readmarker", "marker_reader")  # ros2 run readmarker marker_reader
+    packages.use_interfaces(ctx)
+    from catdog_interfaces.msg import CroppedPicture
+
+    packages.message_item(ctx, "catdog_interfaces", "CroppedPicture", MESSAGE_FIELDS)
+    packages.dependency_items(ctx, "readmarker")
     try:
         with ctx.probe() as probe:
             got: dict[str, list] = {"cat": [], "dog": []}
             # Reliable publisher and best-effort subscriptions match every QoS the student may pick.
             pub = probe.node.create_publisher(Image, "image", QoSProfile(depth=5, reliability=ReliabilityPolicy.RELIABLE))
-            for name in got:
-                probe.node.create_subscription(CompressedImage, f"cropped_img/{name}", got[name].append,
-                                               QoSProfile(depth=10, reliability=ReliabilityPolicy.BEST_EFFORT))
+            numbers = {number: name for name, number in PICTURE_NUMBERS.items()}
+            probe.node.create_subscription(
+                CroppedPicture, "cropped_img",
+                lambda msg: got[numbers[msg.picture]].append(msg.image) if msg.picture in numbers else None,
+                QoSProfile(depth=10, reliability=ReliabilityPolicy.BEST_EFFORT))
             names = lambda: {n for n, _ in probe.node.get_node_names_and_namespaces()}  # noqa: E731
             probe.spin_until(lambda: "marker_reader" in names() or not proc.running(), 25.0)
             if not proc.running():
@@ -218,13 +234,14 @@ def node(ctx: harness.Context) -> None:
             types = dict(probe.node.get_topic_names_and_types())
     finally:
         proc.stop(timeout=2)
+    wanted = ["catdog_interfaces/msg/CroppedPicture"]
     for name in ("cat", "dog"):
-        topic = f"/cropped_img/{name}"
+        topic = f"/cropped_img ({name}, picture {PICTURE_NUMBERS[name]})"
         if not got[name]:
-            seen = types.get(topic)
-            ctx.item(False, f"nothing arrived on {topic} within 8 s" +
-                     (f" (it carries {seen}; the contract says sensor_msgs/msg/CompressedImage)" if seen and
-                      seen != ["sensor_msgs/msg/CompressedImage"] else "") +
+            seen = types.get("/cropped_img")
+            ctx.item(False, f"no {name} (picture = {PICTURE_NUMBERS[name]}) arrived on /cropped_img within 8 s" +
+                     (f" (it carries {seen}; the contract says {wanted[0]})" if seen and seen != wanted else
+                      "" if seen else f" (topics: {sorted(t for t in types if not t.startswith(('/rosout', '/parameter')))})") +
                      "; the node's output:\n" + harness.clip(proc.log_tail(4)))
             continue
         try:

@@ -28,11 +28,10 @@ class BrightnessNode(Node):
     """Subscribes /image and publishes the average brightness of every frame on /brightness."""
 
     def __init__(self):
-        super().__init__('my_node')
+        super().__init__("my_node")
         ### BEGIN SOLUTION
-        self.publisher = self.create_publisher(UInt8, '/brightness', qos_profile_sensor_data)
-        self.subscription = self.create_subscription(
-            Image, '/image', self.on_image, qos_profile_sensor_data)
+        self.publisher = self.create_publisher(UInt8, "/brightness", qos_profile_sensor_data)
+        self.subscription = self.create_subscription(Image, "/image", self.on_image, qos_profile_sensor_data)
         ### END SOLUTION
 
     def on_image(self, msg: Image) -> None:
