@@ -387,9 +387,9 @@ def run_here(command, cwd, env, wall_seconds):
 
 
 def reference_interfaces(assignment: str, cache: InterfaceCache, scratch: Path) -> list[Path]:
-    """The assignment's reference interface packages (assignments/reference_ws/src), built by the
-    grader itself (cached like the students' under keys of their own) and copied into `scratch`:
-    the checks' probes load these, so no code a student built runs in a check process.
+    """The assignment's reference interface packages (assignments/reference_ws/src), from the cache
+    or built by the grader itself, copied into `scratch`: the checks' probes load these, so no
+    package a student wrote runs in a check process.
 
     Raises:
         RuntimeError: a reference package does not build (the course's fault, not the student's).
@@ -403,7 +403,10 @@ def reference_interfaces(assignment: str, cache: InterfaceCache, scratch: Path) 
         folder = REFERENCE_SRC / name
         if not is_interface_package(folder):
             continue
-        key = content_key(folder, ["reference"])
+        # The same key as a student's identical package: an entry depends on the package's files
+        # and this environment only (the build runs alone, in a fresh sandbox), so a class that
+        # hands in the reference .msg files and the checks share one build.
+        key = content_key(folder)
         install, failure = cache.lookup(key)
         if install is None:
             install, failure = _build_interface(name, folder, key, cache, scratch, env, run_here, None)
@@ -414,3 +417,28 @@ def reference_interfaces(assignment: str, cache: InterfaceCache, scratch: Path) 
             shutil.copytree(install, copy, symlinks=True)
         found.append(copy)
     return found
+
+
+def local_cache() -> InterfaceCache:
+    """A cache of interface builds for runs outside a course (tests, benchmarks, record-answers)."""
+    import tempfile
+
+    return InterfaceCache(Path(tempfile.gettempdir()) / f"ros2cv-interface-cache-{os.getuid()}")
+
+
+def build_here(assignment: str, workdir: Path, cache: InterfaceCache | None = None) -> BuildReport:
+    """Build workdir/ros2_ws as the grader does, without a sandbox (reference solutions, tests,
+    benchmarks). The report goes to workdir/.colcon/build-report.json; checks run with
+    REPORT_ENV set to it use this build (see course_lib.checks.packages)."""
+    scratch = Path(workdir) / ".colcon"
+    scratch.mkdir(exist_ok=True)
+    cache = cache or local_cache()
+    report = build_workspace(Path(workdir) / WORKSPACE, cache, scratch, run_here)
+    report.reference_underlays = [str(p) for p in reference_interfaces(assignment, cache, scratch)]
+    report.write(scratch / "build-report.json")
+    return report
+
+
+def report_path(workdir: Path) -> Path:
+    """Where build_here wrote its report."""
+    return Path(workdir) / ".colcon" / "build-report.json"
