@@ -110,6 +110,7 @@ def package_cells(packages: list[str], plain_ros: str) -> list:
     solution cell when the file has solution regions), then the build."""
     files = [item for package in packages for item in package_files(package)]
     folders = sorted({str(PurePosixPath(path).parent) for path, _ in files})
+    empty = [path for path, text in files if not text]  # %%writefile refuses an empty cell
     cells = [md(f"""
 ## Your packages
 
@@ -117,8 +118,11 @@ Each cell below writes one file of your workspace `{WORKSPACE}/src/`: run them a
 (or edit the files in JupyterLab's file browser and copy your changes back here: the notebook is what
 you hand in, and grading runs it). {plain_ros}
 """),
-             code("# The package folders (in a terminal: the same command).\n!mkdir -p " + " ".join(folders))]
+             code("# The package folders and empty files (in a terminal: the same commands).\n"
+                  f"!mkdir -p {' '.join(folders)}\n!touch {' '.join(empty)}")]
     for path, text in files:
+        if not text:
+            continue
         source = f"%%writefile {path}\n{text}"
         if "### BEGIN SOLUTION" in text:
             cells.append(code(source, "solution", PurePosixPath(path).stem))

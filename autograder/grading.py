@@ -398,8 +398,10 @@ def grade_submission(sub: Submission, course: Path, domain_id: int) -> GradeResu
             # notebook wrote the student's module.
             workdir = autograded / kernel.WORK_SUBDIR if result.kernel_uid is not None else autograded
             if packages.needed(sub.assignment, workdir):
-                env = {**env, **packages.build_for_checks(sub.assignment, course, work, workdir, result.kernel_uid, domain_id, env,
-                                                          hide, _run_sandboxed)}
+                built = packages.build_for_checks(sub.assignment, course, work, workdir, result.kernel_uid, domain_id, env,
+                                                  hide, _run_sandboxed)
+                env = {**env, **built}
+                result.detail += packages.instructor_note(built)
             _grade_outside(sub, result, work, autograded, workdir, domain_id, env, hide)
             _scrub_paths(autograded, work)
         if any(c["auto_score"] is None for c in result.cells):

@@ -61,6 +61,7 @@ class BuildReport:
         seconds: wall time of the whole build.
         reference_underlays: install prefixes of the assignment's reference interface packages,
             built by the grader (the checks' own nodes use these, never code the student built).
+        log: for the instructor: the end of the failed build's output.
     """
 
     ok: bool
@@ -71,6 +72,7 @@ class BuildReport:
     built_interfaces: list[str] = dataclasses.field(default_factory=list)
     seconds: float = 0.0
     reference_underlays: list[str] = dataclasses.field(default_factory=list)
+    log: str = ""
 
     def write(self, path: Path) -> Path:
         path.write_text(json.dumps(dataclasses.asdict(self), indent=1))
@@ -193,7 +195,8 @@ def _colcon(ws: Path, args: list[str], env: dict, run) -> tuple[bool, str]:
         return True, output
     if returncode is None:
         return False, f"colcon build did not finish within {BUILD_SECONDS:g} s.\n{output[-2000:]}"
-    return False, _package_log(ws, output)
+    log = _package_log(ws, output)
+    return False, log if log.strip() else f"colcon build ended with exit code {returncode} and printed nothing"
 
 
 def _underlay_env(base: dict, underlays: list[Path]) -> dict:
@@ -269,6 +272,7 @@ def build_workspace(ws: Path, cache: InterfaceCache, scratch: Path, run, give=No
         report.ok = True
     else:
         report.reason = _reason(output)
+        report.log = output[-4000:]
     report.seconds = round(time.monotonic() - started, 1)
     return report
 
@@ -442,3 +446,13 @@ def build_here(assignment: str, workdir: Path, cache: InterfaceCache | None = No
 def report_path(workdir: Path) -> Path:
     """Where build_here wrote its report."""
     return Path(workdir) / ".colcon" / "build-report.json"
+
+
+def instructor_note(variables: dict) -> str:
+    """For the grading report: what failed in the build whose report `variables` (build_for_checks)
+    names, with the end of its output ("" when it built)."""
+    try:
+        report = BuildReport.read(Path(variables[REPORT_ENV]))
+    except (KeyError, OSError, ValueError, TypeError):
+        return ""
+    return "" if report.ok else f"\nThe workspace did not build: {report.reason}\n{report.log[-1500:]}"

@@ -34,6 +34,10 @@ def write_files(nb: nbformat.NotebookNode, folder: Path, edits=()) -> Path:
     with the solution markers removed and each (old, new) edit applied to the first file that
     holds `old`; return folder/ros2_ws."""
     files = {}
+    for cell in nb.cells:  # the shell cell that makes the folders and the empty files
+        for line in cell.source.splitlines() if cell.cell_type == "code" else ():
+            if line.startswith("!touch "):
+                files.update({path: "" for path in line.split()[1:]})
     for cell in writefile_cells(nb):
         first, _, body = solution_source(cell.source).partition("\n")
         files[first.split()[1]] = body + ("\n" if body and not body.endswith("\n") else "")

@@ -161,7 +161,9 @@ def ros_packages(ctx) -> set[str]:
 
 def dependency_items(ctx, package: str, weight: float = 1.0) -> None:
     """One item: every ROS package the package's Python code imports is a <depend> or
-    <exec_depend> of its package.xml (``rosdep`` and a full ROS install rely on it)."""
+    <exec_depend> of its package.xml (``rosdep`` and a full ROS install rely on it). Like every
+    package item it costs `weight` when wrong and earns nothing when right (the release's
+    package.xml is right already: an untouched release must score 0)."""
     folder = package_dir(ctx, package)
     try:
         have = declared(folder / "package.xml")
@@ -178,7 +180,7 @@ def dependency_items(ctx, package: str, weight: float = 1.0) -> None:
         ctx.item(False, f"{package}/package.xml does not declare what the code uses ({lines}): add {tags}",
                  weight=weight)
     else:
-        ctx.item(True, f"{package}/package.xml declares every ROS package its code imports", weight=weight)
+        ctx.item(True, f"{package}/package.xml declares every ROS package its code imports", weight=0.0)
 
 
 # ---- messages ----------------------------------------------------------------------------------
@@ -211,17 +213,19 @@ def message_fields(path: Path) -> list[tuple[str, str]]:
     return fields
 
 
-def message_item(ctx, package: str, message: str, expected: list[tuple[str, str]]) -> bool:
-    """One item: the student's msg/<message>.msg of `package` has exactly the contract's fields."""
+def message_item(ctx, package: str, message: str, expected: list[tuple[str, str]], weight: float = 1.0) -> bool:
+    """One item: the student's msg/<message>.msg of `package` has exactly the contract's fields
+    (costs `weight` when wrong, earns nothing when right, as dependency_items)."""
     path = package_dir(ctx, package) / "msg" / f"{message}.msg"
     if not path.is_file():
-        return ctx.item(False, f"{package}/msg/{message}.msg does not exist: write it with the notebook's cell")
+        return ctx.item(False, f"{package}/msg/{message}.msg does not exist: write it with the notebook's cell",
+                        weight=weight)
     fields = message_fields(path)
     # builtin_interfaces/Time and builtin_interfaces/msg/Time name the same type.
     found = [(kind.replace("/msg/", "/"), name) for kind, name in fields]
     wanted = ", ".join(f"{kind} {name}" for kind, name in expected)
     if found == expected:
-        return ctx.item(True, f"{package}/msg/{message}.msg has the fields {wanted}")
+        return ctx.item(True, f"{package}/msg/{message}.msg has the fields {wanted}", weight=0.0)
     have = ", ".join(f"{kind} {name}" for kind, name in fields) or "no fields"
     return ctx.item(False, f"{package}/msg/{message}.msg has {have}; the contract says {wanted} "
-                           "(a node that uses other fields cannot talk to the grader's)")
+                           "(a node that uses other fields cannot talk to the grader's)", weight=weight)
