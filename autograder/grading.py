@@ -476,7 +476,7 @@ def _keep_log(course: Path, sub: Submission, log: str) -> None:
 
 def _scrub_paths(folder: Path, work: Path) -> None:
     """Remove the grader's folders from the notebooks in `folder`: a traceback of the student's
-    module names it as pubsub_nodes.py, not /tmp/autograder-work-.../.autograder-cwd/pubsub_nodes.py,
+    module names it as ros2_ws/src/..., not /tmp/autograder-work-.../.autograder-cwd/ros2_ws/src/...,
     and the grader's own files by their place in the repository (autograder/student.py)."""
     prefixes = [f"{folder / kernel.WORK_SUBDIR}{os.sep}", f"{folder}{os.sep}", f"{REPO}{os.sep}"]
     for path in sorted(folder.glob("*.ipynb")):
