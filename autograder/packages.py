@@ -10,7 +10,8 @@ by the notebook's ``%%writefile`` cells). After the notebook ran, the grader bui
   and kept in a cache folder of the course (:class:`InterfaceCache`, keyed by the hash of the
   package's files and of this environment), so a class that hands in identical ``.msg`` files
   costs one CMake build; the workspace's other packages are built on top of the cached install
-  (an underlay, as ``source other_ws/install/setup.bash`` before ``colcon build``).
+  (an underlay, as ``source other_ws/install/setup.bash`` before ``colcon build
+  --packages-ignore <interface packages>``).
 
 The outcome is a :class:`BuildReport` (written as JSON for the checks, see
 course_lib.checks.packages): when the build failed, its ``reason`` quotes the first error lines of
@@ -266,7 +267,7 @@ def build_workspace(ws: Path, cache: InterfaceCache, scratch: Path, run, give=No
             shutil.copytree(install, underlay, symlinks=True)
             _readable(underlay.parent)
         underlays.append(underlay)
-    skip = ["--packages-skip", *interfaces] if interfaces else []
+    skip = ["--packages-ignore", *interfaces] if interfaces else []
     ok, output = _colcon(ws, skip, _underlay_env(base, underlays), run)
     if ok:
         report.ok = True
@@ -359,7 +360,9 @@ def build_for_checks(assignment: str, course: Path, work: Path, workdir: Path, u
             command = ["setpriv", f"--reuid={uid}", f"--regid={uid}", "--clear-groups", "--", *command]
         limits = processes.Limits(wall_seconds=wall_seconds, memory_mb=BUILD_MEMORY_MB, file_size_mb=256,
                                   max_processes=None if uid is None else 384, grace_seconds=3.0)
-        proc = run_sandboxed(command, hide, f"colcon build {Path(cwd).name}", domain_id,
+        # A name of its own: a process started under the name of a running one replaces it (stops
+        # it), and another worker builds its own ros2_ws at the same time.
+        proc = run_sandboxed(command, hide, f"colcon build {cwd}", domain_id,
                              {**env, **sandbox, "HOME": str(home), "PYTHONDONTWRITEBYTECODE": "1"}, cwd, limits)
         return (None if proc.exit_reason == "wall_seconds" else proc.returncode), proc.log
 
