@@ -323,10 +323,10 @@ def corners_using(marker_corner):
     """A picture_corners_of that takes corner marker_corner[k] of the k-th marker of the picture."""
     import numpy as np
 
-    from course_lib import scenes
+    from course_lib import marker_board
 
     def picture_corners_of(markers, picture):
-        return np.array([markers[m][c] for m, c in zip(scenes.PICTURES[picture], marker_corner)])
+        return np.array([markers[m][c] for m, c in zip(marker_board.PICTURES[picture], marker_corner)])
     return picture_corners_of
 
 
