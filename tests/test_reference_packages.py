@@ -23,7 +23,7 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 from sensor_msgs.msg import CompressedImage, Image
 
-from course_lib import images, marker_board, pictures, rosenv, scenes, workspace
+from course_lib import colcon, images, marker_board, pictures, rosenv, scenes, workspace
 
 SOURCE = Path(__file__).resolve().parents[1] / "assignments" / "reference_ws" / "src"
 PACKAGES = ("webcam", "readmarker")
@@ -275,7 +275,7 @@ def built_ws(tmp_path_factory):
                 target = ws / "src" / path.relative_to(SOURCE)
                 target.parent.mkdir(parents=True, exist_ok=True)
                 target.write_bytes(path.read_bytes())
-    result = workspace.build(ws, timeout=240)
+    result = colcon.build(ws, timeout=240)
     assert sorted(result.finished) == sorted(PACKAGES), result.output
     return ws
 

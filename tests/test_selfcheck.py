@@ -4,12 +4,12 @@ import pytest
 from rclpy.node import Node
 from std_msgs.msg import Header, Int32, String
 
-from course_lib import graph, selfcheck, session
+from course_lib import discovery, selfcheck, session
 
 
 @pytest.fixture
 def my_node(monkeypatch):
-    monkeypatch.setattr(graph, "SETTLE_SECONDS", 0)  # in-process nodes need no discovery wait
+    monkeypatch.setattr(discovery, "SETTLE_SECONDS", 0)  # in-process nodes need no discovery wait
     session.start()
     node = session.add_node(Node("my_node"))
     yield node
@@ -39,7 +39,7 @@ def test_task1_someone_elses_node(my_node):
 
 
 def test_task1_node_not_running(monkeypatch):
-    monkeypatch.setattr(graph, "SETTLE_SECONDS", 0)
+    monkeypatch.setattr(discovery, "SETTLE_SECONDS", 0)
     session.start()
     try:
         verdict = selfcheck.task1_node_name("/my_node")
@@ -181,7 +181,7 @@ class AnnouncerStub(Node):
 
 @pytest.fixture
 def exercise_session(domain_id, monkeypatch):
-    monkeypatch.setattr(graph, "SETTLE_SECONDS", 0)
+    monkeypatch.setattr(discovery, "SETTLE_SECONDS", 0)
     session.start(domain_id=domain_id)
     yield
     session.stop()
