@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import time
 
-from course_lib import session
+from course_lib import session, waiting
 
 #: Seconds a newly started tool node waits for discovery before its first answer. Fast DDS
 #: took about 2 s to show another process's node on the course machines; lower it for a
@@ -57,18 +57,20 @@ def wait_for_discovery(minimum: float | None = None, quiet: float = _SETTLE_QUIE
     minimum = SETTLE_SECONDS if minimum is None else minimum
     others_here = _participants_here(node.context.get_domain_id()) - 1 if complete_within else 0
     ours = 1 + len(session.nodes())  # the nodes of this process share its participant
-    last = _snapshot(node)
-    quiet_since = time.monotonic()
-    while True:
+    seen = {"graph": _snapshot(node), "since": time.monotonic(), "checks": 0}
+
+    def settled():
+        if seen["checks"]:  # after each wait, look again; a change restarts the quiet time
+            current = _snapshot(node)
+            if current != seen["graph"]:
+                seen["graph"], seen["since"] = current, time.monotonic()
+        seen["checks"] += 1
         now = time.monotonic()
         age = now - node.created_at
-        missing = age < complete_within and len(last[0]) - ours < others_here
-        if age >= _SETTLE_MAX or (age >= minimum and now - quiet_since >= quiet and not missing):
-            break
-        time.sleep(_SETTLE_POLL)
-        current = _snapshot(node)
-        if current != last:
-            last, quiet_since = current, time.monotonic()
+        missing = age < complete_within and len(seen["graph"][0]) - ours < others_here
+        return age >= minimum and now - seen["since"] >= quiet and not missing
+
+    waiting.spin_until(settled, max(0.0, _SETTLE_MAX - (time.monotonic() - node.created_at)), poll=_SETTLE_POLL)
     _settled_node = node
 
 

@@ -29,7 +29,7 @@ import cv2
 import ipywidgets
 import numpy as np
 
-from course_lib import discovery, graph, images, message_yaml, rosenv, session
+from course_lib import discovery, graph, images, message_yaml, rosenv, session, waiting
 
 #: Redraws, and seconds after its creation, after which a view stops by itself under test or grading.
 LIMITED_UPDATES = 20
@@ -218,12 +218,13 @@ def image_view(topic: str = "/image", **options) -> ImageView:
 
 def _image_class(tool, topic: str, msg_type, timeout: float):
     if msg_type is None:
-        deadline = time.monotonic() + timeout
-        while True:
-            kinds = [k for name, ks in tool.get_topic_names_and_types() if name == topic for k in ks]
-            if kinds or time.monotonic() >= deadline:
-                break
-            time.sleep(0.05)
+        kinds = []
+
+        def known():
+            kinds[:] = [k for name, ks in tool.get_topic_names_and_types() if name == topic for k in ks]
+            return bool(kinds)
+
+        waiting.spin_until(known, timeout)
         msg_type = kinds[0] if len(kinds) == 1 else IMAGE_TYPES[0]
         if len(kinds) > 1:
             raise ValueError(f"Topic {topic} carries several types {kinds}: pass msg_type= to choose one")
@@ -415,17 +416,19 @@ def resolve_field_path(tool, path: str, msg_type=None, timeout: float = 5.0):
             except ValueError as error:
                 problem = error
         raise problem
-    deadline = time.monotonic() + timeout
-    while True:
-        topics = dict(tool.get_topic_names_and_types())
-        topic = next((t for t in _topic_prefixes(name) if t in topics), None)
-        if topic is not None:
-            break
-        if time.monotonic() >= deadline:
-            raise TimeoutError(f"No topic in the ROS graph begins {name}: is its publisher running, on the "
-                               f"same ROS_DOMAIN_ID? graph.topic_list() shows the topics there are, or pass "
-                               f"msg_type= to plot before it appears")
-        time.sleep(0.05)
+    topics, found = {}, []
+
+    def known():
+        topics.clear()
+        topics.update(tool.get_topic_names_and_types())
+        found[:] = [t for t in _topic_prefixes(name) if t in topics][:1]
+        return bool(found)
+
+    if not waiting.spin_until(known, timeout):
+        raise TimeoutError(f"No topic in the ROS graph begins {name}: is its publisher running, on the "
+                           f"same ROS_DOMAIN_ID? graph.topic_list() shows the topics there are, or pass "
+                           f"msg_type= to plot before it appears")
+    topic = found[0]
     kinds = topics[topic]
     if len(kinds) != 1:
         raise ValueError(f"Topic {topic} carries several types {kinds}: pass msg_type= to choose one")
