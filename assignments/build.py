@@ -313,12 +313,12 @@ from rclpy.node import Node
 from rclpy.qos import qos_profile_sensor_data
 from sensor_msgs.msg import CompressedImage, Image
 
-from course_lib import images, scenes
+from course_lib import boards, images, marker_board
 
-# The board convention lives in course_lib.scenes: scenes.PICTURES (the markers framing each
-# picture, top-left, top-right, bottom-right, bottom-left), scenes.CORNER_OF_MARKER (which corner
-# of each marker touches the picture) and scenes.detector() (DICT_4X4_50).
-DETECTOR = scenes.detector()
+# The board convention lives in course_lib.marker_board: marker_board.PICTURES (the markers framing each
+# picture, top-left, top-right, bottom-right, bottom-left), marker_board.CORNER_OF_MARKER (which corner
+# of each marker touches the picture) and marker_board.detector() (DICT_4X4_50).
+DETECTOR = marker_board.detector()
 
 
 def crop_pictures(frame_bgr: np.ndarray, size=(320, 240)) -> dict:
@@ -328,7 +328,7 @@ def crop_pictures(frame_bgr: np.ndarray, size=(320, 240)) -> dict:
         corners, ids, _rejected = DETECTOR.detectMarkers(image)
         return {} if ids is None else {int(i): c.reshape(4, 2) for i, c in zip(ids.ravel(), corners)}
 
-    board_ids = [i for ids in scenes.PICTURES.values() for i in ids]
+    board_ids = [i for ids in marker_board.PICTURES.values() for i in ids]
     found = detect(frame_bgr)
     if not all(i in found for i in board_ids):
         # A marker touching a dark picture corner merges with it in the threshold image. Look again
@@ -346,11 +346,11 @@ def crop_pictures(frame_bgr: np.ndarray, size=(320, 240)) -> dict:
         known = [i for i in board_ids if i in found]
         if 2 <= len(known) < len(board_ids):
             # Two markers give the board's homography: paint the pictures white and look again.
-            board = scenes.default_board()
+            board = boards.default_board()
             H, _ = cv2.findHomography(np.concatenate([board.marker_square(i) for i in known]).astype(np.float32),
                                       np.concatenate([found[i] for i in known]).astype(np.float32))
             painted = grey.copy()
-            for name in scenes.PICTURES if H is not None else ():
+            for name in marker_board.PICTURES if H is not None else ():
                 slot = cv2.perspectiveTransform(board.picture_slot(name)[None].astype(np.float32), H)[0]
                 cv2.fillConvexPoly(painted, np.round(slot * 16).astype(np.int32), 255, cv2.LINE_AA, shift=4)
             for i, c in (detect(painted) if H is not None else {}).items():
@@ -359,11 +359,11 @@ def crop_pictures(frame_bgr: np.ndarray, size=(320, 240)) -> dict:
                     cv2.cornerSubPix(grey, c, (3, 3), (-1, -1), (cv2.TERM_CRITERIA_EPS + cv2.TERM_CRITERIA_COUNT, 30, 0.01))
                     found[i] = c.reshape(4, 2)
     width, height = size
-    target = scenes.crop_corners(size)
+    target = marker_board.crop_corners(size)
     crops = {}
-    for name, markers in scenes.PICTURES.items():
+    for name, markers in marker_board.PICTURES.items():
         if all(m in found for m in markers):
-            source = np.float32([found[m][c] for m, c in zip(markers, scenes.CORNER_OF_MARKER)])
+            source = np.float32([found[m][c] for m, c in zip(markers, marker_board.CORNER_OF_MARKER)])
             H = cv2.getPerspectiveTransform(source, target)
             crops[name] = cv2.warpPerspective(frame_bgr, H, (width, height))
     return crops
@@ -377,7 +377,7 @@ class MarkerReader(Node):
         super().__init__("marker_reader")
         ### BEGIN SOLUTION
         self.publishers_ = {name: self.create_publisher(CompressedImage, f"cropped_img/{name}", 10)
-                            for name in scenes.PICTURES}
+                            for name in marker_board.PICTURES}
         self.subscription = self.create_subscription(Image, "image", self.on_image, qos_profile_sensor_data)
         ### END SOLUTION
 
@@ -411,7 +411,7 @@ A camera looks at the course's marker board: a cat picture framed by ArUco marke
 picture framed by markers 5-8 (dictionary `DICT_4X4_50`), in the order top-left, top-right,
 bottom-right, bottom-left. Each marker touches its picture with one corner: marker 1 with its
 corner 2, marker 2 with corner 3, marker 3 with corner 0, marker 4 with corner 1
-(`course_lib.scenes.PICTURES` and `CORNER_OF_MARKER`; OpenCV numbers a marker's corners
+(`course_lib.marker_board.PICTURES` and `CORNER_OF_MARKER`; OpenCV numbers a marker's corners
 clockwise from its top-left).
 
 **Contract** (this is exactly what is graded):
@@ -425,10 +425,10 @@ clockwise from its top-left).
 3. `main(args=None)` runs the node until Ctrl-C.
 
 The grader renders scenes (`course_lib.scenes.render_scene`) with poses and lighting you have not
-seen, and compares your crops with the true ones (`scenes.crop_similarity`, passing at
-`scenes.SAME_CROP_THRESHOLD`). Try your function on `scenes.render_scene(seed).frame`.
+seen, and compares your crops with the true ones (`marker_board.crop_similarity`, passing at
+`marker_board.SAME_CROP_THRESHOLD`). Try your function on `scenes.render_scene(seed).frame`.
 """, "intro"),
-        setup_cell("catdog_warp", "marker_reader", "from course_lib import scenes\n"),
+        setup_cell("catdog_warp", "marker_reader", "from course_lib import marker_board, scenes\n"),
         md("## Your module", "task_md"),
         code(MARKER_MODULE, "solution", "marker_reader"),
         import_cell("marker_reader", "crop_pictures, MarkerReader"),

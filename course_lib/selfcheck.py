@@ -485,9 +485,9 @@ def _board_views():
     """(name, {marker id: corners}, {picture: corners}) of the board seen upright, turned and in perspective."""
     import numpy as np
 
-    from course_lib import scenes
+    from course_lib import boards, marker_board
 
-    board = scenes.default_board()
+    board = boards.default_board()
     bw, bh = board.size
     views = []
     for name, degrees, tilt in (("an upright board", 0, 0.0), ("a board turned by 120 degrees", 120, 0.0),
@@ -500,8 +500,8 @@ def _board_views():
             p = np.column_stack([points, np.ones(len(points))]) @ H.T
             return (p[:, :2] / p[:, 2:]).astype(np.float32)
 
-        markers = {i: project(board.marker_square(i)) for ids in scenes.PICTURES.values() for i in ids}
-        pictures = {picture: project(board.picture_slot(picture)) for picture in scenes.PICTURES}
+        markers = {i: project(board.marker_square(i)) for ids in marker_board.PICTURES.values() for i in ids}
+        pictures = {picture: project(board.picture_slot(picture)) for picture in marker_board.PICTURES}
         views.append((name, markers, pictures))
     return views
 
@@ -510,9 +510,9 @@ def task_picture_corners(function) -> Verdict:
     """Lesson 03: picture_corners_of(markers, picture) takes each framing marker's corner that touches the picture."""
     import numpy as np
 
-    from course_lib import scenes
+    from course_lib import marker_board
 
-    hint = ("Write picture_corners_of(markers, picture): for each marker of scenes.PICTURES[picture] (top-left, "
+    hint = ("Write picture_corners_of(markers, picture): for each marker of marker_board.PICTURES[picture] (top-left, "
             "top-right, bottom-right, bottom-left), take the one of its four corners that touches the picture, and "
             "return the four points as a (4, 2) array.")
     if (result := _not_done(function, hint)) is not None:
@@ -526,7 +526,7 @@ def task_picture_corners(function) -> Verdict:
                                            "picture_corners_of", hint, f"the {picture}")
             if problem is not None:
                 return problem
-            for place, marker_id, point, want in zip(places, scenes.PICTURES[picture], answer, expected):
+            for place, marker_id, point, want in zip(places, marker_board.PICTURES[picture], answer, expected):
                 if np.allclose(point, want, atol=1e-2):
                     continue
                 which = [(i, k) for i, corners in markers.items() for k in range(4)
@@ -534,7 +534,7 @@ def task_picture_corners(function) -> Verdict:
                 if which and which[0][0] != marker_id:
                     return _verdict(False, f"For the {picture}'s {place} corner ({view}) you took a corner of marker "
                                            f"{which[0][0]}; that corner lies on marker {marker_id} "
-                                           f"(scenes.PICTURES[{picture!r}] lists the markers top-left first).")
+                                           f"(marker_board.PICTURES[{picture!r}] lists the markers top-left first).")
                 if which:
                     return _verdict(False, f"For the {picture}'s {place} corner ({view}) you took corner "
                                            f"{which[0][1]} of marker {marker_id}, which does not touch the picture: "

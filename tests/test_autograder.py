@@ -111,10 +111,10 @@ CATDOG_MISTAKES = {
     "bgr_swapped": ([("            crops[name] = cv2.warpPerspective(frame_bgr, H, (width, height))",
                       "            crops[name] = cv2.cvtColor(cv2.warpPerspective(frame_bgr, H, (width, height)), "
                       "cv2.COLOR_BGR2RGB)")], "red and blue are swapped"),
-    "mirrored": ([("target = scenes.crop_corners(size)",
+    "mirrored": ([("target = marker_board.crop_corners(size)",
                    "target = np.float32([[width - 1, 0], [0, 0], [0, height - 1], [width - 1, height - 1]])")],
                  "mirrored left-right"),
-    "corner_order": ([("zip(markers, scenes.CORNER_OF_MARKER)", "zip(markers, (0, 1, 2, 3))")], "similarity"),
+    "corner_order": ([("zip(markers, marker_board.CORNER_OF_MARKER)", "zip(markers, (0, 1, 2, 3))")], "similarity"),
     "size_swapped": ([("(width, height))\n", "(height, width))\n")], "size is (width, height)"),
 }
 

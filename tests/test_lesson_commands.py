@@ -17,7 +17,7 @@ from pathlib import Path
 
 import pytest
 
-from course_lib import processes, workspace
+from course_lib import colcon, pkg_create, processes, workspace
 
 NOTEBOOKS = Path(__file__).resolve().parents[1] / "notebooks"
 LESSON = "02b_packages_launch_parameters.ipynb"
@@ -171,9 +171,9 @@ def test_launch_file_and_parameter_commands(built):
 def test_lesson_00_commands(tmp_path):
     """The lesson's package built as the lesson builds it, its node running: the ! lines print what it shows."""
     ws = tmp_path / "ros2_ws"
-    workspace.create_package(ws, "my_package", dependencies=["rclpy"], node_name="my_node")
+    pkg_create.create_package(ws, "my_package", dependencies=["rclpy"], node_name="my_node")
     (ws / "src/my_package/my_package/my_node.py").write_text(lesson_files(LESSON_00)["ros2_ws/src/my_package/my_package/my_node.py"])
-    workspace.build(ws, ["my_package"])
+    colcon.build(ws, ["my_package"])
     env = workspace.workspace_environment(ws)
     node = workspace.run(ws, "my_package", "my_node")
     try:

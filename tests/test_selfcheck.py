@@ -4,12 +4,12 @@ import pytest
 from rclpy.node import Node
 from std_msgs.msg import Header, Int32, String
 
-from course_lib import graph, selfcheck, session
+from course_lib import discovery, selfcheck, session
 
 
 @pytest.fixture
 def my_node(monkeypatch):
-    monkeypatch.setattr(graph, "SETTLE_SECONDS", 0)  # in-process nodes need no discovery wait
+    monkeypatch.setattr(discovery, "SETTLE_SECONDS", 0)  # in-process nodes need no discovery wait
     session.start()
     node = session.add_node(Node("my_node"))
     yield node
@@ -39,7 +39,7 @@ def test_task1_someone_elses_node(my_node):
 
 
 def test_task1_node_not_running(monkeypatch):
-    monkeypatch.setattr(graph, "SETTLE_SECONDS", 0)
+    monkeypatch.setattr(discovery, "SETTLE_SECONDS", 0)
     session.start()
     try:
         verdict = selfcheck.task1_node_name("/my_node")
@@ -181,7 +181,7 @@ class AnnouncerStub(Node):
 
 @pytest.fixture
 def exercise_session(domain_id, monkeypatch):
-    monkeypatch.setattr(graph, "SETTLE_SECONDS", 0)
+    monkeypatch.setattr(discovery, "SETTLE_SECONDS", 0)
     session.start(domain_id=domain_id)
     yield
     session.stop()
@@ -323,10 +323,10 @@ def corners_using(marker_corner):
     """A picture_corners_of that takes corner marker_corner[k] of the k-th marker of the picture."""
     import numpy as np
 
-    from course_lib import scenes
+    from course_lib import marker_board
 
     def picture_corners_of(markers, picture):
-        return np.array([markers[m][c] for m, c in zip(scenes.PICTURES[picture], marker_corner)])
+        return np.array([markers[m][c] for m, c in zip(marker_board.PICTURES[picture], marker_corner)])
     return picture_corners_of
 
 

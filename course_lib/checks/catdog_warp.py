@@ -1,9 +1,9 @@
 """Checks of the catdog_warp assignment: ``crop_pictures`` and ``MarkerReader``, on generated scenes.
 
 The contract (also in the notebook and in assignments/README.md); the board convention is
-course_lib.scenes' (markers of DICT_4X4_50; "cat" framed by markers 1-4, "dog" by 5-8, in the
+course_lib.marker_board's (markers of DICT_4X4_50; "cat" framed by markers 1-4, "dog" by 5-8, in the
 order top-left, top-right, bottom-right, bottom-left; the picture's corners are those marker
-corners that touch it, scenes.CORNER_OF_MARKER):
+corners that touch it, marker_board.CORNER_OF_MARKER):
 
 - ``crop_pictures(frame_bgr, size=(320, 240)) -> dict``: ``{"cat": crop, "dog": crop}`` with a
   key only when all four of that picture's markers are found; each crop is a BGR uint8 image of
@@ -14,7 +14,7 @@ corners that touch it, scenes.CORNER_OF_MARKER):
 - ``main(args=None)`` runs the node until Ctrl-C.
 
 Crops are compared with the ground truth of the generated scene (Scene.expected_crops) by
-scenes.crop_similarity, passing at scenes.SAME_CROP_THRESHOLD; colours are checked separately
+marker_board.crop_similarity, passing at marker_board.SAME_CROP_THRESHOLD; colours are checked separately
 (crop_similarity compares grey levels, so a red/blue swap would pass it).
 """
 
@@ -49,7 +49,7 @@ def _seed(ctx) -> int:
 
 def compare_crop(ctx, label: str, crop, expected, show: bool = False) -> bool:
     """One item: the student's crop is the expected picture (shape, dtype, content, colours)."""
-    from course_lib import scenes
+    from course_lib import marker_board
 
     if not isinstance(crop, np.ndarray):
         return ctx.item(False, f"{label}: the crop is a {type(crop).__name__}, not a numpy image")
@@ -57,18 +57,18 @@ def compare_crop(ctx, label: str, crop, expected, show: bool = False) -> bool:
     if crop.shape != want or crop.dtype != np.uint8:
         hint = " (size is (width, height): warpPerspective(frame, H, size))" if crop.shape[:2] == want[1::-1] else ""
         return ctx.item(False, f"{label}: crop has shape {crop.shape} {crop.dtype}, expected {want} uint8{hint}")
-    similarity = scenes.crop_similarity(crop, expected)
+    similarity = marker_board.crop_similarity(crop, expected)
     if show:
         ctx.image(f"{label}: yours ({similarity:.2f})", crop)
         ctx.image(f"{label}: expected", expected)
-    if similarity < scenes.SAME_CROP_THRESHOLD:
+    if similarity < marker_board.SAME_CROP_THRESHOLD:
         hints = []
         for name, variant in (("mirrored left-right", crop[:, ::-1]), ("upside down", crop[::-1, ::-1]),
                               ("flipped top-bottom", crop[::-1])):
-            if scenes.crop_similarity(variant, expected) >= scenes.SAME_CROP_THRESHOLD:
+            if marker_board.crop_similarity(variant, expected) >= marker_board.SAME_CROP_THRESHOLD:
                 hints.append(f"it is the expected picture {name}: check the order of the four corners "
                              "(top-left, top-right, bottom-right, bottom-left) on both sides of the warp")
-        return ctx.item(False, f"{label}: similarity {similarity:.2f} < {scenes.SAME_CROP_THRESHOLD}"
+        return ctx.item(False, f"{label}: similarity {similarity:.2f} < {marker_board.SAME_CROP_THRESHOLD}"
                                + (f"; {hints[0]}" if hints else ""))
     mine, theirs = crop.reshape(-1, 3).mean(axis=0), expected.reshape(-1, 3).mean(axis=0)
     if np.abs(mine - theirs).max() > COLOUR_TOLERANCE:
@@ -79,7 +79,7 @@ def compare_crop(ctx, label: str, crop, expected, show: bool = False) -> bool:
 
 
 def _check_scene(ctx, label: str, scene, outcome, show: bool = False) -> None:
-    from course_lib import scenes
+    from course_lib import marker_board
 
     if not outcome.ok:
         hint = " (replace `raise NotImplementedError()` with your code)" if outcome.error.startswith("NotImplementedError") else ""
@@ -89,13 +89,13 @@ def _check_scene(ctx, label: str, scene, outcome, show: bool = False) -> None:
     if not isinstance(result, dict):
         ctx.item(False, f"{label}: crop_pictures returned a {outcome.pytype}, not a dict like {{'cat': crop}}")
         return
-    unknown = sorted(set(result) - set(scenes.PICTURES))
+    unknown = sorted(set(result) - set(marker_board.PICTURES))
     if unknown:
         ctx.item(False, f"{label}: unexpected keys {unknown}; the keys are 'cat' and 'dog'")
     expected = scene.expected_crops(SIZE) if scene is not None else {}
     framed = scene.fully_framed if scene is not None else ()
     visible = set(scene.visible_ids) if scene is not None else set()
-    for name, markers in scenes.PICTURES.items():
+    for name, markers in marker_board.PICTURES.items():
         if name in framed:
             if name not in result:
                 ctx.item(False, f"{label}: no '{name}' although its markers {markers} are all in view")
@@ -141,13 +141,13 @@ def hard(ctx: harness.Context) -> None:
 @check(points=2, timeout=60)
 def missing_and_none(ctx: harness.Context) -> None:
     """A picture with any one of its markers missing is left out; frames without markers give an empty dict."""
-    from course_lib import scenes
+    from course_lib import marker_board, scenes
 
     # Every marker is the missing one once, in every grading: scene k lacks the k-th marker of
     # each picture (so a solution that looks at only some of a picture's markers always loses).
     cases = []
     for k in range(4):
-        gone = [ids[k] for ids in scenes.PICTURES.values()]
+        gone = [ids[k] for ids in marker_board.PICTURES.values()]
         cases.append((f"markers {gone} missing", scenes.render_scene(_seed(ctx), difficulty="easy", missing_markers=gone)))
     cases.append(("no markers on the board", scenes.render_scene(_seed(ctx), difficulty="easy",
                                                                  missing_markers=list(range(1, 9)))))
@@ -165,10 +165,10 @@ def missing_and_none(ctx: harness.Context) -> None:
 @check(points=1, timeout=60)
 def noisy(ctx: harness.Context) -> None:
     """crop_pictures copes with sensor noise, blur and JPEG artefacts, and with another crop size."""
-    from course_lib import scenes
+    from course_lib import camera_views, scenes
 
     base = scenes.render_scene(_seed(ctx), difficulty="easy")
-    look = scenes.Look(noise=7.0, blur=1.0, jpeg_quality=60, gain=0.9)
+    look = camera_views.Look(noise=7.0, blur=1.0, jpeg_quality=60, gain=0.9)
     scene = scenes.render_scene(_seed(ctx), difficulty="easy", pose=base.pose, look=look)
     small = (200, 150)
     outcomes = ctx.call("crop_pictures", [((scene.frame,), {"size": list(SIZE)}),
