@@ -4,11 +4,10 @@ As root: ``unshare --net --mount``: a network namespace with only loopback (no c
 the machine; DDS traffic stays in it), a private /dev/shm (Fast DDS shared memory), and the
 course directory and the repository's instructor folders hidden under empty tmpfs mounts.
 
-Two halves: :func:`sandbox_command` (the grader's side) wraps a command in ``unshare`` and this
-file run as a script, ``python -I -S sandbox.py HIDDEN... -- COMMAND...``; inside the new
-namespaces :func:`enter` brings loopback up and mounts (mount(2) through ctypes, as mount(8)
-would), then :func:`main` execs the command. Limits (time, memory, processes) are not the
-sandbox's job: course_lib.processes applies them to the sandboxed command.
+:func:`sandbox_command` wraps a command in ``unshare`` and autograder/sandbox_entry.py, which
+runs first inside the new namespaces: it brings loopback up, makes the mounts and execs the
+command. Limits (time, memory, processes) are not the sandbox's job: course_lib.processes applies
+them to the sandboxed command (:func:`run_sandboxed`).
 
 Not root: ``unshare --user --map-root-user --net --mount`` when unprivileged user namespaces are
 allowed (network and mounts isolated, but one uid for all workers: RLIMIT_NPROC is then shared by
@@ -20,20 +19,20 @@ stderr and in the grading report's ``isolation`` column).
 from __future__ import annotations
 
 import os
+import shutil
+import subprocess
 import sys
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parent.parent
+#: The script that runs first inside the namespaces (see sandbox_command).
+ENTRY = Path(__file__).resolve().parent / "sandbox_entry.py"
 
 _ISOLATION: str | None = None
 
 
 def isolation() -> str:
     """"root" (namespaces and per-worker uids), "userns" (namespaces, one uid) or "none"."""
-    # Imported here, not at the top: the script run inside every sandbox starts faster without them.
-    import shutil
-    import subprocess
-
     global _ISOLATION
     if _ISOLATION is None:
         if os.geteuid() == 0 and shutil.which("unshare"):
@@ -51,15 +50,14 @@ def isolation() -> str:
 
 def sandbox_command(command: list[str], hide: list[Path]) -> list[str]:
     """Wrap a command so that it runs in a network + mount namespace (see the module docstring):
-    unshare makes the namespaces, then this file, run as a script inside them (:func:`enter`),
-    mounts what the sandbox hides and execs the command."""
+    unshare makes the namespaces, autograder/sandbox_entry.py sets them up and execs the command."""
     mode = isolation()
     if mode == "none":
         return command
     prefix = ["unshare", "--net", "--mount"] if mode == "root" else \
         ["unshare", "--user", "--map-root-user", "--net", "--mount"]
     # -I -S: the standard library only, nothing from the environment's PYTHON* variables.
-    return prefix + [sys.executable, "-I", "-S", str(Path(__file__).resolve()),
+    return prefix + [sys.executable, "-I", "-S", str(ENTRY),
                      *[str(p) for p in hide], "--", *command]
 
 
@@ -95,76 +93,3 @@ def run_sandboxed(command: list[str], hide: list[Path], name: str, domain_id: in
 HIDDEN_FROM_STUDENTS = [REPO / "assignments", REPO / "autograder", REPO / "tests", REPO / "benchmarks"]
 
 
-
-# ---------------------------------------------------------------------------------------------
-# Inside the namespaces: ``python -I -S sandbox.py HIDDEN... -- COMMAND...`` (see sandbox_command)
-# ---------------------------------------------------------------------------------------------
-
-_MS_BIND, _MS_MOVE, _MS_REC, _MS_PRIVATE = 0x1000, 0x2000, 0x4000, 0x40000
-_SIOCGIFFLAGS, _SIOCSIFFLAGS, _IFF_UP = 0x8913, 0x8914, 0x1
-
-
-def _mount(source: str, target: str, fstype: str | None = None, flags: int = 0, options: str | None = None) -> None:
-    """mount(2), as mount(8) would call it; raises OSError naming the target."""
-    import ctypes
-
-    libc = ctypes.CDLL(None, use_errno=True)
-    if libc.mount(source.encode(), target.encode(), fstype and fstype.encode(), flags,
-                  options and options.encode()) != 0:
-        error = ctypes.get_errno()
-        raise OSError(error, f"the sandbox could not mount {source} on {target}: {os.strerror(error)}")
-
-
-def _loopback_up() -> None:
-    """``ip link set lo up``: a new network namespace has its loopback interface down."""
-    import fcntl
-    import socket
-    import struct
-
-    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sock:
-        request = struct.pack("16sh22x", b"lo", 0)  # struct ifreq: name, flags
-        flags = struct.unpack("16sh22x", fcntl.ioctl(sock, _SIOCGIFFLAGS, request))[1]
-        fcntl.ioctl(sock, _SIOCSIFFLAGS, struct.pack("16sh22x", b"lo", flags | _IFF_UP))
-
-
-def enter(hidden: list[str], env: dict) -> None:
-    """Set up the namespaces this process was started in: loopback up, mounts private to the
-    namespace, a private /dev/shm, `hidden` folders under empty tmpfs mounts, and the
-    interpreter made reachable when it sits below a folder others cannot enter (`env`'s
-    AUTOGRADER_EXPOSE, AUTOGRADER_BLOCKED and AUTOGRADER_STAGE, from interpreter_exposure)."""
-    _loopback_up()
-    _mount("none", "/", flags=_MS_REC | _MS_PRIVATE)
-    # No sticky bit: Fast DDS replaces a dead participant's shared-memory port by unlinking it, and
-    # the student's uid must be able to do so for ports a (root) check process left behind.
-    _mount("autograder-shm", "/dev/shm", "tmpfs", options="size=2g,mode=0777")
-    if env.get("AUTOGRADER_EXPOSE"):
-        # The interpreter lives under a directory the kernel's uid cannot enter (a pyenv under /root):
-        # hide that directory under a tmpfs and put the interpreter's prefix back at the same path.
-        expose, stage = env["AUTOGRADER_EXPOSE"], env["AUTOGRADER_STAGE"]
-        _mount(expose, stage, flags=_MS_BIND)
-        _mount("autograder-home", env["AUTOGRADER_BLOCKED"], "tmpfs", options="size=1m,mode=755")
-        os.makedirs(expose, exist_ok=True)
-        _mount(stage, expose, flags=_MS_MOVE)
-    for folder in hidden:
-        if os.path.isdir(folder):
-            _mount("autograder-hidden", folder, "tmpfs", options="size=1m,mode=755")
-
-
-def main(argv: list[str]) -> int:
-    """``sandbox.py HIDDEN... -- COMMAND...``: enter, then exec COMMAND (searched on PATH)."""
-    if "--" not in argv or argv.index("--") == len(argv) - 1:
-        print("usage: sandbox.py HIDDEN_FOLDER... -- COMMAND [ARG...]", file=sys.stderr)
-        return 2
-    split = argv.index("--")
-    try:
-        enter(argv[:split], dict(os.environ))
-    except OSError as error:
-        print(f"autograder sandbox: {error}", file=sys.stderr)
-        return 1
-    command = argv[split + 1:]
-    os.execvp(command[0], command)
-    return 1  # not reached
-
-
-if __name__ == "__main__":
-    sys.exit(main(sys.argv[1:]))
