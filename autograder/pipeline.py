@@ -105,7 +105,7 @@ class Grading:
 
 def stage_course_root(g: Grading) -> None:
     """A course root of its own in the work folder (config, a root-only copy of the
-    gradebook and of the submission), the sandbox's kernelspec, and a copy of the grader."""
+    gradebook and of the submission) and the sandbox's kernelspec."""
     os.chmod(g.work, 0o711)
     root = g.root
     root.mkdir(mode=0o711)
@@ -126,8 +126,9 @@ def stage_course_root(g: Grading) -> None:
 
 
 def choose_environment(g: Grading) -> None:
-    """The sandboxed processes' environment: grading flags, Jupyter's folders, the staged
-    grader first on PYTHONPATH; as root the worker's uid and process limit for the student's code."""
+    """A root-only copy of the grader (autograder.staging) and the sandboxed processes'
+    environment: grading flags, Jupyter's folders, that copy first on PYTHONPATH; as root the
+    worker's uid and process limit for the student's code."""
     work = g.work
     grader = stage_grader(work)
     g.env = {"COURSE_LIB_GRADING": "1", "COURSE_LIB_UNDER_TEST": None, "AUTOGRADER_SEED": None,
