@@ -27,7 +27,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path[:0] = [str(ROOT), str(ROOT / "tests")]  # the grader runs from the repository
 
 import zoo  # noqa: E402 (tests/zoo builds submissions from the reference solutions)
-from autograder import grading  # noqa: E402
+from autograder import grading, release, sandbox  # noqa: E402
 
 ASSIGNMENTS = ["brightness", "pubsub", "catdog_warp"]
 
@@ -45,12 +45,12 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     with tempfile.TemporaryDirectory(prefix="bench-grading-") as scratch:
         course = Path(scratch) / "course"
-        grading.release(course, ASSIGNMENTS)
+        release.release(course, ASSIGNMENTS)
         for index in range(args.students):
             for assignment in ASSIGNMENTS:
                 zoo.submit(course, f"student{index}", assignment)
         runs = {workers: timed_grade(course, workers) for workers in (1, args.workers)}
-    print(f"{platform.node()}: {os.cpu_count()} CPUs, isolation {grading.isolation()}, "
+    print(f"{platform.node()}: {os.cpu_count()} CPUs, isolation {sandbox.isolation()}, "
           f"{args.students} reference submissions per assignment\n")
     print(f"{'assignment':<14}{'s/submission (1 worker)':>26}{f's/submission ({args.workers} workers)':>28}"
           f"{'scores':>14}")

@@ -12,7 +12,7 @@ import pytest
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import zoo  # noqa: E402
-from autograder import grading, reference  # noqa: E402
+from autograder import grading, reference, release, sandbox  # noqa: E402
 from course_lib.checks import harness, validate  # noqa: E402
 
 ASSIGNMENTS = ["brightness", "pubsub", "catdog_warp"]
@@ -65,9 +65,9 @@ def test_cell_timeouts_give_graded_cells_longer():
 
 def test_sandbox_hides_directories_and_keeps_the_command():
     """As root the command runs under unshare with a network and mount namespace."""
-    command = grading.sandbox_command(["python", "-V"], [Path("/somewhere/course")])
+    command = sandbox.sandbox_command(["python", "-V"], [Path("/somewhere/course")])
     assert command[-3:] == ["--", "python", "-V"]
-    if grading.isolation() == "root":
+    if sandbox.isolation() == "root":
         assert command[:3] == ["unshare", "--net", "--mount"] and "/somewhere/course" in command
 
 
@@ -187,7 +187,7 @@ FULL_RUN_REFERENCES = ["catdog_warp"]
 @pytest.fixture(scope="module")
 def course(tmp_path_factory):
     course = tmp_path_factory.mktemp("course")
-    grading.release(course, ASSIGNMENTS)
+    release.release(course, ASSIGNMENTS)
     for assignment in FULL_RUN_REFERENCES:
         zoo.submit(course, "reference", assignment)
     for assignment, (edits, _reason) in FULL_RUN_MISTAKES.items():

@@ -9,7 +9,7 @@ import sys
 
 import pytest
 
-from autograder import config, grading, guard
+from autograder import config, guard, release
 from course_lib.checks import harness
 
 
@@ -20,7 +20,7 @@ def course(tmp_path_factory):
     from autograder import gradebook
 
     root = tmp_path_factory.mktemp("course")
-    grading.release(root, ["pubsub"])
+    release.release(root, ["pubsub"])
     for folder in ("submitted", "autograded"):
         (root / folder / "alice" / "pubsub").mkdir(parents=True)
         shutil.copy(root / "release" / "pubsub" / "pubsub.ipynb", root / folder / "alice" / "pubsub")

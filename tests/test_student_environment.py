@@ -19,7 +19,8 @@ from pathlib import Path
 import nbformat
 import pytest
 
-from autograder import grading, reference
+import autograder.release
+from autograder import reference
 from course_lib.checks import harness
 
 REPO = Path(__file__).resolve().parent.parent
@@ -102,7 +103,7 @@ def _text(data: bytes) -> str | None:
 @pytest.fixture(scope="module")
 def release(tmp_path_factory) -> Path:
     course = tmp_path_factory.mktemp("course")
-    grading.release(course, ASSIGNMENTS)
+    autograder.release.release(course, ASSIGNMENTS)
     return course / "release"
 
 
