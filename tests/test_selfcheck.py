@@ -443,7 +443,7 @@ def test_brightness_package_check_finds_a_stale_copy_of_a_build_without_symlinks
     ({"Image, 'image'": "Image, '/camera/image_raw'"}, "still subscribes /camera/image_raw"),
     ({"int(frame[height // 2, width // 2, 0])": "frame[height // 2, width // 2, 0]"}, "wrap it in int(...)"),
     ({"frame[height // 2, width // 2, 0]": "frame[width // 2, height // 2, 0]"}, "numpy indexes [row, column]"),
-    ({"'brightness', qos_profile_sensor_data": "'brightness', 10"}, "publisher is reliable"),
+    ({"import UInt8": "import Float32", "UInt8": "Float32"}, "publishes std_msgs/msg/Float32 on /brightness"),
 ])
 def test_brightness_package_check_runs_the_node_as_ros2_run_would(built_brightness, change, expected):
     """With --symlink-install a changed node file runs without a build; the check sends it frames."""
