@@ -549,7 +549,7 @@ def task_picture_corners(function) -> Verdict:
 
 # ---- lesson 02: the brightness node as a package -----------------------------------------------
 
-#: The package, executable, node and node file of lesson 02's exercise (the brightness assignment
+#: The package and executable of lesson 02's exercise (the brightness assignment
 #: continues from this package).
 BRIGHTNESS_PACKAGE = "brightness"
 BRIGHTNESS_EXECUTABLE = "brightness_node"
@@ -760,8 +760,12 @@ def _run_brightness_node(ws) -> Verdict:
 
     command = (f"ros2 run {BRIGHTNESS_PACKAGE} {BRIGHTNESS_EXECUTABLE} --ros-args -r /image:={CHECK_CAMERA_TOPIC}")
     with rosenv.reserve_domain_id() as reservation, RosProbe(reservation.domain_id) as probe:
-        process = workspace.run(ws, BRIGHTNESS_PACKAGE, BRIGHTNESS_EXECUTABLE, remap={"/image": CHECK_CAMERA_TOPIC},
-                                domain_id=reservation.domain_id, name=f"{BRIGHTNESS_EXECUTABLE} (self-check)")
+        try:
+            process = workspace.run(ws, BRIGHTNESS_PACKAGE, BRIGHTNESS_EXECUTABLE,
+                                    remap={"/image": CHECK_CAMERA_TOPIC}, domain_id=reservation.domain_id,
+                                    name=f"{BRIGHTNESS_EXECUTABLE} (self-check)")
+        except (OSError, RuntimeError) as error:  # FileNotFoundError names what the build lacks
+            return _verdict(False, f"`{command}` could not start: {error}")
         try:
             def student_nodes():
                 return [(n, ns) for n, ns in probe.node.get_node_names_and_namespaces() if n != probe.node.get_name()]
