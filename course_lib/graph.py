@@ -206,7 +206,7 @@ def topic_echo(topic: str, count: int = 1, timeout: float = 5.0, msg_type=None) 
         msg_type: the message class or type name; None takes it from the graph.
 
     Returns:
-        The ``count`` first messages received. ``print(graph.format_messages(msgs))`` shows
+        The ``count`` first messages received. ``print(message_yaml.format_messages(msgs))`` shows
         them as ``ros2 topic echo`` would.
 
     Raises:
