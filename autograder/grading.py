@@ -16,7 +16,7 @@ One submission is graded like this (:func:`grade_submission`, run by a worker th
    run in the student's kernel could be faked by the student's code (patch checks.grade and
    every test cell "passes").
 4. The hidden checks run after the notebook, in a fresh sandbox of the same kind, as processes
-   of the grader (``python -m course_lib.checks.harness outside``, root), against the module the
+   of the grader (``python -m autograder.checks_outside``, root), against the module the
    notebook wrote; the student's code they start runs as the worker's uid, with the same limits.
    Their points replace nbgrader's scores of those cells, and their verdicts (seed, what passed
    and failed, pictures) replace the cells' outputs in the autograded notebook.
@@ -54,7 +54,8 @@ from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 from autograder import config, gradebook, intake, kernel
-from course_lib.checks import harness
+from course_lib.checks import registry, runner, student_processes
+from course_lib.checks.result import Result, images_html, verdict_text
 
 REPO = Path(__file__).resolve().parent.parent
 REPO_SOURCE = REPO / "assignments" / "source"
@@ -162,13 +163,18 @@ def _tree_digest(paths: list[Path], digest) -> None:
             digest.update(str(path.relative_to(base.parent)).encode() + b"\0" + path.read_bytes() + b"\0")
 
 
+#: The modules of course_lib.checks that run every assignment's checks (a change regrades).
+CHECK_MODULES = ["registry", "result", "runner", "check_process", "context", "student_calls", "student_processes",
+                 "probe", "student", "answers"]
+
+
 def submission_digest(sub: Submission, course: Path) -> str:
     """Changes when the submission, the assignment's source or the grading code changes."""
     digest = hashlib.sha256()
     _tree_digest([sub.path, course / "source" / sub.assignment], digest)
-    here, checks = Path(__file__).resolve().parent, Path(harness.__file__).resolve().parent
-    code = [here / "kernel.py", here / "config.py", here / "answers" / f"{sub.assignment}.py",
-            checks / "harness.py", checks / "student.py", checks / "answers.py", checks / f"{sub.assignment}.py"]
+    here, checks = Path(__file__).resolve().parent, Path(registry.__file__).resolve().parent
+    code = [here / "kernel.py", here / "config.py", here / "checks_outside.py", here / "answers" / f"{sub.assignment}.py",
+            *(checks / f"{name}.py" for name in CHECK_MODULES), checks / f"{sub.assignment}.py"]
     _tree_digest([path for path in code if path.exists()], digest)
     return digest.hexdigest()
 
@@ -359,7 +365,7 @@ def grade_submission(sub: Submission, course: Path, domain_id: int) -> GradeResu
             os.chmod(folder, 0o711)
         grader = stage_grader(work)
         env = {"COURSE_LIB_GRADING": "1", "COURSE_LIB_UNDER_TEST": None, "AUTOGRADER_SEED": None,
-               harness.OUTSIDE_ENV: "1",
+               runner.OUTSIDE_ENV: "1",
                "JUPYTER_PATH": str(work / "jupyter"), "JUPYTER_RUNTIME_DIR": str(work / "runtime"),
                "JUPYTER_CONFIG_DIR": str(work / "jupyter-config"), "AUTOGRADER_KERNEL_TMP": str(work / "kernel-tmp"),
                "PYTHONPATH": os.pathsep.join([str(grader), _env_for_tools()["PYTHONPATH"]]), "HOME": str(work),
@@ -367,7 +373,7 @@ def grade_submission(sub: Submission, course: Path, domain_id: int) -> GradeResu
         if result.isolation == "root":
             result.kernel_uid = KERNEL_UID_BASE + domain_id
             env.update(AUTOGRADER_KERNEL_UID=str(result.kernel_uid), AUTOGRADER_KERNEL_NPROC=str(NPROC))
-            env.update({harness.STUDENT_UID_ENV: str(result.kernel_uid), harness.STUDENT_NPROC_ENV: str(NPROC)})
+            env.update({student_processes.STUDENT_UID_ENV: str(result.kernel_uid), student_processes.STUDENT_NPROC_ENV: str(NPROC)})
             exposure = interpreter_exposure()
             if exposure:
                 (work / "stage").mkdir()
@@ -415,7 +421,7 @@ def _grade_outside(sub: Submission, result: GradeResult, work: Path, autograded:
     """Run the hidden checks of the graded cells in processes of the grader, not in the student's
     kernel, against the module the notebook wrote in `workdir`; their points replace the cells'
     scores and their verdicts replace the outputs of the cells of the notebooks in `autograded`
-    (harness.grade only said "graded outside").
+    (runner.grade only said "graded outside").
 
     The check runs as root in a fresh sandbox (network and mount namespaces); the student's
     processes it starts run as the worker's uid, so they cannot touch the check or its results.
@@ -423,7 +429,7 @@ def _grade_outside(sub: Submission, result: GradeResult, work: Path, autograded:
     from course_lib import processes
 
     try:
-        checks = harness.checks_of(sub.assignment)
+        checks = registry.checks_of(sub.assignment)
     except ModuleNotFoundError:  # an assignment of the instructor's own, graded by nbgrader alone
         return
     names = [name for name in (_check_of(c["cell"]) for c in result.cells) if name in checks]
@@ -431,18 +437,18 @@ def _grade_outside(sub: Submission, result: GradeResult, work: Path, autograded:
         return
     out = work / "checks"
     out.mkdir(mode=0o700)
-    command = [sys.executable, "-m", "course_lib.checks.harness", "outside", sub.assignment, *names,
+    command = [sys.executable, "-m", "autograder.checks_outside", sub.assignment, *names,
                "--workdir", str(workdir), "--out", str(out)]
     wall = sum(checks[name].timeout + 30 for name in names)
-    env = {**env, harness.SEED_ENV: None, "AUTOGRADER_SEED": os.environ.get("AUTOGRADER_SEED")}
+    env = {**env, runner.SEED_ENV: None, "AUTOGRADER_SEED": os.environ.get("AUTOGRADER_SEED")}
     proc = _run_sandboxed(command, hide, f"checks {sub.key}", domain_id, env, out,
                           processes.Limits(wall_seconds=wall, grace_seconds=5.0))
     verdicts = {}
     for name in names:
         try:
-            verdicts[name] = harness.Result(**json.loads((out / f"{name}.json").read_text()))
+            verdicts[name] = Result(**json.loads((out / f"{name}.json").read_text()))
         except (OSError, ValueError, TypeError):
-            verdicts[name] = harness.Result(sub.assignment, name, 0.0, checks[name].points, 0,
+            verdicts[name] = Result(sub.assignment, name, 0.0, checks[name].points, 0,
                                             error=f"The grader could not run this check ({proc.describe_exit()}):\n"
                                                   f"{proc.log_tail(8)}")
     for cell in result.cells:
@@ -499,8 +505,8 @@ def _write_verdicts(folder: Path, verdicts: dict) -> None:
             if cell.cell_type != "code" or name not in verdicts:
                 continue
             verdict = verdicts[name]
-            cell.outputs = [nbformat.v4.new_output("stream", name="stdout", text=harness.verdict_text(verdict, True))]
-            html = harness.images_html(verdict)
+            cell.outputs = [nbformat.v4.new_output("stream", name="stdout", text=verdict_text(verdict, True))]
+            html = images_html(verdict)
             if html:
                 cell.outputs.append(nbformat.v4.new_output("display_data", data={"text/html": html}))
         nbformat.write(nb, path)
