@@ -12,6 +12,7 @@ import tempfile
 import time
 from pathlib import Path
 
+from autograder.student_uid import StudentUid
 from course_lib.checks import answers
 from course_lib.checks.check_process import _write_json, run_in_this_process
 from course_lib.checks.registry import get_check
@@ -21,14 +22,17 @@ from course_lib.checks.runner import _embed_images, fresh_seed
 def run_outside(assignment: str, names: list[str], workdir, out: Path) -> None:
     """The grader's run of a graded notebook's checks: each with a fresh seed and the answer key,
     one after the other in this process (one interpreter start-up for all of them; the student's
-    code they call runs in processes of its own, bounded in time), each result in out/<name>.json."""
+    code they call runs in processes of its own, bounded in time, as the grader's student uid when it
+    set one: autograder.student_uid), each result in out/<name>.json."""
     os.environ[answers.MODE_ENV] = "graded"
+    students = StudentUid.from_environment()
     for name in names:
         spec = get_check(assignment, name)
         scratch = Path(tempfile.mkdtemp(prefix=f"autograder-{name}-"))
         started = time.monotonic()
         try:
-            result = run_in_this_process(assignment, name, fresh_seed(), Path(workdir).resolve(), scratch)
+            result = run_in_this_process(assignment, name, fresh_seed(), Path(workdir).resolve(), scratch,
+                                         students)
             _embed_images(result, scratch)
         finally:
             shutil.rmtree(scratch, ignore_errors=True)

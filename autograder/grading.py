@@ -53,8 +53,8 @@ import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
-from autograder import config, gradebook, intake, kernel
-from course_lib.checks import registry, runner, student_processes
+from autograder import config, gradebook, intake, kernel, student_uid
+from course_lib.checks import registry, runner
 from course_lib.checks.result import Result, images_html, verdict_text
 
 REPO = Path(__file__).resolve().parent.parent
@@ -173,7 +173,8 @@ def submission_digest(sub: Submission, course: Path) -> str:
     digest = hashlib.sha256()
     _tree_digest([sub.path, course / "source" / sub.assignment], digest)
     here, checks = Path(__file__).resolve().parent, Path(registry.__file__).resolve().parent
-    code = [here / "kernel.py", here / "config.py", here / "checks_outside.py", here / "answers" / f"{sub.assignment}.py",
+    code = [here / "kernel.py", here / "config.py", here / "checks_outside.py", here / "student_uid.py", here / "run_as.py",
+            here / "answers" / f"{sub.assignment}.py",
             *(checks / f"{name}.py" for name in CHECK_MODULES), checks / f"{sub.assignment}.py"]
     _tree_digest([path for path in code if path.exists()], digest)
     return digest.hexdigest()
@@ -373,7 +374,7 @@ def grade_submission(sub: Submission, course: Path, domain_id: int) -> GradeResu
         if result.isolation == "root":
             result.kernel_uid = KERNEL_UID_BASE + domain_id
             env.update(AUTOGRADER_KERNEL_UID=str(result.kernel_uid), AUTOGRADER_KERNEL_NPROC=str(NPROC))
-            env.update({student_processes.STUDENT_UID_ENV: str(result.kernel_uid), student_processes.STUDENT_NPROC_ENV: str(NPROC)})
+            env.update({student_uid.STUDENT_UID_ENV: str(result.kernel_uid), student_uid.STUDENT_NPROC_ENV: str(NPROC)})
             exposure = interpreter_exposure()
             if exposure:
                 (work / "stage").mkdir()

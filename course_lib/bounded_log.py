@@ -1,7 +1,7 @@
 """A log of a stream that keeps its head and its tail: bounded on disk, never growing in memory.
 
-The supervisor (course_lib.supervisor) writes a node's output with :class:`_BoundedLog`; the
-caller (course_lib.processes) reads it back with :func:`_read_log`. Standard library only: the
+The supervisor (course_lib.supervisor) writes a node's output with :class:`BoundedLog`; the
+caller (course_lib.processes) reads it back with :func:`read_log`. Standard library only: the
 supervisor runs without site-packages.
 """
 
@@ -15,7 +15,7 @@ LOG_HEAD_BYTES = 64 * 1024
 LOG_TAIL_BYTES = 256 * 1024
 
 
-class _BoundedLog:
+class BoundedLog:
     """Write a stream to `head` (its first head_bytes) and to numbered `tail.N` chunk files of
     tail_bytes/2 each, deleting all but the newest two chunks: bounded disk, no memory growth."""
 
@@ -61,8 +61,8 @@ class _BoundedLog:
 
 
 
-def _read_log(directory: Path, chunk: int) -> bytes:
-    """Join the head and the newest tail chunks the supervisor wrote (see _BoundedLog)."""
+def read_log(directory: Path, chunk: int) -> bytes:
+    """Join the head and the newest tail chunks the supervisor wrote (see BoundedLog)."""
     for _attempt in range(5):
         try:
             head = (directory / "head").read_bytes() if (directory / "head").exists() else b""

@@ -33,8 +33,8 @@ import time
 from pathlib import Path
 from typing import Callable
 
-from course_lib.bounded_log import LOG_HEAD_BYTES, LOG_TAIL_BYTES, _read_log
-from course_lib.process_tree import _killpg
+from course_lib.bounded_log import LOG_HEAD_BYTES, LOG_TAIL_BYTES, read_log
+from course_lib.process_tree import signal_group
 
 #: Seconds start() waits for the supervisor to report that the command runs.
 START_TIMEOUT = 30.0
@@ -51,7 +51,7 @@ _WATCHER_IDS = itertools.count()
 
 @dataclasses.dataclass(frozen=True)
 class Limits:
-    """Bounds for a child that runs untrusted code (the autograder); None means no bound.
+    """Bounds for a child that runs untrusted code (the checks); None means no bound.
 
     Attributes:
         wall_seconds: real time after which the child is stopped (SIGINT, then SIGKILL after
@@ -61,13 +61,10 @@ class Limits:
             ROS nodes.
         cpu_seconds: CPU time (RLIMIT_CPU); the child gets SIGXCPU when it is used up.
         max_processes: processes *and threads* of the child's user (RLIMIT_NPROC). Fast DDS
-            starts about a dozen threads per node. The kernel does not enforce it for root, so
-            combine it with ``user`` when the caller runs as root.
+            starts about a dozen threads per node. The kernel does not enforce it for root (the
+            grader, as root, runs the student's code as another uid: autograder.run_as).
         file_size_mb: largest file the child may write (RLIMIT_FSIZE); SIGXFSZ beyond it.
         open_files: open file descriptors (RLIMIT_NOFILE).
-        user: run the child as this user (for example "nobody"), or as this numeric uid (and gid),
-            which needs no passwd entry; needs a caller running as root.
-            The child gets a fresh HOME/ROS_HOME it owns, since ROS writes logs there.
         grace_seconds: time between SIGINT and SIGKILL when the wall time runs out.
     """
 
@@ -77,7 +74,6 @@ class Limits:
     max_processes: int | None = None
     file_size_mb: int | None = None
     open_files: int | None = None
-    user: str | int | None = None
     grace_seconds: float = 2.0
 
     def __post_init__(self):
@@ -121,6 +117,8 @@ class NodeProcess:
             None removes a variable).
         cwd: working directory of the child.
         limits: resource bounds (see Limits); None for none.
+        private_dirs: folders that belong to the child (a HOME made for it): removed when it has
+            ended, also when its caller dies first.
         on_output: called as ``on_output(stream, data)`` with each piece of the child's output
             as it arrives, stream being "stdout" or "stderr" (from a thread of its own; the
             log keeps everything as well). By the time returncode is known, on_output has had
@@ -140,7 +138,7 @@ class NodeProcess:
 
     def __init__(self, command: list[str], *, name: str | None = None, domain_id: int | None = None,
                  env: dict | None = None, cwd=None, limits: Limits | None = None,
-                 on_output: Callable[[str, bytes], None] | None = None):
+                 on_output: Callable[[str, bytes], None] | None = None, private_dirs=()):
         from course_lib import rosenv  # imported here: the supervisor runs this file without it
 
         if isinstance(command, (str, bytes)) or not command:
@@ -170,7 +168,7 @@ class NodeProcess:
         self._status: int | None = None
         self._status_buffer = b""
         self._log_dir: Path | None = None
-        self._home_dir: Path | None = None
+        self._private_dirs = [Path(directory) for directory in private_dirs]
         self._final_log: bytes | None = None
         self._returncode: int | None = None
         self._lock = threading.RLock()
@@ -198,20 +196,14 @@ class NodeProcess:
                         other.stop()
             env = dict(self.env)
             self._log_dir = Path(tempfile.mkdtemp(prefix="course_lib-node-"))
-            cleanup = [str(self._log_dir)]
-            if self.limits.user is not None:
-                self._home_dir = _home_for(self.limits.user)
-                env["HOME"] = env["ROS_HOME"] = str(self._home_dir)
-                env.pop("ROS_LOG_DIR", None)
-                cleanup.append(str(self._home_dir))
+            cleanup = [str(self._log_dir), *map(str, self._private_dirs)]
             control_read, self._control = os.pipe()
             self._status, status_write = os.pipe()
             echo_read, echo_write = os.pipe() if self._on_output is not None else (None, None)
             config = {"command": self.command, "cwd": self.cwd, "log_dir": str(self._log_dir),
                       "head_bytes": LOG_HEAD_BYTES, "tail_bytes": LOG_TAIL_BYTES,
                       "rlimits": self.limits.rlimit_pairs(), "wall_seconds": self.limits.wall_seconds,
-                      "grace_seconds": self.limits.grace_seconds, "user": self.limits.user,
-                      "cleanup": cleanup, "echo_fd": echo_write}
+                      "grace_seconds": self.limits.grace_seconds, "cleanup": cleanup, "echo_fd": echo_write}
             try:
                 with open(self._log_dir / "supervisor.err", "wb") as errors:
                     self._supervisor = subprocess.Popen(
@@ -244,7 +236,7 @@ class NodeProcess:
                 return self
             if event and event.get("event") == "error":
                 self._poll(wait=True)
-                raise _start_error(event, self.command, self.cwd, self.limits.user)
+                raise _start_error(event, self.command, self.cwd)
             errors = self._supervisor_errors() or "(none)"
             if self._supervisor.poll() is None:
                 self._kill_supervisor()
@@ -271,7 +263,7 @@ class NodeProcess:
         # No lock: stop() holds it while it waits, and reading the log must not wait for that.
         log_dir, data = self._log_dir, self._final_log
         if data is None and log_dir is not None:
-            data = _read_log(log_dir, LOG_TAIL_BYTES // 2)
+            data = read_log(log_dir, LOG_TAIL_BYTES // 2)
             if self._final_log is not None:  # the child ended while we read
                 data = self._final_log
         return (data or b"").decode("utf-8", errors="replace")
@@ -473,11 +465,11 @@ class NodeProcess:
                 # The supervisor itself died (killed from outside). Its child got SIGKILL through
                 # PR_SET_PDEATHSIG; the child's group may hold more.
                 if self.pid is not None:
-                    _killpg(self.pid, signal.SIGKILL)
+                    signal_group(self.pid, signal.SIGKILL)
                 self._returncode = -signal.SIGKILL
                 self.exit_reason = "supervisor_died"
             if self._log_dir is not None:
-                self._final_log = _read_log(self._log_dir, LOG_TAIL_BYTES // 2)
+                self._final_log = read_log(self._log_dir, LOG_TAIL_BYTES // 2)
             self._close_fds()
             self._remove_dirs()
             with _RUNNING_LOCK:
@@ -512,13 +504,14 @@ class NodeProcess:
                     pass
         self._control = self._status = None
         self._supervisor = None
-        self._log_dir = self._home_dir = None
+        self._log_dir = None
+        self._private_dirs = []
 
     def _kill_supervisor(self) -> None:
         self._supervisor.kill()
         self._supervisor.wait()
         if self.pid is not None:
-            _killpg(self.pid, signal.SIGKILL)
+            signal_group(self.pid, signal.SIGKILL)
 
     def _supervisor_errors(self) -> str:
         try:
@@ -534,10 +527,10 @@ class NodeProcess:
                 setattr(self, attribute, None)
 
     def _remove_dirs(self) -> None:
-        for directory in (self._log_dir, self._home_dir):
+        for directory in (self._log_dir, *self._private_dirs):
             if directory is not None:
                 shutil.rmtree(directory, ignore_errors=True)
-        self._home_dir = None
+        self._private_dirs = []
 
 
 #: Seconds a node of the same name that ran before a new node process started may take to
@@ -607,14 +600,26 @@ def _relay_echo(fd: int, on_output: Callable[[str, bytes], None]) -> None:
 
 
 def python_node(target: str, *args: str, **kwargs) -> NodeProcess:
-    """Start a Python node with this interpreter and return its running NodeProcess.
+    """Start a Python node with this interpreter (python_command) and return its running NodeProcess.
+
+    Args:
+        target, *args: as python_command.
+        **kwargs: passed to NodeProcess (name, domain_id, env, cwd, limits).
+    """
+    process = NodeProcess(python_command(target, *args), **kwargs)
+    if kwargs.get("name") is None:  # a label only: two nodes of one module may run side by side
+        process.name = target.partition(":")[0].rsplit(".", 1)[-1]
+    return process.start()
+
+
+def python_command(target: str, *args: str) -> list[str]:
+    """The command line that runs a Python node with this interpreter.
 
     Args:
         target: "package.module" (run like ``python -m package.module``) or
             "package.module:function" (import it and call ``function()``, like a setup.py
             console-script entry point such as ``talker = demo.talker:main``).
         *args: command-line arguments for the node (sys.argv[1:]), e.g. "--ros-args", "-r", ...
-        **kwargs: passed to NodeProcess (name, domain_id, env, cwd, limits).
 
     Raises:
         ValueError: the target is not in one of the two forms.
@@ -633,10 +638,7 @@ def python_node(target: str, *args: str, **kwargs) -> NodeProcess:
         command = [sys.executable, "-c", code, *args]
     else:
         command = [sys.executable, "-m", module, *args]
-    process = NodeProcess(command, **kwargs)
-    if kwargs.get("name") is None:  # a label only: two nodes of one module may run side by side
-        process.name = module.rsplit(".", 1)[-1]
-    return process.start()
+    return command
 
 
 def stop_all(timeout: float = 5.0) -> None:
@@ -674,38 +676,13 @@ atexit.register(stop_all)
 os.register_at_fork(after_in_child=_disown_after_fork)
 
 
-def _start_error(event: dict, command: list[str], cwd: str | None, user: str | None) -> OSError:
+def _start_error(event: dict, command: list[str], cwd: str | None) -> OSError:
     number = event.get("errno")
     if number == errno.ENOENT:
         where = f" (working directory {cwd})" if cwd else ""
         return FileNotFoundError(number, f"Cannot run {command[0]!r}{where}: no such file or program on PATH; "
                                  f"check the spelling or give a full path", command[0])
     if number in (errno.EACCES, errno.EPERM):
-        if user is not None:
-            fix = (f"user {user!r} (Limits.user) needs read and execute access to it, to the interpreter "
-                   f"it runs and to every directory above them (a virtual environment under /root is not)")
-        else:
-            fix = "make it executable (chmod +x) or run it through its interpreter"
+        fix = "make it executable (chmod +x) or run it through its interpreter"
         return PermissionError(number, f"Cannot run {command[0]!r}: permission denied; {fix}", command[0])
     return OSError(number, f"Cannot run {command!r}: {event.get('message')}")
-
-
-def _home_for(user: str | int) -> Path:
-    """A fresh home directory owned by `user`, for a child that runs as that user."""
-    import pwd
-
-    if isinstance(user, int):
-        uid = gid = user
-    else:
-        try:
-            entry = pwd.getpwnam(user)
-        except KeyError:
-            raise ValueError(f"Limits.user {user!r} does not exist on this machine; use an existing "
-                             f"unprivileged account such as 'nobody'") from None
-        uid, gid = entry.pw_uid, entry.pw_gid
-    if os.geteuid() != 0 and uid != os.geteuid():
-        raise PermissionError(f"Limits.user={user!r} needs the caller to run as root; "
-                              "leave user=None when not running as root")
-    home = Path(tempfile.mkdtemp(prefix="course_lib-home-"))
-    os.chown(home, uid, gid)
-    return home

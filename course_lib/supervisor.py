@@ -9,9 +9,8 @@ nor course_lib's package imports cost start-up time. The supervisor is the node'
 - it reads a pipe whose only writer is the caller: when the caller dies in any way (atexit,
   SIGTERM, even SIGKILL) the pipe closes, and the supervisor stops the group;
 - the node gets PR_SET_PDEATHSIG=SIGKILL, so it dies with the supervisor;
-- resource limits (setrlimit) and the switch to an unprivileged user happen in the
-  supervisor's fork, which has no threads, never in the caller (a kernel or a process that
-  runs DDS threads, where ``preexec_fn`` is unsafe).
+- resource limits (setrlimit) are set in the supervisor's fork, which has no threads, never in
+  the caller (a kernel or a process that runs DDS threads, where ``preexec_fn`` is unsafe).
 
 The supervisor also relays the node's output to a log that keeps its head and its tail, so a
 node that prints a gigabyte neither blocks nor fills memory or disk.
@@ -30,11 +29,11 @@ import time
 
 if __name__ == "__main__":  # run as a script (python -I -S): find the sibling modules by their folder
     sys.path.append(os.path.dirname(os.path.abspath(__file__)))
-    from bounded_log import _BoundedLog
-    from process_tree import _children, _killpg, _signal_tree
+    from bounded_log import BoundedLog
+    import process_tree
 else:
-    from course_lib.bounded_log import _BoundedLog
-    from course_lib.process_tree import _children, _killpg, _signal_tree
+    from course_lib.bounded_log import BoundedLog
+    from course_lib import process_tree
 
 #: Seconds a node gets to shut down after SIGINT when its caller has gone away.
 PARENT_GONE_GRACE = 1.0
@@ -106,13 +105,10 @@ def _supervisor_main(argv: list[str] | None = None) -> int:
         os.set_blocking(echo_fd, False)
         error_read, error_write = os.pipe()
         streams[error_read] = b"e"
-    log = _BoundedLog(config["log_dir"], config["head_bytes"], config["tail_bytes"])
-    user = config["user"]
+    log = BoundedLog(config["log_dir"], config["head_bytes"], config["tail_bytes"])
     try:
         child = subprocess.Popen(config["command"], stdin=subprocess.DEVNULL, stdout=output_write,
-                                 stderr=error_write, cwd=config["cwd"], preexec_fn=prepare_child,
-                                 user=user, group=None if user is None else _group_of(user),
-                                 extra_groups=None if user is None else [])
+                                 stderr=error_write, cwd=config["cwd"], preexec_fn=prepare_child)
     except OSError as error:
         report(event="error", errno=error.errno, message=str(error))
         report(event="exited", returncode=127, reason="not_started", max_rss_kb=0, cpu_seconds=0.0,
@@ -141,7 +137,7 @@ def _supervisor_main(argv: list[str] | None = None) -> int:
         nonlocal reason, kill_at
         if reason is None:
             reason = why
-            _signal_tree(child.pid, signal.SIGINT)
+            process_tree.signal_tree(child.pid, signal.SIGINT)
         deadline = time.monotonic() + max(0.0, grace)
         kill_at = deadline if kill_at is None else min(kill_at, deadline)
 
@@ -212,22 +208,15 @@ def _supervisor_main(argv: list[str] | None = None) -> int:
             wall_deadline = None
             begin_stop("wall_seconds", config["grace_seconds"])
         if kill_at is not None and time.monotonic() >= kill_at:
-            _signal_tree(child.pid, signal.SIGKILL)
+            process_tree.signal_tree(child.pid, signal.SIGKILL)
             kill_at = None  # once is enough; SIGCHLD wakes us when it has died
 
     # The child has exited but is not reaped yet, so its process group id cannot be reused:
     # kill what it left in its group, then whatever was re-parented to us.
-    _killpg(child.pid, signal.SIGKILL)
+    process_tree.signal_group(child.pid, signal.SIGKILL)
     _, wait_status, usage = os.wait4(child.pid, 0)
     child.returncode = os.waitstatus_to_exitcode(wait_status)  # keeps Popen from waiting again
-    leftovers_deadline = time.monotonic() + 5.0
-    while (orphans := _children(me)) and time.monotonic() < leftovers_deadline:
-        for pid in orphans:
-            try:
-                os.kill(pid, signal.SIGKILL)
-                os.waitpid(pid, 0)
-            except (ProcessLookupError, ChildProcessError):
-                pass
+    process_tree.kill_children(timeout=5.0)
     drain_deadline = time.monotonic() + 2.0
     open_streams = list(streams)
     while open_streams and time.monotonic() < drain_deadline:
@@ -251,14 +240,6 @@ def _supervisor_main(argv: list[str] | None = None) -> int:
         for path in config["cleanup"]:
             shutil.rmtree(path, ignore_errors=True)
     return 0
-
-
-def _group_of(user: str | int) -> int:
-    """The primary group of a user name; a bare uid (no passwd entry needed) is its own group."""
-    import pwd
-
-    return user if isinstance(user, int) else pwd.getpwnam(user).pw_gid
-
 
 
 if __name__ == "__main__":

@@ -15,12 +15,15 @@ from course_lib.checks.context import Context, StudentError
 from course_lib.checks.registry import get_check
 from course_lib.checks.result import Result
 from course_lib.checks.runner import SEED_ENV, SELFCHECK_SEED
+from course_lib.checks.student_processes import StudentProcesses
 
 
-def run_in_this_process(assignment: str, name: str, seed: int, workdir: Path, out: Path) -> Result:
-    """Run a check here (the check process) and return its Result."""
+def run_in_this_process(assignment: str, name: str, seed: int, workdir: Path, out: Path,
+                        students: StudentProcesses | None = None) -> Result:
+    """Run a check here (the check process) and return its Result; `students` starts the student's
+    processes (default: as this process's user, course_lib.checks.student_processes)."""
     spec = get_check(assignment, name)
-    ctx = Context(spec, seed, workdir, out)
+    ctx = Context(spec, seed, workdir, out, students)
     error = None
     try:
         spec.function(ctx)

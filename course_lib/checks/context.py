@@ -15,7 +15,7 @@ from course_lib.checks import answers
 from course_lib.checks.probe import RosProbe
 from course_lib.checks.registry import Check
 from course_lib.checks.student_calls import Outcome, _read_outcomes, _tail, _write_calls
-from course_lib.checks.student_processes import _give_to_student, _student_env, _student_limits
+from course_lib.checks.student_processes import StudentProcesses
 
 #: Seconds a student's module gets to import (rclpy alone needs one or two on a busy machine).
 IMPORT_TIMEOUT = 25.0
@@ -38,9 +38,10 @@ class Context:
         seed: this run's seed; rng: a numpy Generator seeded with it.
         workdir: the directory of the student's notebook and module files.
         domain_id: a ROS domain reserved for this check (student nodes and probes use it).
+        students: how the student's processes start (StudentProcesses; the grader passes its own).
     """
 
-    def __init__(self, spec: Check, seed: int, workdir: Path, out: Path):
+    def __init__(self, spec: Check, seed: int, workdir: Path, out: Path, students: StudentProcesses | None = None):
         import numpy as np
 
         self.spec = spec
@@ -48,6 +49,7 @@ class Context:
         self.rng = np.random.default_rng(seed)
         self.workdir = workdir
         self.out = out
+        self.students = students or StudentProcesses()
         self.items: list[dict] = []
         self.notes: list[str] = []
         self.images: list[dict] = []
@@ -167,16 +169,13 @@ class Context:
         Raises:
             StudentError: the module did not import.
         """
-        from course_lib import processes
-
         self.require_module()
-        _give_to_student(job)
+        self.students.give(job)
         timeout = min(timeout, self.remaining())
         deadline = time.monotonic() + timeout
-        proc = processes.NodeProcess([sys.executable, "-m", "course_lib.checks.student", command, self.module, target, str(job)],
-                                     name=f"student-{target}", cwd=self.workdir, domain_id=self.domain_id,
-                                     limits=_student_limits(timeout + 2), env=_student_env())
-        proc.start()
+        proc = self.students.start([sys.executable, "-m", "course_lib.checks.student", command, self.module, target,
+                                    str(job)], name=f"student-{target}", cwd=self.workdir, domain_id=self.domain_id,
+                                   wall_seconds=timeout + 2)
         import_wait = min(IMPORT_TIMEOUT, timeout)
         call_seconds = 0.0
         try:
@@ -212,9 +211,9 @@ class Context:
         from course_lib import processes
 
         self.require_module()
-        limits = _student_limits(self.remaining() + 5)
-        return processes.python_node(f"{self.module}:{entry}", *ros_args, name=f"student-{self.module}-{entry}{tag}",
-                                     cwd=self.workdir, domain_id=self.domain_id, limits=limits, env=_student_env())
+        return self.students.start(processes.python_command(f"{self.module}:{entry}", *ros_args),
+                                   name=f"student-{self.module}-{entry}{tag}", cwd=self.workdir,
+                                   domain_id=self.domain_id, wall_seconds=self.remaining() + 5)
 
     @property
     def domain_id(self) -> int:
@@ -231,7 +230,9 @@ class Context:
 
     def probe(self):
         """A ROS node of the checker in this check's domain (see RosProbe); close() it or use `with`."""
-        return RosProbe(self.domain_id)
+        probe = RosProbe(self.domain_id)
+        self.students.probe_started()
+        return probe
 
     def close(self) -> None:
         from course_lib import processes
@@ -260,7 +261,6 @@ def _mark(path: Path) -> None:
         os.close(os.open(path, os.O_WRONLY | os.O_CREAT | os.O_NOFOLLOW, 0o644))
     except OSError:
         pass
-
 
 
 def clip(text: str, limit: int = 1500) -> str:

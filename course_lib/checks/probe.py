@@ -4,9 +4,6 @@ from __future__ import annotations
 
 import os
 import time
-from pathlib import Path
-
-from course_lib.checks.student_processes import _student_uid
 
 
 class RosProbe:
@@ -23,8 +20,6 @@ class RosProbe:
                                       enable_rosout=False, start_parameter_services=False)
         self.executor = SingleThreadedExecutor(context=self.context)
         self.executor.add_node(self.node)
-        if _student_uid() is not None:
-            _share_shared_memory()
 
     def spin_until(self, condition, timeout: float) -> bool:
         """Process callbacks until condition() is true or `timeout` seconds pass; returns condition()."""
@@ -57,21 +52,3 @@ class RosProbe:
 
     def __exit__(self, *exc):
         self.close()
-
-
-def _share_shared_memory() -> None:
-    """Let the student's uid use this (root) process's Fast DDS shared-memory files.
-
-    Fast DDS creates its segments, ports and port mutexes 0644, so a node of another uid can
-    neither deliver into a root participant's port nor release buffers in its segment: root and
-    student nodes would not even discover each other. The grader's /dev/shm is a private tmpfs of
-    the submission's sandbox, so opening this process's files to "others" opens them to that
-    student's processes only.
-    """
-    me = os.geteuid()
-    for path in Path("/dev/shm").glob("*fastrtps_*"):
-        try:
-            if path.stat().st_uid == me:
-                os.chmod(path, 0o666)
-        except OSError:  # another participant's file went away meanwhile
-            pass
