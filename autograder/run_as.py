@@ -82,24 +82,36 @@ def home_for(user: str | int) -> str:
     return home
 
 
+def become(uid: int, gid: int, max_processes: int | None = None) -> None:
+    """Switch this process to uid and gid with no supplementary groups, then bound the processes
+    and threads of that uid (RLIMIT_NPROC): the wrapper's step, and the grading kernel's
+    (autograder.kernel).
+
+    Raises:
+        PermissionError: this process is not root.
+    """
+    import resource
+
+    os.setgroups([])
+    os.setgid(gid)
+    os.setuid(uid)
+    if max_processes:
+        resource.setrlimit(resource.RLIMIT_NPROC, (max_processes, max_processes))
+
+
 def main(argv: list[str]) -> int:
     """The wrapper: argv is [uid, gid, max_processes (0: none), "--", command...]."""
     import ctypes
-    import resource
 
     uid, gid, nproc = (int(value) for value in argv[:3])
     program = argv[4:]
     parent = os.getppid()
     try:
-        os.setgroups([])
-        os.setgid(gid)
-        os.setuid(uid)
+        become(uid, gid, nproc)
     except PermissionError:
         sys.stderr.write(f"autograder.run_as: switching to uid {uid} needs root, and this process runs as uid "
                          f"{os.geteuid()}; leave the user out when not running as root\n")
         return EXIT_NOT_EXECUTABLE
-    if nproc:
-        resource.setrlimit(resource.RLIMIT_NPROC, (nproc, nproc))
     ctypes.CDLL(None, use_errno=True).prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
     if os.getppid() != parent:  # the supervisor died before prctl took effect
         os.kill(os.getpid(), signal.SIGKILL)
