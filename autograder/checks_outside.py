@@ -14,9 +14,9 @@ from pathlib import Path
 
 from autograder.student_uid import StudentUid
 from course_lib.checks import answers
-from course_lib.checks.check_process import _write_json, run_in_this_process
+from course_lib.checks.check_process import write_json, run_in_this_process
 from course_lib.checks.registry import get_check
-from course_lib.checks.runner import _embed_images, fresh_seed
+from course_lib.checks.runner import embed_images, fresh_seed
 
 
 def run_outside(assignment: str, names: list[str], workdir, out: Path) -> None:
@@ -33,14 +33,12 @@ def run_outside(assignment: str, names: list[str], workdir, out: Path) -> None:
         try:
             result = run_in_this_process(assignment, name, fresh_seed(), Path(workdir).resolve(), scratch,
                                          students)
-            _embed_images(result, scratch)
+            embed_images(result, scratch)
         finally:
             shutil.rmtree(scratch, ignore_errors=True)
         result.points = max(0.0, min(result.points, spec.points))
         result.seconds = round(time.monotonic() - started, 2)
-        _write_json(out / f"{name}.json", dataclasses.asdict(result))
-
-
+        write_json(out / f"{name}.json", dataclasses.asdict(result))
 
 
 def main(argv=None) -> int:

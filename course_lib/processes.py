@@ -33,6 +33,7 @@ import time
 from pathlib import Path
 from typing import Callable
 
+from course_lib import rosenv
 from course_lib.bounded_log import LOG_HEAD_BYTES, LOG_TAIL_BYTES, read_log
 from course_lib.process_tree import signal_group
 
@@ -139,8 +140,6 @@ class NodeProcess:
     def __init__(self, command: list[str], *, name: str | None = None, domain_id: int | None = None,
                  env: dict | None = None, cwd=None, limits: Limits | None = None,
                  on_output: Callable[[str, bytes], None] | None = None, private_dirs=()):
-        from course_lib import rosenv  # imported here: the supervisor runs this file without it
-
         if isinstance(command, (str, bytes)) or not command:
             raise TypeError(f"command must be a non-empty list of strings like ['python', '-m', 'pkg.node'], "
                             f"not {command!r}")

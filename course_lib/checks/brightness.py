@@ -21,7 +21,7 @@ import numpy as np
 from course_lib.checks import runner
 from course_lib.checks.context import Context
 from course_lib.checks.registry import check
-from course_lib.checks.student_processes import _student_env
+from course_lib.checks.student_processes import student_env
 
 ASSIGNMENT = "brightness"
 
@@ -339,7 +339,7 @@ def _start_yardstick(ctx):
 
     return processes.python_node("course_lib.checks.brightness:yardstick_main", "--ros-args",
                                  "-r", "frames:=/image", "-r", f"answers:={YARDSTICK_ANSWERS}",
-                                 name="brightness-yardstick", domain_id=ctx.domain_id, env=_student_env())
+                                 name="brightness-yardstick", domain_id=ctx.domain_id, env=student_env())
 
 
 def yardstick_main(args=None) -> None:

@@ -55,11 +55,12 @@ def main(argv=None) -> int:
     out = Path(args.out)
     seed = args.seed if args.seed is not None else int(os.environ.get(SEED_ENV, SELFCHECK_SEED))
     result = run_in_this_process(args.assignment, args.check, seed, Path(args.workdir).resolve(), out)
-    _write_json(out / "result.json", dataclasses.asdict(result))
+    write_json(out / "result.json", dataclasses.asdict(result))
     return 0
 
 
-def _write_json(path: Path, data) -> None:
+def write_json(path: Path, data) -> None:
+    """Write `data` as JSON so that a reader never sees half a file (a temporary file, renamed)."""
     path.with_suffix(".tmp").write_text(json.dumps(data))
     os.replace(path.with_suffix(".tmp"), path)
 

@@ -14,7 +14,7 @@ from pathlib import Path
 from course_lib.checks import answers
 from course_lib.checks.probe import RosProbe
 from course_lib.checks.registry import Check
-from course_lib.checks.student_calls import Outcome, _read_outcomes, _tail, _write_calls
+from course_lib.checks.student_calls import Outcome, last_lines, read_outcomes, write_calls
 from course_lib.checks.student_processes import StudentProcesses
 
 #: Seconds a student's module gets to import (rclpy alone needs one or two on a busy machine).
@@ -136,10 +136,10 @@ class Context:
         """
         job = Path(tempfile.mkdtemp(prefix="autograder-call-"))
         try:
-            _write_calls(job, calls)
+            write_calls(job, calls)
             timeout = min(timeout or self.remaining(), self.remaining())
             proc, call_seconds = self._run_student("call", function, job, timeout)
-            return _read_outcomes(job, len(calls), proc, call_seconds)
+            return read_outcomes(job, len(calls), proc, call_seconds)
         finally:
             shutil.rmtree(job, ignore_errors=True)
 
@@ -155,7 +155,7 @@ class Context:
                 return json.loads((job / "endpoints.json").read_text())
             except (OSError, ValueError):
                 raise StudentError(f"{class_name}() could not be constructed ({proc.describe_exit()}):\n"
-                                   f"{_tail(proc.log, 6)}") from None
+                                   f"{last_lines(proc.log, 6)}") from None
         finally:
             shutil.rmtree(job, ignore_errors=True)
 
@@ -198,7 +198,7 @@ class Context:
             proc.stop(timeout=1)
         if not (job / "imported").exists():
             raise StudentError(f"{self.module} could not be imported ({proc.describe_exit()}):\n"
-                               f"{_tail(proc.log, 6)}")
+                               f"{last_lines(proc.log, 6)}")
         return proc, call_seconds
 
     def start_node(self, *ros_args: str, entry: str = "main", tag: str = ""):

@@ -24,7 +24,7 @@ class Result:
 
     def verdict_lines(self) -> list[str]:
         """The points, then what failed (each cause followed by its consequences), then what passed."""
-        lines = [f"{self.name}: {_fmt(self.points)} of {_fmt(self.max_points)} points"]
+        lines = [f"{self.name}: {points_text(self.points)} of {points_text(self.max_points)} points"]
         for item in self.items:
             if not item["ok"] and not item.get("consequence"):
                 lines.append("  ✘ " + item["message"])
@@ -40,7 +40,8 @@ class Result:
         return lines
 
 
-def _fmt(value: float) -> str:
+def points_text(value: float) -> str:
+    """Points as a verdict writes them: 4, 2.5, 0.333."""
     return f"{value:g}"
 
 

@@ -45,7 +45,7 @@ from pathlib import Path
 
 from course_lib.checks import answers
 from course_lib.checks.registry import get_check
-from course_lib.checks.result import Result, _fmt, images_html, verdict_text
+from course_lib.checks.result import Result, images_html, points_text, verdict_text
 
 #: The fixed seed of self-checks (what the student sees when running the notebook).
 SELFCHECK_SEED = 2024
@@ -67,7 +67,7 @@ def selfcheck(assignment: str, name: str) -> None:
     result = run_check(assignment, name, SELFCHECK_SEED)
     if result.points < result.max_points:
         lines = [line.strip() for line in result.verdict_lines() if line.lstrip().startswith(("✘", "↳", "!"))]
-        sys.stderr.write(f"Self-check {name}: {_fmt(result.points)} of {_fmt(result.max_points)} points. "
+        sys.stderr.write(f"Self-check {name}: {points_text(result.points)} of {points_text(result.max_points)} points. "
                          "What to fix:\n" + "\n".join(lines) + "\n")
         sys.stderr.flush()
 
@@ -127,7 +127,7 @@ def execute(assignment: str, name: str, seed: int, workdir=None, mode: str = "se
                "--workdir", str(workdir), "--out", str(out)]
     limits = processes.Limits(wall_seconds=spec.timeout + 10, grace_seconds=2.0)
     proc = processes.NodeProcess(command, name=f"autograder-check-{name}", cwd=out, limits=limits,
-                                 env={"PYTHONPATH": _pythonpath(), SEED_ENV: str(seed), answers.MODE_ENV: mode})
+                                 env={"PYTHONPATH": child_pythonpath(), SEED_ENV: str(seed), answers.MODE_ENV: mode})
     try:
         proc.start()
         try:
@@ -142,7 +142,7 @@ def execute(assignment: str, name: str, seed: int, workdir=None, mode: str = "se
             result = Result(assignment, name, 0.0, spec.points, seed,
                             error=f"The check did not finish ({proc.describe_exit()}); "
                                   f"its last output:\n{proc.log_tail(8)}")
-        _embed_images(result, out)
+        embed_images(result, out)
     finally:
         proc.stop(timeout=3)
         shutil.rmtree(out, ignore_errors=True)
@@ -151,7 +151,7 @@ def execute(assignment: str, name: str, seed: int, workdir=None, mode: str = "se
     return result
 
 
-def _embed_images(result: Result, out: Path) -> None:
+def embed_images(result: Result, out: Path) -> None:
     """Replace the file names of the result's pictures (written to `out`) by their PNG bytes."""
     for image in result.images:
         path = out / image.pop("file", "")
@@ -160,7 +160,7 @@ def _embed_images(result: Result, out: Path) -> None:
 
 
 
-def _pythonpath() -> str:
+def child_pythonpath() -> str:
     """The directory holding course_lib (in a course checkout also the autograder), first on the
     path of child processes."""
     root = str(Path(__file__).resolve().parents[2])

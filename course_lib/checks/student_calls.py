@@ -29,7 +29,8 @@ class Outcome:
 
 
 
-def _write_calls(job: Path, calls: list[tuple]) -> None:
+def write_calls(job: Path, calls: list[tuple]) -> None:
+    """Write the calls, (args, kwargs) each, as JOB/calls.json and their arrays as JOB/inputs.npz."""
     import numpy as np
 
     arrays, manifest = {}, []
@@ -44,7 +45,9 @@ def _write_calls(job: Path, calls: list[tuple]) -> None:
     (job / "calls.json").write_text(json.dumps(manifest))
 
 
-def _read_outcomes(job: Path, count: int, proc, timeout: float) -> list[Outcome]:
+def read_outcomes(job: Path, count: int, proc, timeout: float) -> list[Outcome]:
+    """One Outcome per call, read from JOB/<i>.json and .npz; calls without a result say why (the
+    process `proc` ended or ran out of its `timeout` seconds)."""
     import numpy as np
 
     outcomes = []
@@ -55,7 +58,7 @@ def _read_outcomes(job: Path, count: int, proc, timeout: float) -> list[Outcome]
                 why = f"did not return within {timeout:.0f} s (an endless loop?)"
             else:
                 why = f"ended the process ({proc.describe_exit()}) before returning"
-            log = _tail(proc.log, 4)
+            log = last_lines(proc.log, 4)
             outcomes.append(Outcome(error=f"the call {why}. Last output:\n{log}"))
             outcomes.extend(Outcome(error="not run: an earlier call did not return") for _ in range(count - index - 1))
             break
@@ -82,6 +85,7 @@ def _decode(encoded: dict, arrays):
     return encoded.get("repr")
 
 
-def _tail(text: str, lines: int) -> str:
+def last_lines(text: str, lines: int) -> str:
+    """The last `lines` lines of a process's output, or "(no output)"."""
     text = text.strip()
     return "\n".join(text.splitlines()[-lines:]) if text else "(no output)"

@@ -12,7 +12,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from course_lib.checks import answers
-from course_lib.checks.runner import SEED_ENV, _pythonpath
+from course_lib.checks.runner import SEED_ENV, child_pythonpath
 
 #: Memory (address space, MB) of a student's process. rclpy with Fast DDS maps a few hundred MB.
 STUDENT_MEMORY_MB = 2048
@@ -21,10 +21,11 @@ STUDENT_MEMORY_MB = 2048
 STUDENT_FILE_MB = 128
 
 
-def _student_env() -> dict:
+def student_env() -> dict:
+    """The variables of a student process: course_lib importable, none of the grader's seeds or answers."""
     # Fast DDS's set-up for camera frames comes, as for every course process, from
     # course_lib.rosenv.ros_environment (its shared-memory segments need RLIMIT_FSIZE above 32 MB).
-    return {"PYTHONPATH": _pythonpath(), "AUTOGRADER_SEED": None, SEED_ENV: None,
+    return {"PYTHONPATH": child_pythonpath(), "AUTOGRADER_SEED": None, SEED_ENV: None,
             answers.MODE_ENV: None, answers.RECORD_ENV: None, "PYTHONDONTWRITEBYTECODE": "1"}
 
 
@@ -35,7 +36,7 @@ class StudentProcesses:
         """Start `command` (the student's code) and return its running course_lib.processes.NodeProcess."""
         from course_lib import processes
 
-        command, env, private_dirs = self.confine(list(command), _student_env())
+        command, env, private_dirs = self.confine(list(command), student_env())
         return processes.NodeProcess(command, name=name, cwd=cwd, domain_id=domain_id, env=env,
                                      limits=self.limits(wall_seconds), private_dirs=private_dirs).start()
 
