@@ -51,9 +51,9 @@ def code(text: str, kind: str | None = None, grade_id: str | None = None, points
 
 def test_cell(assignment: str, name: str):
     """The graded cell of one check: the self-check, then the hidden graded run with a fresh seed."""
-    from course_lib.checks import harness
+    from course_lib.checks import registry
 
-    spec = harness.get_check(assignment, name)
+    spec = registry.get_check(assignment, name)
     source = (f"# {spec.description} ({spec.points:g} points)\n"
               f"checks.selfcheck({name!r})\n"
               "### BEGIN HIDDEN TESTS\n"

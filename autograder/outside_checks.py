@@ -10,7 +10,8 @@ from pathlib import Path
 from autograder.result import GradeResult
 from autograder.sandbox import run_sandboxed
 from autograder.submissions import Submission
-from course_lib.checks import harness
+from course_lib.checks import registry, runner
+from course_lib.checks.result import Result, images_html, verdict_text
 
 
 def grade_outside(sub: Submission, result: GradeResult, work: Path, autograded: Path, workdir: Path,
@@ -18,7 +19,7 @@ def grade_outside(sub: Submission, result: GradeResult, work: Path, autograded: 
     """Run the hidden checks of the graded cells in processes of the grader, not in the student's
     kernel, against the module the notebook wrote in `workdir`; their points replace the cells'
     scores and their verdicts replace the outputs of the cells of the notebooks in `autograded`
-    (harness.grade only said "graded outside").
+    (runner.grade only said "graded outside").
 
     The check runs as root in a fresh sandbox (network and mount namespaces); the student's
     processes it starts run as the worker's uid, so they cannot touch the check or its results.
@@ -26,7 +27,7 @@ def grade_outside(sub: Submission, result: GradeResult, work: Path, autograded: 
     from course_lib import processes
 
     try:
-        checks = harness.checks_of(sub.assignment)
+        checks = registry.checks_of(sub.assignment)
     except ModuleNotFoundError:  # an assignment of the instructor's own, graded by nbgrader alone
         return
     names = [name for name in (check_of(c["cell"]) for c in result.cells) if name in checks]
@@ -34,18 +35,18 @@ def grade_outside(sub: Submission, result: GradeResult, work: Path, autograded: 
         return
     out = work / "checks"
     out.mkdir(mode=0o700)
-    command = [sys.executable, "-m", "course_lib.checks.harness", "outside", sub.assignment, *names,
+    command = [sys.executable, "-m", "autograder.checks_outside", sub.assignment, *names,
                "--workdir", str(workdir), "--out", str(out)]
     wall = sum(checks[name].timeout + 30 for name in names)
-    env = {**env, harness.SEED_ENV: None, "AUTOGRADER_SEED": os.environ.get("AUTOGRADER_SEED")}
+    env = {**env, runner.SEED_ENV: None, "AUTOGRADER_SEED": os.environ.get("AUTOGRADER_SEED")}
     proc = run_sandboxed(command, hide, f"checks {sub.key}", domain_id, env, out,
                           processes.Limits(wall_seconds=wall, grace_seconds=5.0))
     verdicts = {}
     for name in names:
         try:
-            verdicts[name] = harness.Result(**json.loads((out / f"{name}.json").read_text()))
+            verdicts[name] = Result(**json.loads((out / f"{name}.json").read_text()))
         except (OSError, ValueError, TypeError):
-            verdicts[name] = harness.Result(sub.assignment, name, 0.0, checks[name].points, 0,
+            verdicts[name] = Result(sub.assignment, name, 0.0, checks[name].points, 0,
                                             error=f"The grader could not run this check ({proc.describe_exit()}):\n"
                                                   f"{proc.log_tail(8)}")
     for cell in result.cells:
@@ -71,8 +72,8 @@ def _write_verdicts(folder: Path, verdicts: dict) -> None:
             if cell.cell_type != "code" or name not in verdicts:
                 continue
             verdict = verdicts[name]
-            cell.outputs = [nbformat.v4.new_output("stream", name="stdout", text=harness.verdict_text(verdict, True))]
-            html = harness.images_html(verdict)
+            cell.outputs = [nbformat.v4.new_output("stream", name="stdout", text=verdict_text(verdict, True))]
+            html = images_html(verdict)
             if html:
                 cell.outputs.append(nbformat.v4.new_output("display_data", data={"text/html": html}))
         nbformat.write(nb, path)

@@ -17,7 +17,7 @@ are listed in :data:`STEPS`):
    run in the student's kernel could be faked by the student's code (patch checks.grade and
    every test cell "passes").
 4. The hidden checks run after the notebook, in a fresh sandbox of the same kind, as processes
-   of the grader (``python -m course_lib.checks.harness outside``, root), against the module the
+   of the grader (``python -m autograder.checks_outside``, root), against the module the
    notebook wrote; the student's code they start runs as the worker's uid, with the same limits.
    Their points replace nbgrader's scores of those cells, and their verdicts (seed, what passed
    and failed, pictures) replace the cells' outputs in the autograded notebook.
@@ -38,7 +38,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from autograder import config, gradebook, intake, kernel
+from autograder import config, gradebook, intake, kernel, student_uid
 from autograder.nbgrader_cli import env_for_tools
 from autograder.outputs import keep_autograded, keep_log, scrub_paths
 from autograder.outside_checks import grade_outside
@@ -46,7 +46,7 @@ from autograder.result import GradeResult
 from autograder.sandbox import HIDDEN_FROM_STUDENTS, interpreter_exposure, isolation, run_sandboxed
 from autograder.staging import private_copy, stage_grader
 from autograder.submissions import Submission, submission_digest
-from course_lib.checks import harness
+from course_lib.checks import runner
 
 
 #: Seconds one notebook may take under grading, everything included.
@@ -132,7 +132,7 @@ def choose_environment(g: Grading) -> None:
     work = g.work
     grader = stage_grader(work)
     g.env = {"COURSE_LIB_GRADING": "1", "COURSE_LIB_UNDER_TEST": None, "AUTOGRADER_SEED": None,
-             harness.OUTSIDE_ENV: "1",
+             runner.OUTSIDE_ENV: "1",
              "JUPYTER_PATH": str(work / "jupyter"), "JUPYTER_RUNTIME_DIR": str(work / "runtime"),
              "JUPYTER_CONFIG_DIR": str(work / "jupyter-config"), "AUTOGRADER_KERNEL_TMP": str(work / "kernel-tmp"),
              "PYTHONPATH": os.pathsep.join([str(grader), env_for_tools()["PYTHONPATH"]]), "HOME": str(work),
@@ -140,7 +140,7 @@ def choose_environment(g: Grading) -> None:
     if g.result.isolation == "root":
         g.result.kernel_uid = KERNEL_UID_BASE + g.domain_id
         g.env.update(AUTOGRADER_KERNEL_UID=str(g.result.kernel_uid), AUTOGRADER_KERNEL_NPROC=str(NPROC))
-        g.env.update({harness.STUDENT_UID_ENV: str(g.result.kernel_uid), harness.STUDENT_NPROC_ENV: str(NPROC)})
+        g.env.update({student_uid.STUDENT_UID_ENV: str(g.result.kernel_uid), student_uid.STUDENT_NPROC_ENV: str(NPROC)})
         exposure = interpreter_exposure()
         if exposure:
             (work / "stage").mkdir()

@@ -6,7 +6,7 @@ import dataclasses
 import hashlib
 from pathlib import Path
 
-from course_lib.checks import harness
+from course_lib.checks import registry
 
 
 @dataclasses.dataclass
@@ -43,13 +43,19 @@ def _tree_digest(paths: list[Path], digest) -> None:
             digest.update(str(path.relative_to(base.parent)).encode() + b"\0" + path.read_bytes() + b"\0")
 
 
+#: The modules of course_lib.checks that run every assignment's checks (a change regrades).
+CHECK_MODULES = ["registry", "result", "runner", "check_process", "context", "student_calls", "student_processes",
+                 "probe", "student", "answers"]
+
+
 def submission_digest(sub: Submission, course: Path) -> str:
     """Changes when the submission, the assignment's source or the grading code changes."""
     digest = hashlib.sha256()
     _tree_digest([sub.path, course / "source" / sub.assignment], digest)
-    here, checks = Path(__file__).resolve().parent, Path(harness.__file__).resolve().parent
-    code = [here / "kernel.py", here / "config.py", here / "answers" / f"{sub.assignment}.py",
-            checks / "harness.py", checks / "student.py", checks / "answers.py", checks / f"{sub.assignment}.py"]
+    here, checks = Path(__file__).resolve().parent, Path(registry.__file__).resolve().parent
+    code = [here / "kernel.py", here / "config.py", here / "checks_outside.py", here / "student_uid.py", here / "run_as.py",
+            here / "answers" / f"{sub.assignment}.py",
+            *(checks / f"{name}.py" for name in CHECK_MODULES), checks / f"{sub.assignment}.py"]
     _tree_digest([path for path in code if path.exists()], digest)
     return digest.hexdigest()
 

@@ -756,7 +756,7 @@ def _run_brightness_node(ws) -> Verdict:
     from std_msgs.msg import UInt8
 
     from course_lib import images, rosenv, workspace
-    from course_lib.checks.harness import RosProbe
+    from course_lib.checks.probe import RosProbe
 
     command = (f"ros2 run {BRIGHTNESS_PACKAGE} {BRIGHTNESS_EXECUTABLE} --ros-args -r /image:={CHECK_CAMERA_TOPIC}")
     with rosenv.reserve_domain_id() as reservation, RosProbe(reservation.domain_id) as probe:

@@ -13,7 +13,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import zoo  # noqa: E402
 from autograder import grading, reference, release, sandbox  # noqa: E402
-from course_lib.checks import harness, validate  # noqa: E402
+from course_lib.checks import registry, runner, validate  # noqa: E402
 
 ASSIGNMENTS = ["brightness", "pubsub", "catdog_warp"]
 REPO = Path(__file__).resolve().parent.parent
@@ -22,7 +22,7 @@ REPO = Path(__file__).resolve().parent.parent
 @pytest.mark.parametrize("assignment", ASSIGNMENTS)
 def test_every_check_has_points_timeout_and_description(assignment):
     """Each check declares positive points, a timeout and a one-line description."""
-    checks = harness.checks_of(assignment)
+    checks = registry.checks_of(assignment)
     assert checks
     for spec in checks.values():
         assert spec.points > 0 and spec.timeout > 0 and spec.description and "\n" not in spec.description
@@ -35,7 +35,7 @@ def test_test_cells_match_the_checks(assignment):
     nb = nbformat.read(REPO / "assignments" / "source" / assignment / f"{assignment}.ipynb", as_version=4)
     graded = {c.metadata["nbgrader"]["grade_id"]: c for c in nb.cells
               if c.metadata.get("nbgrader", {}).get("grade") and not c.metadata["nbgrader"].get("solution")}
-    checks = harness.checks_of(assignment)
+    checks = registry.checks_of(assignment)
     assert set(graded) == {f"check_{name}" for name in checks}
     for name, spec in checks.items():
         cell = graded[f"check_{name}"]
@@ -91,7 +91,7 @@ def test_brightness_typical_mistake_gets_its_score_and_reason(tmp_path, student)
     for check in ("values", "node"):
         if entry[check] is None:
             continue  # the entry is about the other check
-        result = harness.execute("brightness", check, 11, workdir=workdir, mode="graded")
+        result = runner.execute("brightness", check, 11, workdir=workdir, mode="graded")
         texts.extend(result.verdict_lines())
         first_failures.extend([line for line in result.verdict_lines() if line.startswith("  ✘ ")][:1])
         expected = entry[check]
@@ -123,7 +123,7 @@ CATDOG_MISTAKES = {
 def test_catdog_typical_mistake_loses_points_with_its_reason(tmp_path, mistake):
     """Typical warp mistakes score below full on easy scenes, and the verdict names the mistake."""
     edits, reason = CATDOG_MISTAKES[mistake]
-    result = harness.execute("catdog_warp", "easy", 3, workdir=_module_dir(tmp_path, "catdog_warp", edits),
+    result = runner.execute("catdog_warp", "easy", 3, workdir=_module_dir(tmp_path, "catdog_warp", edits),
                               mode="graded")
     assert result.points < result.max_points
     assert reason in "\n".join(result.verdict_lines())
@@ -136,7 +136,7 @@ def test_catdog_picture_reported_from_its_first_marker_loses_points_in_every_gra
              ("found[m][c] for m, c in", "found.get(m, found[markers[0]])[c] for m, c in")]
     workdir = _module_dir(tmp_path, "catdog_warp", edits)
     for seed in (3, 4):
-        result = harness.execute("catdog_warp", "missing_and_none", seed, workdir=workdir, mode="graded")
+        result = runner.execute("catdog_warp", "missing_and_none", seed, workdir=workdir, mode="graded")
         assert result.points < result.max_points, result.verdict_lines()
         failed = [item["message"] for item in result.items if not item["ok"]]
         assert len(failed) == 6 and all("although markers" in m for m in failed), result.verdict_lines()
@@ -144,7 +144,7 @@ def test_catdog_picture_reported_from_its_first_marker_loses_points_in_every_gra
 
 def test_catdog_reference_passes_easy_scenes(tmp_path):
     """The reference crop_pictures gets every point on easy scenes (the checks can be passed)."""
-    result = harness.execute("catdog_warp", "easy", 3, workdir=_module_dir(tmp_path, "catdog_warp"), mode="graded")
+    result = runner.execute("catdog_warp", "easy", 3, workdir=_module_dir(tmp_path, "catdog_warp"), mode="graded")
     assert result.points == result.max_points, result.verdict_lines()
 
 
@@ -165,7 +165,7 @@ PUBSUB_MISTAKES = {
 def test_pubsub_typical_mistake_loses_points_with_its_reason(tmp_path, mistake):
     """Typical publisher/subscriber mistakes score below full, and the verdict names the mistake."""
     edits, check, reason = PUBSUB_MISTAKES[mistake]
-    result = harness.execute("pubsub", check, 5, workdir=_module_dir(tmp_path, "pubsub", edits), mode="graded")
+    result = runner.execute("pubsub", check, 5, workdir=_module_dir(tmp_path, "pubsub", edits), mode="graded")
     assert result.points < result.max_points, result.verdict_lines()
     assert reason in "\n".join(result.verdict_lines())
 

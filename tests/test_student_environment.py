@@ -21,7 +21,7 @@ import pytest
 
 import autograder.release
 from autograder import reference
-from course_lib.checks import harness
+from course_lib.checks import registry, runner
 
 REPO = Path(__file__).resolve().parent.parent
 ASSIGNMENTS = ["brightness", "pubsub", "catdog_warp"]
@@ -168,8 +168,8 @@ def test_untouched_release_earns_nothing(release, tmp_path, assignment):
     nb = nbformat.read(release / assignment / f"{assignment}.ipynb", as_version=4)
     reference.write_module(nb, tmp_path)
     verdicts = []
-    for name in harness.checks_of(assignment):
-        result = harness.execute(assignment, name, 7, workdir=tmp_path, mode="graded")
+    for name in registry.checks_of(assignment):
+        result = runner.execute(assignment, name, 7, workdir=tmp_path, mode="graded")
         verdicts.append("\n".join(result.verdict_lines()))
         assert result.points == 0, verdicts[-1]
     assert "NotImplementedError" in "\n".join(verdicts)

@@ -24,8 +24,9 @@ import time
 
 import numpy as np
 
-from course_lib.checks import harness
-from course_lib.checks.harness import check
+from course_lib.checks import runner
+from course_lib.checks.context import Context, clip
+from course_lib.checks.registry import check
 
 ASSIGNMENT = "catdog_warp"
 SIZE = (320, 240)
@@ -35,12 +36,12 @@ COLOUR_TOLERANCE = 20.0
 
 def selfcheck(name: str):
     """Run check `name` with the self-check seed and print what is right and wrong."""
-    return harness.selfcheck(ASSIGNMENT, name)
+    return runner.selfcheck(ASSIGNMENT, name)
 
 
 def grade(name: str):
     """Run check `name` with a fresh seed (grading)."""
-    return harness.grade(ASSIGNMENT, name)
+    return runner.grade(ASSIGNMENT, name)
 
 
 def _seed(ctx) -> int:
@@ -116,7 +117,7 @@ def _run_scenes(ctx, cases, show_first: bool = True) -> None:
 
 
 @check(points=3, timeout=60)
-def easy(ctx: harness.Context) -> None:
+def easy(ctx: Context) -> None:
     """crop_pictures finds and warps both pictures on easy (mildly tilted) views."""
     from course_lib import scenes
 
@@ -124,7 +125,7 @@ def easy(ctx: harness.Context) -> None:
 
 
 @check(points=2, timeout=60)
-def hard(ctx: harness.Context) -> None:
+def hard(ctx: Context) -> None:
     """crop_pictures on hard views: steep, rotated, partly off-frame; only fully framed pictures."""
     from course_lib import scenes
 
@@ -139,7 +140,7 @@ def hard(ctx: harness.Context) -> None:
 
 
 @check(points=2, timeout=60)
-def missing_and_none(ctx: harness.Context) -> None:
+def missing_and_none(ctx: Context) -> None:
     """A picture with any one of its markers missing is left out; frames without markers give an empty dict."""
     from course_lib import marker_board, scenes
 
@@ -163,7 +164,7 @@ def missing_and_none(ctx: harness.Context) -> None:
 
 
 @check(points=1, timeout=60)
-def noisy(ctx: harness.Context) -> None:
+def noisy(ctx: Context) -> None:
     """crop_pictures copes with sensor noise, blur and JPEG artefacts, and with another crop size."""
     from course_lib import camera_views, scenes
 
@@ -185,7 +186,7 @@ def noisy(ctx: harness.Context) -> None:
 
 
 @check(points=3, timeout=90)
-def node(ctx: harness.Context) -> None:
+def node(ctx: Context) -> None:
     """MarkerReader: node marker_reader turns frames on image into crops on cropped_img/cat and cropped_img/dog."""
     from course_lib import images, scenes
     from rclpy.qos import QoSProfile, ReliabilityPolicy
@@ -203,7 +204,7 @@ def node(ctx: harness.Context) -> None:
             names = lambda: {n for n, _ in probe.node.get_node_names_and_namespaces()}  # noqa: E731
             probe.spin_until(lambda: "marker_reader" in names() or not proc.running(), 25.0)
             if not proc.running():
-                ctx.item(False, f"the node process ended ({proc.describe_exit()}):\n{harness.clip(proc.log_tail(6))}")
+                ctx.item(False, f"the node process ended ({proc.describe_exit()}):\n{clip(proc.log_tail(6))}")
                 return
             if not ctx.precondition("marker_reader" in names(), "node marker_reader runs" if "marker_reader" in names() else
                             f"no node named marker_reader (nodes: {sorted(names())})"):
@@ -225,7 +226,7 @@ def node(ctx: harness.Context) -> None:
             ctx.item(False, f"nothing arrived on {topic} within 8 s" +
                      (f" (it carries {seen}; the contract says sensor_msgs/msg/CompressedImage)" if seen and
                       seen != ["sensor_msgs/msg/CompressedImage"] else "") +
-                     "; the node's output:\n" + harness.clip(proc.log_tail(4)))
+                     "; the node's output:\n" + clip(proc.log_tail(4)))
             continue
         try:
             crop = images.compressed_to_image(got[name][-1], want="bgr8")

@@ -18,8 +18,9 @@ from __future__ import annotations
 import re
 import time
 
-from course_lib.checks import harness
-from course_lib.checks.harness import check
+from course_lib.checks import runner
+from course_lib.checks.context import Context, StudentError, clip
+from course_lib.checks.registry import check
 
 ASSIGNMENT = "pubsub"
 TOPIC = "/ros_tutorial_msg"
@@ -32,12 +33,12 @@ HEARD = re.compile(r"I heard: (-?\d+)")
 
 def selfcheck(name: str):
     """Run check `name` with the self-check seed and print what is right and wrong."""
-    return harness.selfcheck(ASSIGNMENT, name)
+    return runner.selfcheck(ASSIGNMENT, name)
 
 
 def grade(name: str):
     """Run check `name` with a fresh seed (grading)."""
-    return harness.grade(ASSIGNMENT, name)
+    return runner.grade(ASSIGNMENT, name)
 
 
 def _stamp_seconds(stamp) -> float:
@@ -50,7 +51,7 @@ def _queue_depth(ctx, class_name: str, kind: str) -> None:
     class is constructed in a student process of its own and asked."""
     try:
         found = [e for e in ctx.endpoints(class_name)[kind] if e["topic"] == TOPIC]
-    except harness.StudentError as error:
+    except StudentError as error:
         ctx.item(False, f"queue depth: {error}")
         return
     if not found:
@@ -67,7 +68,7 @@ def _wait_node(ctx, probe, proc, name: str) -> bool:
                              or not proc.running(), 25.0)
     if not proc.running():
         ctx.item(False, f"the process ended ({proc.describe_exit()}) before node {name} appeared:\n"
-                        f"{harness.clip(proc.log_tail(6))}")
+                        f"{clip(proc.log_tail(6))}")
         return False
     if not found:
         names = sorted(n for n, _ in probe.node.get_node_names_and_namespaces() if not n.startswith("autograder"))
@@ -77,7 +78,7 @@ def _wait_node(ctx, probe, proc, name: str) -> bool:
 
 
 @check(points=5, timeout=60)
-def publisher(ctx: harness.Context) -> None:
+def publisher(ctx: Context) -> None:
     """CounterPublisher: std_msgs/Header on ros_tutorial_msg at 10 Hz, counter +1 per message, increasing stamps."""
     from std_msgs.msg import Header
 
@@ -126,7 +127,7 @@ def publisher(ctx: harness.Context) -> None:
 
 
 @check(points=3, timeout=60)
-def subscriber(ctx: harness.Context) -> None:
+def subscriber(ctx: Context) -> None:
     """CounterSubscriber: node counter_subscriber hears every message on ros_tutorial_msg and logs 'I heard: N'."""
     from std_msgs.msg import Header
 
@@ -164,7 +165,7 @@ def _heard(log: str) -> list[int]:
 
 
 @check(points=2, timeout=60)
-def together(ctx: harness.Context) -> None:
+def together(ctx: Context) -> None:
     """The subscriber receives what the publisher publishes: consecutive counters, none lost."""
     pub = ctx.start_node(entry="main_publisher")
     sub = ctx.start_node(entry="main_subscriber")
