@@ -56,9 +56,9 @@ def code(text: str, kind: str | None = None, grade_id: str | None = None, points
 
 def test_cell(assignment: str, name: str):
     """The graded cell of one check: the self-check, then the hidden graded run with a fresh seed."""
-    from course_lib.checks import harness
+    from course_lib.checks import registry
 
-    spec = harness.get_check(assignment, name)
+    spec = registry.get_check(assignment, name)
     source = (f"# {spec.description} ({spec.points:g} points)\n"
               f"checks.selfcheck({name!r})\n"
               "### BEGIN HIDDEN TESTS\n"
@@ -255,7 +255,7 @@ A camera looks at the course's marker board: a cat picture framed by ArUco marke
 picture framed by markers 5-8 (dictionary `DICT_4X4_50`), in the order top-left, top-right,
 bottom-right, bottom-left. Each marker touches its picture with one corner: marker 1 with its
 corner 2, marker 2 with corner 3, marker 3 with corner 0, marker 4 with corner 1
-(`course_lib.scenes.PICTURES` and `CORNER_OF_MARKER`; OpenCV numbers a marker's corners
+(`course_lib.marker_board.PICTURES` and `CORNER_OF_MARKER`; OpenCV numbers a marker's corners
 clockwise from its top-left).
 
 **Contract** (this is exactly what is graded). Your workspace `ros2_ws/src` holds three packages:
@@ -278,10 +278,10 @@ clockwise from its top-left).
      code imports.
 
 The grader renders scenes (`course_lib.scenes.render_scene`) with poses and lighting you have not
-seen, and compares your crops with the true ones (`scenes.crop_similarity`, passing at
-`scenes.SAME_CROP_THRESHOLD`). Try your function on `scenes.render_scene(seed).frame`.
+seen, and compares your crops with the true ones (`marker_board.crop_similarity`, passing at
+`marker_board.SAME_CROP_THRESHOLD`). Try your function on `scenes.render_scene(seed).frame`.
 """, "intro"),
-        setup_cell("catdog_warp", "from course_lib import scenes\n"),
+        setup_cell("catdog_warp", "from course_lib import marker_board, scenes\n"),
         *package_cells(["catdog_interfaces", "webcam", "readmarker"],
                        "In plain ROS 2 the packages come from `ros2 pkg create` (`--build-type ament_cmake` for "
                        "`catdog_interfaces`, `ament_python` for the others)."),

@@ -57,16 +57,16 @@ def _run(parser, args) -> int:
         for path in record.record_answers(args.assignments or None):
             print(path)
         return 0
-    from autograder import grading
+    from autograder import grading, release
 
     if args.command == "roster":
         from autograder import roster
 
-        grading.prepare_course(args.course_dir)
+        release.prepare_course(args.course_dir)
         count, ignored = roster.import_roster(args.course_dir, args.roster)
         print(f"{count} students in the gradebook" + (f" (columns ignored: {', '.join(ignored)})" if ignored else ""))
     elif args.command == "release":
-        for path in grading.release(args.course_dir, args.assignment, duedate=args.duedate):
+        for path in release.release(args.course_dir, args.assignment, duedate=args.duedate):
             print(path)
     elif args.command == "collect":
         from autograder import collect

@@ -63,9 +63,9 @@ def collect(course_dir, assignment: str, archives: list) -> list[str]:
         FileNotFoundError: an archive does not exist.
         ValueError: the assignment was not released, or nothing in the download matched the file names.
     """
-    from autograder import gradebook, grading, intake
+    from autograder import gradebook, intake, nbgrader_cli, release
 
-    course = grading.prepare_course(course_dir)
+    course = release.prepare_course(course_dir)
     if not (course / "release" / assignment).is_dir():
         raise ValueError(f"{assignment} has not been released in {course}: run python -m autograder release {course} "
                          f"--assignment {assignment} first (zip_collect compares the names with the released notebooks)")
@@ -76,7 +76,7 @@ def collect(course_dir, assignment: str, archives: list) -> list[str]:
             raise FileNotFoundError(f"{archive} does not exist: give the path of the LMS download (a .zip or notebooks)")
         shutil.copy2(archive, inbox / archive.name)
     before = _files(course, assignment)
-    log = grading.run_nbgrader(["zip_collect", assignment, "--force"], course)
+    log = nbgrader_cli.run_nbgrader(["zip_collect", assignment, "--force"], course)
     after = _files(course, assignment)
     students = sorted({path.parent.parent.name for path, stamp in after.items() if before.get(path) != stamp})
     if not students:

@@ -15,7 +15,7 @@ from __future__ import annotations
 import html
 from pathlib import Path
 
-from autograder import grading
+from autograder import nbgrader_cli, store
 
 #: Added to nbgrader's feedback pages: output lines (the verdicts) wrap at the page's width.
 WRAP_STYLE = ("<style id='autograder-wrap'>div.output_area pre, div.output_subarea pre "
@@ -26,9 +26,9 @@ def write_feedback(course_dir, assignment: str | None = None, student: str | Non
     """Write the feedback of one assignment's, one student's or every graded submission; return the
     index pages written."""
     course = Path(course_dir).resolve()
-    chosen = grading.recorded_results(course, assignment, student)
+    chosen = store.recorded_results(course, assignment, student)
     for name in sorted({r.assignment for r in chosen if r.status != "failed"}):
-        grading.run_nbgrader(["generate_feedback", name, "--force", *(["--student", student] if student else [])],
+        nbgrader_cli.run_nbgrader(["generate_feedback", name, "--force", *(["--student", student] if student else [])],
                              course)
     for r in chosen:
         for page in (course / "feedback" / r.student / r.assignment).glob("*.html"):
@@ -36,7 +36,7 @@ def write_feedback(course_dir, assignment: str | None = None, student: str | Non
     pages = []
     for name in sorted({r.student for r in chosen}):
         # Every assignment of the student, not only this run's: the index lists them all.
-        pages.append(_write_index(course, name, grading.recorded_results(course, student=name)))
+        pages.append(_write_index(course, name, store.recorded_results(course, student=name)))
     return pages
 
 

@@ -19,7 +19,7 @@ import os
 
 from nbconvert.exporters import NotebookExporter
 
-from course_lib.checks.harness import OUTSIDE_ENV
+from course_lib.checks.runner import OUTSIDE_ENV
 
 
 def grade_command(course: str, assignment: str, student: str) -> str:

@@ -10,8 +10,8 @@ When the grader runs as root it sets AUTOGRADER_KERNEL_UID, and this launcher (s
   could write in that folder could replace the notebook by a symlink that root then writes
   through. Modules the notebook writes (%%writefile) land in WORK_SUBDIR, where the grader's
   checks find them,
-- sets RLIMIT_NPROC (the kernel enforces it for non-root users only: a fork bomb stops there),
-- drops to the uid with no supplementary groups, and execs ipykernel.
+- drops to the uid with no supplementary groups and sets RLIMIT_NPROC (the kernel enforces it for
+  non-root users only: a fork bomb stops there) with autograder.run_as.become, and execs ipykernel.
 
 So the student's code never runs as root: it cannot read the gradebook (0600, root) or other
 students' files, and its process count is bounded per worker (each worker has its own uid).
@@ -21,10 +21,11 @@ Without AUTOGRADER_KERNEL_UID (not root), it execs ipykernel unchanged.
 from __future__ import annotations
 
 import os
-import resource
 import shutil
 import sys
 import tempfile
+
+from autograder import run_as
 
 #: The kernel's working directory, inside the notebook's folder (see the module docstring).
 WORK_SUBDIR = ".autograder-cwd"
@@ -60,15 +61,11 @@ def main(argv=None) -> int:
         os.chmod(work, 0o700)
         os.chmod(os.getcwd(), 0o711)
         os.chdir(work)
-        nproc = int(os.environ.get("AUTOGRADER_KERNEL_NPROC", "512"))
-        resource.setrlimit(resource.RLIMIT_NPROC, (nproc, nproc))
         os.environ.update(HOME=os.path.join(private, "home"), TMPDIR=os.path.join(private, "tmp"),
                           IPYTHONDIR=os.path.join(private, "home", ".ipython"),
                           MPLCONFIGDIR=os.path.join(private, "home", ".matplotlib"))
         os.environ.pop("ROS_LOG_DIR", None)
-        os.setgroups([])
-        os.setgid(uid)
-        os.setuid(uid)
+        run_as.become(uid, uid, int(os.environ.get("AUTOGRADER_KERNEL_NPROC", "512")))
         connection = copy
     os.execv(sys.executable, [sys.executable, "-m", "ipykernel_launcher", "-f", connection])
     return 1  # not reached

@@ -321,6 +321,9 @@ REPORT_ENV = "AUTOGRADER_BUILD_REPORT"
 #: Memory (address space, MB) of the build: CMake, the compiler and rosidl's generators.
 BUILD_MEMORY_MB = 4096
 
+#: Processes and threads of the student's uid during the build (make -j and colcon's workers).
+BUILD_PROCESSES = 384
+
 #: The sandbox variables of the grader's environment that a build needs too (autograder.grading).
 _SANDBOX_VARIABLES = ("AUTOGRADER_EXPOSE", "AUTOGRADER_BLOCKED", "AUTOGRADER_STAGE")
 
@@ -332,13 +335,15 @@ def cache_of(course: Path) -> InterfaceCache:
 
 def build_for_checks(assignment: str, course: Path, work: Path, workdir: Path, uid: int | None, domain_id: int,
                      grader_env: dict, hide: list[Path], run_sandboxed) -> dict:
-    """Build the submission's workspace (``workdir/ros2_ws``) in the sandbox as the student's uid,
+    """Build the submission's workspace (``workdir/ros2_ws``) in the sandbox as the student's uid
+    (autograder.run_as),
     write the report into the grader's `work` folder, and return the variables that tell the
     checks where it is ({REPORT_ENV: path}).
 
     Args:
         run_sandboxed: autograder.grading's ``_run_sandboxed(command, hide, name, domain_id, env, cwd, limits)``.
     """
+    from autograder import run_as
     from course_lib import processes
 
     scratch = work / "colcon"
@@ -357,9 +362,9 @@ def build_for_checks(assignment: str, course: Path, work: Path, workdir: Path, u
 
     def run(command, cwd, env, wall_seconds):
         if uid is not None:
-            command = ["setpriv", f"--reuid={uid}", f"--regid={uid}", "--clear-groups", "--", *command]
+            command = run_as.command(uid, command, max_processes=BUILD_PROCESSES)
         limits = processes.Limits(wall_seconds=wall_seconds, memory_mb=BUILD_MEMORY_MB, file_size_mb=256,
-                                  max_processes=None if uid is None else 384, grace_seconds=3.0)
+                                  grace_seconds=3.0)
         # A name of its own: a process started under the name of a running one replaces it (stops
         # it), and another worker builds its own ros2_ws at the same time.
         proc = run_sandboxed(command, hide, f"colcon build {cwd}", domain_id,

@@ -14,7 +14,7 @@ import tempfile
 from pathlib import Path
 
 from autograder import packages, reference
-from course_lib.checks import answers, harness
+from course_lib.checks import answers, registry, runner
 
 ANSWER_KEYS = Path(__file__).resolve().parent / "answers"
 
@@ -44,8 +44,8 @@ def record_answers(assignments: list[str] | None = None) -> list[Path]:
                 if not report.ok:
                     raise RuntimeError(f"the {assignment} reference packages do not build: {report.reason}")
                 os.environ[packages.REPORT_ENV] = str(packages.report_path(workdir))
-                for name in harness.checks_of(assignment):
-                    result = harness.execute(assignment, name, harness.SELFCHECK_SEED, workdir=workdir, mode="record")
+                for name in registry.checks_of(assignment):
+                    result = runner.execute(assignment, name, runner.SELFCHECK_SEED, workdir=workdir, mode="record")
                     if result.points < result.max_points:
                         raise RuntimeError(f"the reference solution got {result.points:g} of {result.max_points:g} "
                                            f"points in {assignment}/{name}:\n" + "\n".join(result.verdict_lines()))

@@ -27,10 +27,10 @@ def _first_line(text: str) -> str:
 
 def write_report(course_dir, results=()) -> Path:
     """Write the report of every recorded result, this run's `results` in place of their records."""
-    from autograder import grading
+    from autograder import store
 
     course = Path(course_dir)
-    rows = {(r.student, r.assignment): r for r in grading.recorded_results(course)}
+    rows = {(r.student, r.assignment): r for r in store.recorded_results(course)}
     this_run = {(r.student, r.assignment): r for r in results}
     rows.update(this_run)
     path = course / FILE_NAME

@@ -28,7 +28,7 @@ READMARKER = Path(__file__).resolve().parents[1] / "assignments" / "reference_ws
 
 def score(crop_pictures, scenes_list) -> dict:
     """Counts of framed, recovered and false pictures, and seconds per frame, of one crop function."""
-    from course_lib import scenes
+    from course_lib import marker_board
 
     framed = recovered = false = 0
     seconds = 0.0
@@ -38,8 +38,8 @@ def score(crop_pictures, scenes_list) -> dict:
         seconds += time.perf_counter() - started
         expected = scene.expected_crops()
         visible = set(scene.visible_ids)
-        for name, markers in scenes.PICTURES.items():
-            good = name in crops and scenes.crop_similarity(crops[name], expected[name]) >= scenes.SAME_CROP_THRESHOLD
+        for name, markers in marker_board.PICTURES.items():
+            good = name in crops and marker_board.crop_similarity(crops[name], expected[name]) >= marker_board.SAME_CROP_THRESHOLD
             if name in scene.fully_framed:
                 framed += 1
                 recovered += good
@@ -57,7 +57,7 @@ def main(argv=None) -> int:
     sys.path.insert(0, str(READMARKER))
     from readmarker.crop import crop_pictures
 
-    from course_lib import scenes
+    from course_lib import dark_corners, scenes
 
     def before(frame):
         return crop_pictures(frame, second_look=False)
@@ -67,7 +67,7 @@ def main(argv=None) -> int:
     print("| board | scenes | fully framed pictures | recovered before | recovered after | false before / after "
           "| ms per frame before / after |")
     print("|---|---|---:|---:|---:|---:|---:|")
-    for board_name, make_board in (("dark corners (dark_corner_board)", scenes.dark_corner_board),
+    for board_name, make_board in (("dark corners (dark_corner_board)", dark_corners.dark_corner_board),
                                    ("drawn cat and dog", lambda seed: None)):
         for difficulty, count in (("easy", args.easy), ("hard", args.hard)):
             rendered = [scenes.render_scene(seed, difficulty=difficulty, board=make_board(seed))

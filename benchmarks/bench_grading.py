@@ -32,7 +32,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path[:0] = [str(ROOT), str(ROOT / "tests")]  # the grader runs from the repository
 
 import zoo  # noqa: E402 (tests/zoo builds submissions from the reference solutions)
-from autograder import grading, packages  # noqa: E402
+from autograder import grading, packages, release, sandbox  # noqa: E402
 
 ASSIGNMENTS = ["brightness", "pubsub", "catdog_warp"]
 
@@ -50,14 +50,14 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     with tempfile.TemporaryDirectory(prefix="bench-grading-") as scratch:
         course = Path(scratch) / "course"
-        grading.release(course, ASSIGNMENTS)
+        release.release(course, ASSIGNMENTS)
         for index in range(args.students):
             for assignment in ASSIGNMENTS:
                 zoo.submit(course, f"student{index}", assignment)
         shutil.rmtree(packages.cache_of(course).root, ignore_errors=True)
         runs = {"cold": timed_grade(course, 1), "cached": timed_grade(course, 1),
                 "workers": timed_grade(course, args.workers)}
-    print(f"{platform.node()}: {os.cpu_count()} CPUs, isolation {grading.isolation()}, "
+    print(f"{platform.node()}: {os.cpu_count()} CPUs, isolation {sandbox.isolation()}, "
           f"{args.students} reference submissions per assignment\n")
     print(f"{'assignment':<14}{'first, cold':>12}{'mean, cold':>12}{'mean, cached':>14}"
           f"{f'mean, {args.workers} workers':>18}{'scores':>12}")

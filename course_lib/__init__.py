@@ -15,8 +15,10 @@ from course_lib import rosenv as _rosenv
 
 _rosenv.prepare_current_process()
 
-_MODULES = ("ament", "camera", "doctor", "graph", "images", "interfaces", "launch", "live", "parameters",
-            "processes", "rosenv", "scenes", "selfcheck", "session", "vision", "wheelfix", "workspace")
+_MODULES = ("ament", "boards", "camera", "camera_views", "colcon", "dark_corners", "discovery", "doctor", "graph",
+            "images", "interfaces", "launch", "live", "marker_board", "message_yaml", "parameters", "pictures",
+            "pkg_create", "processes", "rates", "rosenv", "rqt_graph", "scenes", "selfcheck", "session", "table",
+            "vision", "waiting", "wheelfix", "workspace")
 
 
 def __getattr__(name):

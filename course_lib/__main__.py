@@ -26,8 +26,8 @@ def main(argv: list[str] | None = None) -> int:
         from course_lib import doctor
         return doctor.main(rest)
     if command == "build":
-        from course_lib import workspace
-        return workspace.main_build(rest)
+        from course_lib import colcon
+        return colcon.main_build(rest)
     if command == "env":
         from course_lib import rosenv
         return rosenv.main_env(rest)

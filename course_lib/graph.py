@@ -12,117 +12,29 @@ command, :mod:`course_lib.ros2cli`, prints them):
 ``ros2 topic hz /t``            ``graph.topic_hz("/t")``
 ``ros2 topic info -v /t``       ``print(graph.format_topic_info(graph.topic_info("/t")))``
 ``ros2 node info /talker``      ``print(graph.format_node_info(graph.node_info("/talker")))``
-``rqt_graph``                   ``graph.draw_graph()``
+``rqt_graph``                   ``rqt_graph.draw_graph()``
 ==============================  ==========================================
 
 Another process's nodes become visible only after discovery (up to a few seconds), so the first
-query after the tool node starts waits, briefly and boundedly, for the graph to settle; pass
-``wait_for=[...]`` to wait for particular names.
+query after the tool node starts waits, briefly and boundedly, for the graph to settle
+(:mod:`course_lib.discovery`); pass ``wait_for=[...]`` to wait for particular names. Messages are
+printed and filled by :mod:`course_lib.message_yaml`, rates computed by :mod:`course_lib.rates`.
 """
 
 from __future__ import annotations
 
-import array
 import contextlib
 import dataclasses
-import functools
-import importlib
 import math
 import time
 
-import numpy as np
-
 from course_lib import session
-
-#: Topics every rclpy node has; draw_graph() leaves them out unless asked.
-DEFAULT_HIDDEN_TOPICS = ("/rosout", "/parameter_events")
-
-#: Seconds a newly started tool node waits for discovery before its first answer. Fast DDS
-#: took about 2 s to show another process's node on the course machines; lower it for a
-#: quicker first answer when only this kernel's nodes matter.
-SETTLE_SECONDS = 2.5
-# After SETTLE_SECONDS the graph must also have stayed the same for _SETTLE_QUIET s (things
-# found late bring more with them), but the wait never lasts longer than _SETTLE_MAX s.
-_SETTLE_POLL = 0.05
-_SETTLE_QUIET = 0.3
-_SETTLE_MAX = 5.0
-_settled_node = None
+from course_lib.discovery import _graph_node
+from course_lib.message_yaml import message_class
+from course_lib.rates import RateStatistics, rate_statistics
 
 
-# --- the tool node and the settling wait -------------------------------------------------
-
-def _graph_node():
-    """The session's tool node, after a bounded wait for discovery on its first use."""
-    node = session.tool_node()
-    if _settled_node is not node:
-        wait_for_discovery()
-    return node
-
-
-def wait_for_discovery(minimum: float | None = None, quiet: float = _SETTLE_QUIET,
-                       complete_within: float = 0.0) -> None:
-    """Wait until discovery has shown the graph to the tool node; later queries do not wait.
-
-    The functions of this module call it on the tool node's first use, with the defaults;
-    the ``ros2`` command calls it first with its own (--spin-time, or no wait at all for a
-    verb that waits for the name it is given).
-
-    Args:
-        minimum: seconds after the tool node's creation to wait at least (default
-            SETTLE_SECONDS).
-        quiet: then wait until the graph has not changed for this long.
-        complete_within: also wait, up to this many seconds after the tool node's creation,
-            while the graph shows fewer nodes of other processes than there are other DDS
-            participants on this machine in this domain (each ROS process has one, holding its
-            nodes). On a busy machine some of them take seconds to be discovered.
-
-    The wait never lasts longer than 5 s after the tool node's creation.
-    """
-    global _settled_node
-    node = session.tool_node()
-    minimum = SETTLE_SECONDS if minimum is None else minimum
-    others_here = _participants_here(node.context.get_domain_id()) - 1 if complete_within else 0
-    ours = 1 + len(session.nodes())  # the nodes of this process share its participant
-    last = _snapshot(node)
-    quiet_since = time.monotonic()
-    while True:
-        now = time.monotonic()
-        age = now - node.created_at
-        missing = age < complete_within and len(last[0]) - ours < others_here
-        if age >= _SETTLE_MAX or (age >= minimum and now - quiet_since >= quiet and not missing):
-            break
-        time.sleep(_SETTLE_POLL)
-        current = _snapshot(node)
-        if current != last:
-            last, quiet_since = current, time.monotonic()
-    _settled_node = node
-
-
-def _participants_here(domain_id: int) -> int:
-    """How many DDS participants run on this machine in a domain.
-
-    Each binds the UDP port 7400 + 250 * domain + 10 + 2 * (its participant id) for discovery
-    traffic (the RTPS standard port mapping), so /proc/net/udp tells. 0 when it cannot.
-    """
-    first = 7410 + 250 * domain_id
-    ports = set()
-    for table in ("/proc/net/udp", "/proc/net/udp6"):
-        try:
-            with open(table) as handle:
-                rows = handle.read().splitlines()[1:]
-        except OSError:
-            continue
-        for row in rows:
-            port = int(row.split()[1].rsplit(":", 1)[1], 16)
-            if first <= port < first + 240 and (port - first) % 2 == 0:
-                ports.add(port)
-    return len(ports)
-
-
-def _snapshot(node):
-    return (sorted(node.get_fully_qualified_node_names()),
-            sorted((name, tuple(types)) for name, types in node.get_topic_names_and_types()))
-
+# --- helpers ------------------------------------------------------------------------------
 
 def _wait_until(condition, timeout: float) -> bool:
     return session.wait_for(condition, timeout=timeout, poll=0.05)
@@ -201,41 +113,6 @@ def topic_list(types: bool = False, include_hidden: bool = False, wait_for=(),
     pairs = sorted((name, list(kinds)) for name, kinds in current()
                    if include_hidden or not _is_hidden(name))
     return pairs if types else [name for name, _ in pairs]
-
-
-# --- message types ----------------------------------------------------------------------
-
-def message_class(type_name: str):
-    """The Python class of a message type name.
-
-    Args:
-        type_name: "std_msgs/msg/String" (the form the graph reports) or "std_msgs/String".
-
-    Returns:
-        The message class, e.g. ``std_msgs.msg.String``.
-
-    Raises:
-        ValueError: the name is malformed, or its package is not installed (the message says
-            which pip package provides it).
-    """
-    parts = type_name.split("/")
-    if len(parts) == 2:
-        parts = [parts[0], "msg", parts[1]]
-    if len(parts) != 3 or not all(parts):
-        raise ValueError(f"Message type {type_name!r} is not of the form 'package/msg/Type', "
-                         "e.g. 'std_msgs/msg/String'")
-    package, kind, name = parts
-    try:
-        module = importlib.import_module(f"{package}.{kind}")
-    except ModuleNotFoundError:
-        raise ValueError(f"Cannot import the message type {type_name}: its package {package} is "
-                         f"not installed; install ros-jazzy-{package.replace('_', '-')} "
-                         "(pip) or build it in your colcon workspace and source it") from None
-    try:
-        return getattr(module, name)
-    except AttributeError:
-        raise ValueError(f"Package {package} has no {kind} type {name!r}; check the spelling "
-                         f"(`ros2 topic list -t` or graph.topic_list(types=True) shows the types in use)") from None
 
 
 def _topic_class(node, topic: str, msg_type, timeout: float | None):
@@ -329,7 +206,7 @@ def topic_echo(topic: str, count: int = 1, timeout: float = 5.0, msg_type=None) 
         msg_type: the message class or type name; None takes it from the graph.
 
     Returns:
-        The ``count`` first messages received. ``print(graph.format_messages(msgs))`` shows
+        The ``count`` first messages received. ``print(message_yaml.format_messages(msgs))`` shows
         them as ``ros2 topic echo`` would.
 
     Raises:
@@ -359,208 +236,7 @@ def topic_echo(topic: str, count: int = 1, timeout: float = 5.0, msg_type=None) 
     return received[:count]
 
 
-def message_to_dict(msg, truncate_length: int | None = 128, no_arr: bool = False,
-                    no_str: bool = False):
-    """A message as plain dicts, lists and numbers (for printing, JSON or comparisons).
-
-    Converts the way ``ros2 topic echo`` does before it prints YAML.
-
-    Args:
-        msg: a ROS message (nested messages and arrays are converted too).
-        truncate_length: arrays and strings longer than this keep their first elements and
-            end with "..." (ros2 topic echo's default is 128); None keeps everything.
-        no_arr: show each array field as its type and length only (echo's ``--no-arr``).
-        no_str: show each string field as its length only (echo's ``--no-str``).
-
-    Returns:
-        A dict in field order, or the plain value when ``msg`` is not a message.
-    """
-    if hasattr(msg, "get_fields_and_field_types"):
-        return {field: _field_to_plain(getattr(msg, field), slot_type, truncate_length, no_arr, no_str)
-                for field, slot_type in zip(msg.get_fields_and_field_types(), msg.SLOT_TYPES)}
-    if isinstance(msg, (bytes, bytearray)):
-        text = "".join(chr(byte) for byte in msg[:truncate_length])
-        return text + "..." if truncate_length is not None and len(msg) > truncate_length else text
-    if isinstance(msg, str):
-        if no_str:
-            return f"<string length: <{len(msg)}>>"
-        cut = truncate_length is not None and len(msg) > truncate_length
-        return msg[:truncate_length] + "..." if cut else msg
-    if isinstance(msg, (np.ndarray, array.array)):
-        msg = msg.tolist()
-    if isinstance(msg, (list, tuple)):
-        items = list(msg)
-        cut = truncate_length is not None and len(items) > truncate_length
-        items = [message_to_dict(item, truncate_length, no_arr, no_str)
-                 for item in (items[:truncate_length] if cut else items)]
-        return items + ["..."] if cut else items
-    if isinstance(msg, np.generic):
-        return msg.item()
-    return msg
-
-
-def _field_to_plain(value, slot_type, truncate_length, no_arr, no_str):
-    from rosidl_parser import definition
-
-    if no_arr and isinstance(slot_type, definition.AbstractNestedType):
-        element = slot_type.value_type
-        element = ("string" if isinstance(element, definition.AbstractString) else
-                   "/".join(element.namespaced_name()) if isinstance(element, definition.NamespacedType)
-                   else getattr(element, "typename", "unknown"))
-        if isinstance(slot_type, definition.Array):
-            return f"<array type: {element}[{slot_type.size}]>"
-        if isinstance(slot_type, definition.BoundedSequence):
-            return f"<sequence type: {element}[{slot_type.maximum_size}], length: {len(value)}>"
-        return f"<sequence type: {element}, length: {len(value)}>"
-    return message_to_dict(value, truncate_length, no_arr, no_str)
-
-
-def format_message(msg, truncate_length: int | None = 128, no_arr: bool = False,
-                   no_str: bool = False) -> str:
-    """One message as YAML, the way ``ros2 topic echo`` prints it (without the "---")."""
-    import yaml
-
-    return yaml.safe_dump(message_to_dict(msg, truncate_length, no_arr, no_str), sort_keys=False,
-                          default_flow_style=False, allow_unicode=True, width=1 << 30)
-
-
-def format_messages(messages, truncate_length: int | None = 128) -> str:
-    """Messages as ``ros2 topic echo`` prints them: YAML, each followed by a "---" line."""
-    return "".join(format_message(msg, truncate_length) + "---\n" for msg in messages)
-
-
-def fill_message(msg, values) -> list:
-    """Set a message's fields from plain values, the way ``ros2 topic pub`` reads its YAML.
-
-    Args:
-        msg: the message to fill; it is changed in place.
-        values: ``{field: value}``; a nested message takes a dict, an array a list. As in
-            ``ros2 topic pub``, ``header: auto`` (a std_msgs/Header) and ``stamp: now`` (a
-            builtin_interfaces/Time) mean "the time of each publish".
-
-    Returns:
-        One setter per field marked auto/now: call each with a builtin_interfaces/Time
-        (``node.get_clock().now().to_msg()``) before publishing.
-
-    Raises:
-        ValueError: a field the message does not have, or a value that does not fit its field
-            (the message names the field and its type).
-    """
-    setters: list = []
-    _fill(msg, values, setters, "")
-    return setters
-
-
-def _type_name(msg) -> str:
-    module = type(msg).__module__.split(".")
-    return f"{module[0]}/{module[1]}/{type(msg).__name__}"
-
-
-def _fill(msg, values, setters: list, path: str) -> None:
-    from rosidl_parser import definition
-
-    fields = msg.get_fields_and_field_types()
-    if not isinstance(values, dict):
-        raise ValueError(f"{path.rstrip('.') or 'The message'} is a {_type_name(msg)} and needs a "
-                         f"dictionary of its fields ({', '.join(fields)}), not {values!r}")
-    slots = dict(zip(fields, msg.SLOT_TYPES))
-    for field, value in values.items():
-        where = path + str(field)
-        if field not in fields:
-            raise ValueError(f"{_type_name(msg)} has no field {field!r}"
-                             f"{' (in ' + path.rstrip('.') + ')' if path else ''}; its fields are: "
-                             f"{', '.join(fields)}")
-        current = getattr(msg, field)
-        slot = slots[field]
-        if hasattr(current, "get_fields_and_field_types"):
-            kind = _type_name(current)
-            if value == "auto" and kind == "std_msgs/msg/Header":
-                setters.append(functools.partial(setattr, current, "stamp"))
-            elif value == "now" and kind == "builtin_interfaces/msg/Time":
-                setters.append(functools.partial(setattr, msg, field))
-            else:
-                _fill(current, value, setters, where + ".")
-            continue
-        if isinstance(slot, definition.AbstractNestedType) and \
-                isinstance(slot.value_type, definition.NamespacedType):
-            element = getattr(importlib.import_module(".".join(slot.value_type.namespaces)),
-                              slot.value_type.name)
-            if not isinstance(value, list):
-                raise ValueError(f"{where} ({fields[field]}) needs a list, not {value!r}")
-            items = []
-            for index, item in enumerate(value):
-                items.append(element())
-                _fill(items[-1], item, setters, f"{where}[{index}].")
-            value = items
-        elif isinstance(current, array.array):
-            value = _converted(lambda: array.array(current.typecode, value), where, fields[field], value)
-        elif isinstance(current, np.ndarray):
-            value = _converted(lambda: np.array(value, dtype=current.dtype), where, fields[field], value)
-        elif not isinstance(current, list) and type(value) is not type(current):
-            value = _converted(lambda: type(current)(value), where, fields[field], value)
-        _converted(lambda: setattr(msg, field, value), where, fields[field], value)
-
-
-def _converted(convert, where: str, field_type: str, value):
-    try:
-        return convert()
-    except (AssertionError, TypeError, ValueError, OverflowError) as error:
-        raise ValueError(f"{where} is a {field_type} and cannot take {value!r}"
-                         f"{': ' + str(error) if str(error) else ''}") from None
-
-
 # --- ros2 topic hz ----------------------------------------------------------------------
-
-@dataclasses.dataclass(frozen=True)
-class RateStatistics:
-    """The publishing rate of a topic, as ``ros2 topic hz`` reports it.
-
-    Attributes:
-        rate: average rate in Hz (1 / mean period).
-        min_period, max_period: shortest and longest time between two messages, seconds.
-        std_dev: standard deviation of the periods, seconds.
-        samples: number of periods measured (what ros2 prints as "window").
-    """
-
-    rate: float
-    min_period: float
-    max_period: float
-    std_dev: float
-    samples: int
-
-    def __str__(self) -> str:
-        return (f"average rate: {self.rate:.3f}\n\tmin: {self.min_period:.3f}s "
-                f"max: {self.max_period:.3f}s std dev: {self.std_dev:.5f}s "
-                f"window: {self.samples}")
-
-
-def rate_statistics(times, window: int | None = None) -> RateStatistics:
-    """Rate statistics of arrival times.
-
-    Args:
-        times: arrival times in seconds, in order of arrival (1-D array-like).
-        window: use only the last ``window`` periods; None uses all.
-
-    Returns:
-        The statistics of the periods between consecutive arrivals.
-
-    Raises:
-        ValueError: fewer than two times, or times that go backwards.
-    """
-    times = np.asarray(times, dtype=float)
-    if times.ndim != 1 or times.size < 2:
-        raise ValueError(f"Need at least two arrival times to measure a rate, got {times.size}: "
-                         "measure for longer, or check that the topic is published")
-    periods = np.diff(times)
-    if np.any(periods < 0):
-        raise ValueError("Arrival times must not decrease: pass them in order of arrival")
-    if window is not None:
-        periods = periods[-window:]
-    mean = float(periods.mean())
-    return RateStatistics(rate=1.0 / mean if mean > 0 else math.inf,
-                          min_period=float(periods.min()), max_period=float(periods.max()),
-                          std_dev=float(periods.std()), samples=int(periods.size))
-
 
 def topic_hz(topic: str, window: int = 10000, duration: float = 2.0, timeout: float = 5.0,
              msg_type=None) -> RateStatistics:
@@ -843,144 +519,3 @@ def format_node_info(info: NodeInfo) -> str:
         lines.append(f"  {title}:")
         lines += [f"    {topic}: {', '.join(kinds)}" for topic, kinds in pairs] or [""]
     return "\n".join(lines) + "\n"
-
-
-# --- rqt_graph --------------------------------------------------------------------------
-
-def graph_edges(all: bool = False,  # noqa: A002
-                hide_topics=DEFAULT_HIDDEN_TOPICS) -> list[tuple[str, str, str]]:
-    """Who publishes and who subscribes to what, as (node, topic, "publishes"/"subscribes").
-
-    Args:
-        all: keep hidden nodes and topics (like the session's tool node).
-        hide_topics: topics to leave out.
-
-    Returns:
-        Sorted, de-duplicated triples with fully-qualified names.
-    """
-    node = _graph_node()
-    edges = set()
-    for topic, _ in node.get_topic_names_and_types():
-        if topic in hide_topics or (not all and _is_hidden(topic)):
-            continue
-        for kind, infos in (("publishes", node.get_publishers_info_by_topic(topic)),
-                            ("subscribes", node.get_subscriptions_info_by_topic(topic))):
-            for info in infos:
-                if all or not info.node_name.startswith("_"):
-                    edges.add((_full_name(info.node_namespace, info.node_name), topic, kind))
-    return sorted(edges)
-
-
-def layered_layout(edges) -> dict:
-    """Columns and rows for a left-to-right drawing of a directed graph.
-
-    Each vertex goes one column right of its furthest predecessor (cycles are broken where a
-    depth-first walk in name order closes them); within a column, vertices sit near the mean
-    row of their predecessors, ties broken by name. The layout depends only on ``edges``.
-
-    Args:
-        edges: (source, target) pairs of sortable vertices (names, or tuples of names).
-
-    Returns:
-        ``{vertex: (column, row)}``.
-    """
-    vertices = sorted({v for edge in edges for v in edge})
-    successors = {v: sorted({t for s, t in edges if s == v}) for v in vertices}
-    # Depth-first walk in name order; edges back to a vertex still on the stack close a cycle.
-    on_stack, done, finish_order, forward = set(), set(), [], []
-    for root in vertices:
-        if root in done:
-            continue
-        stack = [(root, iter(successors[root]))]
-        on_stack.add(root)
-        while stack:
-            vertex, children = stack[-1]
-            child = next(children, None)
-            if child is None:
-                stack.pop()
-                on_stack.discard(vertex)
-                done.add(vertex)
-                finish_order.append(vertex)
-            elif child in on_stack:
-                continue  # back edge: ignored for layering
-            else:
-                forward.append((vertex, child))
-                if child not in done:
-                    on_stack.add(child)
-                    stack.append((child, iter(successors[child])))
-    predecessors = {v: sorted({s for s, t in forward if t == v}) for v in vertices}
-    column = {}
-    for vertex in reversed(finish_order):  # a topological order of the acyclic part
-        column[vertex] = max((column[p] + 1 for p in predecessors[vertex]), default=0)
-    layout = {}
-    for col in range(max(column.values(), default=-1) + 1):
-        members = [v for v in vertices if column[v] == col]
-
-        def centre(v):
-            rows = [layout[p][1] for p in predecessors[v] if p in layout]
-            return (sum(rows) / len(rows) if rows else math.inf, v)
-
-        for row, vertex in enumerate(sorted(members, key=centre)):
-            layout[vertex] = (col, row)
-    return layout
-
-
-def draw_graph(ax=None, all: bool = False,  # noqa: A002
-               hide_topics=DEFAULT_HIDDEN_TOPICS):
-    """Draw nodes (ellipses) and topics (boxes) with publisher -> topic -> subscriber arrows.
-
-    Like rqt_graph's "Nodes/Topics" view, drawn with matplotlib in a fixed layered layout.
-
-    Args:
-        ax: a matplotlib Axes to draw into; None makes a new Figure (not through pyplot, so
-            a notebook shows it once, as the cell's value).
-        all: also draw hidden nodes and topics (the session's tool node).
-        hide_topics: topics to leave out; by default /rosout and /parameter_events.
-
-    Returns:
-        The matplotlib Figure.
-    """
-    from matplotlib.figure import Figure
-
-    # Vertices are ("node", name) or ("topic", name): a node and a topic may share a name.
-    edges = []
-    for node, topic, kind in graph_edges(all=all, hide_topics=hide_topics):
-        pair = [("node", node), ("topic", topic)]
-        edges.append(tuple(pair if kind == "publishes" else pair[::-1]))
-    layout = layered_layout(edges)
-    # Nodes without any shown connection still belong in the picture, in a column of their own.
-    lonely = sorted({("node", name) for name in node_list(all=all)} - set(layout))
-    spare_column = max((c for c, _ in layout.values()), default=-1) + 1
-    for row, vertex in enumerate(lonely):
-        layout[vertex] = (spare_column, row)
-    columns = max((c for c, _ in layout.values()), default=0) + 1
-    height = {col: sum(1 for c, _ in layout.values() if c == col) for col in range(columns)}
-    rows = max(height.values(), default=1)
-    if ax is None:
-        figure = Figure(figsize=(max(4.0, 2.4 * columns), max(2.0, 0.9 * rows + 0.8)))
-        ax = figure.add_subplot()
-    figure = ax.figure
-    ax.set_axis_off()
-    ax.set_xlim(-0.6, columns - 0.4)
-    ax.set_ylim(-0.6 - (rows - 1) / 2, 0.6 + (rows - 1) / 2)
-    if not layout:
-        ax.text(0, 0, "no nodes found", ha="center", va="center", color="gray")
-        return figure
-    labels = {}
-    for vertex, (col, row) in sorted(layout.items()):
-        kind, name = vertex
-        style = (dict(boxstyle="square,pad=0.4", facecolor="#fff2cc", edgecolor="#b58900")
-                 if kind == "topic" else
-                 dict(boxstyle="ellipse,pad=0.3", facecolor="#dbe9f6", edgecolor="#1f4e79"))
-        labels[vertex] = ax.text(col, (height[col] - 1) / 2 - row, name, ha="center",
-                                 va="center", fontsize=9, bbox=style, zorder=2)
-    for source, target in edges:
-        ax.annotate("", xy=labels[target].get_position(), xytext=labels[source].get_position(),
-                    arrowprops=dict(arrowstyle="-|>", color="#444444", shrinkA=0, shrinkB=0,
-                                    mutation_scale=12,
-                                    patchA=labels[source].get_bbox_patch(),
-                                    patchB=labels[target].get_bbox_patch()),
-                    # Above the labels: their boxes, which clip the arrow, are sized as they
-                    # are drawn, so they must be drawn first.
-                    zorder=3)
-    return figure

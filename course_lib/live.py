@@ -29,7 +29,7 @@ import cv2
 import ipywidgets
 import numpy as np
 
-from course_lib import graph, images, rosenv, session
+from course_lib import discovery, graph, images, message_yaml, rosenv, session, waiting
 
 #: Redraws, and seconds after its creation, after which a view stops by itself under test or grading.
 LIMITED_UPDATES = 20
@@ -137,7 +137,7 @@ class ImageView(_View):
                  seconds: float | None = None, updates: int | None = None, timeout: float = 5.0):
         from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 
-        tool = graph._graph_node()
+        tool = discovery._graph_node()
         self.topic = tool.resolve_topic_name(topic)
         self.msg_type = _image_class(tool, self.topic, msg_type, timeout)
         self.max_width = int(max_width)
@@ -218,16 +218,17 @@ def image_view(topic: str = "/image", **options) -> ImageView:
 
 def _image_class(tool, topic: str, msg_type, timeout: float):
     if msg_type is None:
-        deadline = time.monotonic() + timeout
-        while True:
-            kinds = [k for name, ks in tool.get_topic_names_and_types() if name == topic for k in ks]
-            if kinds or time.monotonic() >= deadline:
-                break
-            time.sleep(0.05)
+        kinds = []
+
+        def known():
+            kinds[:] = [k for name, ks in tool.get_topic_names_and_types() if name == topic for k in ks]
+            return bool(kinds)
+
+        waiting.spin_until(known, timeout)
         msg_type = kinds[0] if len(kinds) == 1 else IMAGE_TYPES[0]
         if len(kinds) > 1:
             raise ValueError(f"Topic {topic} carries several types {kinds}: pass msg_type= to choose one")
-    cls = graph.message_class(msg_type) if isinstance(msg_type, str) else msg_type
+    cls = message_yaml.message_class(msg_type) if isinstance(msg_type, str) else msg_type
     name = f"{cls.__module__.split('.')[0]}/msg/{cls.__name__}"
     if name not in IMAGE_TYPES:
         raise ValueError(f"Topic {topic} carries {name}, not an image: image_view shows "
@@ -289,7 +290,7 @@ class PlotView(_View):
                  timeout: float = 5.0):
         if not paths:
             raise ValueError("live.plot() needs at least one topic, e.g. live.plot('/brightness')")
-        tool = graph._graph_node()
+        tool = discovery._graph_node()
         fields = [resolve_field_path(tool, path, msg_type, timeout) for path in paths]
         if len({series for series, _, _, _ in fields}) != len(fields):
             raise ValueError(f"live.plot() got the same path twice in {paths}: give each once")
@@ -407,7 +408,7 @@ def resolve_field_path(tool, path: str, msg_type=None, timeout: float = 5.0):
     """
     name = path.rstrip("/") if path.startswith("/") else "/" + path.rstrip("/")
     if msg_type is not None:
-        cls = graph.message_class(msg_type) if isinstance(msg_type, str) else msg_type
+        cls = message_yaml.message_class(msg_type) if isinstance(msg_type, str) else msg_type
         problem = None
         for topic in _topic_prefixes(name):  # the longest topic whose rest is a field of msg_type
             try:
@@ -415,21 +416,23 @@ def resolve_field_path(tool, path: str, msg_type=None, timeout: float = 5.0):
             except ValueError as error:
                 problem = error
         raise problem
-    deadline = time.monotonic() + timeout
-    while True:
-        topics = dict(tool.get_topic_names_and_types())
-        topic = next((t for t in _topic_prefixes(name) if t in topics), None)
-        if topic is not None:
-            break
-        if time.monotonic() >= deadline:
-            raise TimeoutError(f"No topic in the ROS graph begins {name}: is its publisher running, on the "
-                               f"same ROS_DOMAIN_ID? graph.topic_list() shows the topics there are, or pass "
-                               f"msg_type= to plot before it appears")
-        time.sleep(0.05)
+    topics, found = {}, []
+
+    def known():
+        topics.clear()
+        topics.update(tool.get_topic_names_and_types())
+        found[:] = [t for t in _topic_prefixes(name) if t in topics][:1]
+        return bool(found)
+
+    if not waiting.spin_until(known, timeout):
+        raise TimeoutError(f"No topic in the ROS graph begins {name}: is its publisher running, on the "
+                           f"same ROS_DOMAIN_ID? graph.topic_list() shows the topics there are, or pass "
+                           f"msg_type= to plot before it appears")
+    topic = found[0]
     kinds = topics[topic]
     if len(kinds) != 1:
         raise ValueError(f"Topic {topic} carries several types {kinds}: pass msg_type= to choose one")
-    cls = graph.message_class(kinds[0])
+    cls = message_yaml.message_class(kinds[0])
     return name, topic, cls, _field_reader(cls, name[len(topic):], topic)
 
 
@@ -479,7 +482,7 @@ def _field_reader(cls, rest: str, topic: str):
         if element in NUMBER_TYPES:
             current = None
         elif "/" in element:
-            current = graph.message_class(element)
+            current = message_yaml.message_class(element)
         else:
             raise ValueError(f"{where} is a {element}, not a number")
     if current is not None:
@@ -511,7 +514,7 @@ def _field_examples(cls, topic: str, limit: int = 3) -> str:
             if kind in NUMBER_TYPES:
                 found.append(f"{prefix}/{field}")
             elif "/" in kind and not _element_type(kind)[1]:
-                walk(graph.message_class(kind), f"{prefix}/{field}", depth + 1)
+                walk(message_yaml.message_class(kind), f"{prefix}/{field}", depth + 1)
     walk(cls, topic, 0)
     return ", ".join(found) or "(it has no numeric fields)"
 

@@ -10,28 +10,16 @@ module, and the autograder runs student code through it with resource limits::
         ...                      # talk to it
     print(talker.log)            # everything it printed, rclpy log lines included
 
-How children are kept from outliving their caller: each NodeProcess starts a small supervisor
-(this same file, run as a script by a fresh ``python -I -S``, so neither site-packages, the
-ROS bootstrapper nor course_lib's other imports cost start-up time). The supervisor is the
-node's direct parent, and
-
-- it puts the node in a process group of its own, so a stop reaches the node's own children;
-- it is a child subreaper, so descendants that leave the group (``setsid``, daemons) are
-  re-parented to it and killed too;
-- it reads a pipe whose only writer is the caller: when the caller dies in any way (atexit,
-  SIGTERM, even SIGKILL) the pipe closes, and the supervisor stops the group;
-- the node gets PR_SET_PDEATHSIG=SIGKILL, so it dies with the supervisor;
-- resource limits (setrlimit) and the switch to an unprivileged user happen in the
-  supervisor's fork, which has no threads, never in the caller (a kernel or a process that
-  runs DDS threads, where ``preexec_fn`` is unsafe).
-
-The supervisor also relays the node's output to a log that keeps its head and its tail, so a
-node that prints a gigabyte neither blocks nor fills memory or disk.
+How children are kept from outliving their caller, and how their output is bounded: see
+course_lib.supervisor, the small process each NodeProcess starts as the node's direct parent.
 """
 
 from __future__ import annotations
 
-# The supervisor part of this file (first) needs only these; see the imports after it.
+import atexit
+import dataclasses
+import errno
+import itertools
 import json
 import os
 import select
@@ -39,346 +27,22 @@ import shutil
 import signal
 import subprocess
 import sys
+import tempfile
+import threading
 import time
+from pathlib import Path
+from typing import Callable
 
-#: Bytes of a node's output kept from its start and from its end; the middle is dropped.
-LOG_HEAD_BYTES = 64 * 1024
-LOG_TAIL_BYTES = 256 * 1024
-
-#: Seconds a node gets to shut down after SIGINT when its caller has gone away.
-PARENT_GONE_GRACE = 1.0
-
-#: Largest piece of output in one echo frame: a frame (3 header bytes + piece) stays within
-#: PIPE_BUF, so a non-blocking write of it is all or nothing and frames never interleave.
-_ECHO_PIECE = 4000
-
-_PR_SET_PDEATHSIG = 1
-_PR_SET_CHILD_SUBREAPER = 36
-
-
-# ---------------------------------------------------------------------------------------------
-# The supervisor. It runs as `python -I -S processes.py`, stops at the __main__ check below,
-# and so never pays for the imports of the public part (dataclasses alone costs more than
-# the whole supervisor needs).
-
-
-class _BoundedLog:
-    """Write a stream to `head` (its first head_bytes) and to numbered `tail.N` chunk files of
-    tail_bytes/2 each, deleting all but the newest two chunks: bounded disk, no memory growth."""
-
-    def __init__(self, directory: str, head_bytes: int, tail_bytes: int):
-        self.directory = directory
-        self.head = open(os.path.join(directory, "head"), "wb", buffering=0)
-        self.head_left = head_bytes
-        self.chunk = max(1, tail_bytes // 2)
-        self.index = -1
-        self.tail = None
-        self.tail_left = 0
-
-    def write(self, data: bytes) -> None:
-        if self.head_left:
-            piece = data[:self.head_left]
-            self.head.write(piece)
-            self.head_left -= len(piece)
-            data = data[len(piece):]
-        while data:
-            if self.tail_left == 0:
-                self._next_chunk()
-            piece = data[:self.tail_left]
-            self.tail.write(piece)
-            self.tail_left -= len(piece)
-            data = data[len(piece):]
-
-    def _next_chunk(self) -> None:
-        if self.tail is not None:
-            self.tail.close()
-        self.index += 1
-        self.tail = open(os.path.join(self.directory, f"tail.{self.index:012d}"), "wb", buffering=0)
-        self.tail_left = self.chunk
-        if self.index >= 2:
-            try:
-                os.remove(os.path.join(self.directory, f"tail.{self.index - 2:012d}"))
-            except FileNotFoundError:
-                pass
-
-    def close(self) -> None:
-        self.head.close()
-        if self.tail is not None:
-            self.tail.close()
-
-
-def _children(pid: int) -> list[int]:
-    """Direct children of process `pid` (this supervisor has a single thread)."""
-    try:
-        with open(f"/proc/{pid}/task/{pid}/children") as handle:
-            return [int(p) for p in handle.read().split()]
-    except FileNotFoundError:  # kernel without CONFIG_PROC_CHILDREN: scan /proc
-        found = []
-        for entry in os.listdir("/proc"):
-            if entry.isdigit():
-                try:
-                    with open(f"/proc/{entry}/stat") as handle:
-                        stat = handle.read()
-                except OSError:
-                    continue
-                if int(stat.rsplit(")", 1)[1].split()[1]) == pid:
-                    found.append(int(entry))
-        return found
-
-
-def _peak_rss_kb() -> int:
-    """This process's peak resident memory since its exec (getrusage's ru_maxrss would include
-    the memory of the process it was forked from)."""
-    with open("/proc/self/status") as handle:
-        for line in handle:
-            if line.startswith("VmHWM:"):
-                return int(line.split()[1])
-    return 0
-
-
-def _supervisor_main(argv: list[str] | None = None) -> int:
-    """Entry of the supervisor process: argv is [status_fd, config_json]; stdin is the control pipe."""
-    import ctypes
-    import resource
-
-    status_fd, config = sys.argv[1:3] if argv is None else argv
-    config = json.loads(config)
-    status = os.fdopen(int(status_fd), "wb", buffering=0)
-    me, parent = os.getpid(), os.getppid()
-    libc = ctypes.CDLL(None, use_errno=True)
-    libc.prctl(_PR_SET_CHILD_SUBREAPER, 1, 0, 0, 0)
-
-    def report(**event) -> None:
-        try:
-            status.write(json.dumps(event).encode() + b"\n")
-        except OSError:  # the caller has gone
-            pass
-
-    wake_read, wake_write = os.pipe()
-    os.set_blocking(wake_read, False)
-    os.set_blocking(wake_write, False)
-    signal.set_wakeup_fd(wake_write, warn_on_full_buffer=False)
-    signalled = []
-    signal.signal(signal.SIGCHLD, lambda *_: None)
-    for sig in (signal.SIGTERM, signal.SIGINT, signal.SIGHUP):
-        signal.signal(sig, lambda number, _frame: signalled.append(number))
-
-    rlimits = [(getattr(resource, name), tuple(pair)) for name, pair in config["rlimits"].items()]
-
-    def prepare_child() -> None:
-        # Runs in the forked child, before exec. Safe here: the supervisor has no threads.
-        os.setpgid(0, 0)
-        libc.prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
-        if os.getppid() != me:  # the supervisor died before prctl took effect
-            os.kill(os.getpid(), signal.SIGKILL)
-        for resource_id, pair in rlimits:
-            resource.setrlimit(resource_id, pair)
-
-    # Without an echo the child's stdout and stderr share one pipe, so the log keeps their exact
-    # order; with one they get a pipe each, so the caller can tell them apart.
-    echo_fd = config.get("echo_fd")
-    output_read, output_write = os.pipe()
-    streams = {output_read: b"o"}
-    error_write = output_write
-    if echo_fd is not None:
-        os.set_blocking(echo_fd, False)
-        error_read, error_write = os.pipe()
-        streams[error_read] = b"e"
-    log = _BoundedLog(config["log_dir"], config["head_bytes"], config["tail_bytes"])
-    user = config["user"]
-    try:
-        child = subprocess.Popen(config["command"], stdin=subprocess.DEVNULL, stdout=output_write,
-                                 stderr=error_write, cwd=config["cwd"], preexec_fn=prepare_child,
-                                 user=user, group=None if user is None else _group_of(user),
-                                 extra_groups=None if user is None else [])
-    except OSError as error:
-        report(event="error", errno=error.errno, message=str(error))
-        report(event="exited", returncode=127, reason="not_started", max_rss_kb=0, cpu_seconds=0.0,
-               supervisor_max_rss_kb=_peak_rss_kb())
-        log.close()
-        return 0
-    finally:
-        os.close(output_write)
-        if error_write != output_write:
-            os.close(error_write)
-    report(event="started", pid=child.pid)
-
-    poller = select.poll()
-    poller.register(0, select.POLLIN)
-    for fd in streams:
-        os.set_blocking(fd, False)
-        poller.register(fd, select.POLLIN)
-    poller.register(wake_read, select.POLLIN)
-    wall = config["wall_seconds"]
-    wall_deadline = None if wall is None else time.monotonic() + wall
-    reason = None
-    kill_at = None
-    parent_gone = False
-
-    def begin_stop(why: str, grace: float) -> None:
-        nonlocal reason, kill_at
-        if reason is None:
-            reason = why
-            _signal_tree(child.pid, signal.SIGINT)
-        deadline = time.monotonic() + max(0.0, grace)
-        kill_at = deadline if kill_at is None else min(kill_at, deadline)
-
-    echo_dropped = {b"o": 0, b"e": 0}
-
-    def echo(stream: bytes, data: bytes) -> None:
-        """Pass output on to the caller in frames (stream, length, bytes); what does not fit
-        in the pipe is dropped (the log keeps it) and counted in a note, so the child never
-        waits for a slow reader."""
-        nonlocal echo_fd
-        dropped_before, echo_dropped[stream] = echo_dropped[stream], 0
-        note = f"[... {dropped_before} bytes of output not shown ...]\n".encode() if dropped_before else b""
-        payload = note + data
-        for start in range(0, len(payload), _ECHO_PIECE):
-            piece = payload[start:start + _ECHO_PIECE]
-            try:
-                os.write(echo_fd, stream + len(piece).to_bytes(2, "big") + piece)
-            except BlockingIOError:
-                unsent = len(payload) - start
-                echo_dropped[stream] = min(unsent, len(data)) + (dropped_before if unsent > len(data) else 0)
-                return
-            except OSError:  # the caller closed its end: stop echoing
-                os.close(echo_fd)
-                echo_fd = None
-                return
-
-    def relay_output(fd: int) -> bool:
-        """Copy what the child wrote to the log (and the echo); False at end of stream."""
-        while True:
-            try:
-                data = os.read(fd, 65536)
-            except BlockingIOError:
-                return True
-            if not data:
-                return False
-            log.write(data)
-            if echo_fd is not None:
-                echo(streams[fd], data)
-
-    while os.waitid(os.P_PID, child.pid, os.WEXITED | os.WNOHANG | os.WNOWAIT) is None:
-        timeouts = [0.5] + [t - time.monotonic() for t in (kill_at, wall_deadline) if t is not None]
-        for fd, _events in poller.poll(max(0, int(min(timeouts) * 1000) + 1)):
-            if fd in streams and not relay_output(fd):
-                poller.unregister(fd)
-            elif fd == wake_read:
-                while True:
-                    try:
-                        if not os.read(wake_read, 512):
-                            break
-                    except BlockingIOError:
-                        break
-            elif fd == 0:
-                command = os.read(0, 4096)
-                if not command:  # the caller closed its end: it has exited, one way or another
-                    parent_gone = True
-                    poller.unregister(0)
-                    begin_stop("parent_exited", PARENT_GONE_GRACE)
-                for line in command.decode(errors="replace").splitlines():
-                    if line.startswith("stop"):
-                        begin_stop("stopped", float(line.split()[1]))
-        if signalled:
-            signalled.clear()
-            begin_stop("stopped", PARENT_GONE_GRACE)
-        if not parent_gone and os.getppid() != parent:
-            parent_gone = True
-            begin_stop("parent_exited", PARENT_GONE_GRACE)
-        if wall_deadline is not None and time.monotonic() >= wall_deadline:
-            wall_deadline = None
-            begin_stop("wall_seconds", config["grace_seconds"])
-        if kill_at is not None and time.monotonic() >= kill_at:
-            _signal_tree(child.pid, signal.SIGKILL)
-            kill_at = None  # once is enough; SIGCHLD wakes us when it has died
-
-    # The child has exited but is not reaped yet, so its process group id cannot be reused:
-    # kill what it left in its group, then whatever was re-parented to us.
-    _killpg(child.pid, signal.SIGKILL)
-    _, wait_status, usage = os.wait4(child.pid, 0)
-    child.returncode = os.waitstatus_to_exitcode(wait_status)  # keeps Popen from waiting again
-    leftovers_deadline = time.monotonic() + 5.0
-    while (orphans := _children(me)) and time.monotonic() < leftovers_deadline:
-        for pid in orphans:
-            try:
-                os.kill(pid, signal.SIGKILL)
-                os.waitpid(pid, 0)
-            except (ProcessLookupError, ChildProcessError):
-                pass
-    drain_deadline = time.monotonic() + 2.0
-    open_streams = list(streams)
-    while open_streams and time.monotonic() < drain_deadline:
-        ready = select.select(open_streams, [], [], max(0.0, drain_deadline - time.monotonic()))[0]
-        if not ready:
-            break
-        for fd in ready:
-            if not relay_output(fd):
-                open_streams.remove(fd)
-    if echo_fd is not None and any(echo_dropped.values()):
-        # Say what was not shown, if the reader catches up soon enough.
-        if select.select([], [echo_fd], [], PARENT_GONE_GRACE * 2)[1]:
-            for stream in echo_dropped:
-                if echo_dropped[stream] and echo_fd is not None:
-                    echo(stream, b"")
-    log.close()
-    report(event="exited", returncode=child.returncode, reason=reason or "exited",
-           max_rss_kb=usage.ru_maxrss, cpu_seconds=round(usage.ru_utime + usage.ru_stime, 3),
-           supervisor_max_rss_kb=_peak_rss_kb())
-    if parent_gone:  # nobody will read the log: leave nothing behind
-        for path in config["cleanup"]:
-            shutil.rmtree(path, ignore_errors=True)
-    return 0
-
-
-def _group_of(user: str | int) -> int:
-    """The primary group of a user name; a bare uid (no passwd entry needed) is its own group."""
-    import pwd
-
-    return user if isinstance(user, int) else pwd.getpwnam(user).pw_gid
-
-
-def _killpg(pgid: int, sig: int) -> None:
-    try:
-        os.killpg(pgid, sig)
-    except (ProcessLookupError, PermissionError):
-        pass
-
-
-def _signal_tree(pid: int, sig: int) -> None:
-    """Signal the process group `pid` leads, and `pid` itself only if it left that group.
-
-    Signalling a group member twice would deliver SIGINT twice: the second one can land in the
-    node's own clean-up (its finally block) and turn a clean exit into a traceback.
-    """
-    _killpg(pid, sig)
-    try:
-        if os.getpgid(pid) != pid:
-            os.kill(pid, sig)
-    except ProcessLookupError:
-        pass
-
-
-if __name__ == "__main__":
-    sys.exit(_supervisor_main())
-
-# ---------------------------------------------------------------------------------------------
-# The public part, used in the caller.
-
-import atexit  # noqa: E402 (after the supervisor on purpose, see above)
-import dataclasses  # noqa: E402
-import errno  # noqa: E402
-import itertools  # noqa: E402
-import tempfile  # noqa: E402
-import threading  # noqa: E402
-from pathlib import Path  # noqa: E402
-from typing import Callable  # noqa: E402
+from course_lib import rosenv
+from course_lib.bounded_log import LOG_HEAD_BYTES, LOG_TAIL_BYTES, read_log
+from course_lib.process_tree import signal_group
 
 #: Seconds start() waits for the supervisor to report that the command runs.
 START_TIMEOUT = 30.0
 
-#: How the supervisor starts: this file run as a script by a fresh python -I -S.
-_SUPERVISOR_COMMAND = [sys.executable, "-I", "-S", os.path.abspath(__file__)]
+#: How the supervisor starts: its file run as a script by a fresh python -I -S.
+_SUPERVISOR_COMMAND = [sys.executable, "-I", "-S", os.path.join(os.path.dirname(os.path.abspath(__file__)),
+                                                             "supervisor.py")]
 
 #: Every NodeProcess this process started and has not yet stopped (for stop_all and atexit).
 _RUNNING: set["NodeProcess"] = set()
@@ -388,7 +52,7 @@ _WATCHER_IDS = itertools.count()
 
 @dataclasses.dataclass(frozen=True)
 class Limits:
-    """Bounds for a child that runs untrusted code (the autograder); None means no bound.
+    """Bounds for a child that runs untrusted code (the checks); None means no bound.
 
     Attributes:
         wall_seconds: real time after which the child is stopped (SIGINT, then SIGKILL after
@@ -398,13 +62,10 @@ class Limits:
             ROS nodes.
         cpu_seconds: CPU time (RLIMIT_CPU); the child gets SIGXCPU when it is used up.
         max_processes: processes *and threads* of the child's user (RLIMIT_NPROC). Fast DDS
-            starts about a dozen threads per node. The kernel does not enforce it for root, so
-            combine it with ``user`` when the caller runs as root.
+            starts about a dozen threads per node. The kernel does not enforce it for root (the
+            grader, as root, runs the student's code as another uid: autograder.run_as).
         file_size_mb: largest file the child may write (RLIMIT_FSIZE); SIGXFSZ beyond it.
         open_files: open file descriptors (RLIMIT_NOFILE).
-        user: run the child as this user (for example "nobody"), or as this numeric uid (and gid),
-            which needs no passwd entry; needs a caller running as root.
-            The child gets a fresh HOME/ROS_HOME it owns, since ROS writes logs there.
         grace_seconds: time between SIGINT and SIGKILL when the wall time runs out.
     """
 
@@ -414,7 +75,6 @@ class Limits:
     max_processes: int | None = None
     file_size_mb: int | None = None
     open_files: int | None = None
-    user: str | int | None = None
     grace_seconds: float = 2.0
 
     def __post_init__(self):
@@ -458,6 +118,8 @@ class NodeProcess:
             None removes a variable).
         cwd: working directory of the child.
         limits: resource bounds (see Limits); None for none.
+        private_dirs: folders that belong to the child (a HOME made for it): removed when it has
+            ended, also when its caller dies first.
         on_output: called as ``on_output(stream, data)`` with each piece of the child's output
             as it arrives, stream being "stdout" or "stderr" (from a thread of its own; the
             log keeps everything as well). By the time returncode is known, on_output has had
@@ -477,9 +139,7 @@ class NodeProcess:
 
     def __init__(self, command: list[str], *, name: str | None = None, domain_id: int | None = None,
                  env: dict | None = None, cwd=None, limits: Limits | None = None,
-                 on_output: Callable[[str, bytes], None] | None = None):
-        from course_lib import rosenv  # imported here: the supervisor runs this file without it
-
+                 on_output: Callable[[str, bytes], None] | None = None, private_dirs=()):
         if isinstance(command, (str, bytes)) or not command:
             raise TypeError(f"command must be a non-empty list of strings like ['python', '-m', 'pkg.node'], "
                             f"not {command!r}")
@@ -507,7 +167,7 @@ class NodeProcess:
         self._status: int | None = None
         self._status_buffer = b""
         self._log_dir: Path | None = None
-        self._home_dir: Path | None = None
+        self._private_dirs = [Path(directory) for directory in private_dirs]
         self._final_log: bytes | None = None
         self._returncode: int | None = None
         self._lock = threading.RLock()
@@ -535,20 +195,14 @@ class NodeProcess:
                         other.stop()
             env = dict(self.env)
             self._log_dir = Path(tempfile.mkdtemp(prefix="course_lib-node-"))
-            cleanup = [str(self._log_dir)]
-            if self.limits.user is not None:
-                self._home_dir = _home_for(self.limits.user)
-                env["HOME"] = env["ROS_HOME"] = str(self._home_dir)
-                env.pop("ROS_LOG_DIR", None)
-                cleanup.append(str(self._home_dir))
+            cleanup = [str(self._log_dir), *map(str, self._private_dirs)]
             control_read, self._control = os.pipe()
             self._status, status_write = os.pipe()
             echo_read, echo_write = os.pipe() if self._on_output is not None else (None, None)
             config = {"command": self.command, "cwd": self.cwd, "log_dir": str(self._log_dir),
                       "head_bytes": LOG_HEAD_BYTES, "tail_bytes": LOG_TAIL_BYTES,
                       "rlimits": self.limits.rlimit_pairs(), "wall_seconds": self.limits.wall_seconds,
-                      "grace_seconds": self.limits.grace_seconds, "user": self.limits.user,
-                      "cleanup": cleanup, "echo_fd": echo_write}
+                      "grace_seconds": self.limits.grace_seconds, "cleanup": cleanup, "echo_fd": echo_write}
             try:
                 with open(self._log_dir / "supervisor.err", "wb") as errors:
                     self._supervisor = subprocess.Popen(
@@ -581,7 +235,7 @@ class NodeProcess:
                 return self
             if event and event.get("event") == "error":
                 self._poll(wait=True)
-                raise _start_error(event, self.command, self.cwd, self.limits.user)
+                raise _start_error(event, self.command, self.cwd)
             errors = self._supervisor_errors() or "(none)"
             if self._supervisor.poll() is None:
                 self._kill_supervisor()
@@ -608,7 +262,7 @@ class NodeProcess:
         # No lock: stop() holds it while it waits, and reading the log must not wait for that.
         log_dir, data = self._log_dir, self._final_log
         if data is None and log_dir is not None:
-            data = _read_log(log_dir, LOG_TAIL_BYTES // 2)
+            data = read_log(log_dir, LOG_TAIL_BYTES // 2)
             if self._final_log is not None:  # the child ended while we read
                 data = self._final_log
         return (data or b"").decode("utf-8", errors="replace")
@@ -810,11 +464,11 @@ class NodeProcess:
                 # The supervisor itself died (killed from outside). Its child got SIGKILL through
                 # PR_SET_PDEATHSIG; the child's group may hold more.
                 if self.pid is not None:
-                    _killpg(self.pid, signal.SIGKILL)
+                    signal_group(self.pid, signal.SIGKILL)
                 self._returncode = -signal.SIGKILL
                 self.exit_reason = "supervisor_died"
             if self._log_dir is not None:
-                self._final_log = _read_log(self._log_dir, LOG_TAIL_BYTES // 2)
+                self._final_log = read_log(self._log_dir, LOG_TAIL_BYTES // 2)
             self._close_fds()
             self._remove_dirs()
             with _RUNNING_LOCK:
@@ -849,13 +503,14 @@ class NodeProcess:
                     pass
         self._control = self._status = None
         self._supervisor = None
-        self._log_dir = self._home_dir = None
+        self._log_dir = None
+        self._private_dirs = []
 
     def _kill_supervisor(self) -> None:
         self._supervisor.kill()
         self._supervisor.wait()
         if self.pid is not None:
-            _killpg(self.pid, signal.SIGKILL)
+            signal_group(self.pid, signal.SIGKILL)
 
     def _supervisor_errors(self) -> str:
         try:
@@ -871,10 +526,10 @@ class NodeProcess:
                 setattr(self, attribute, None)
 
     def _remove_dirs(self) -> None:
-        for directory in (self._log_dir, self._home_dir):
+        for directory in (self._log_dir, *self._private_dirs):
             if directory is not None:
                 shutil.rmtree(directory, ignore_errors=True)
-        self._home_dir = None
+        self._private_dirs = []
 
 
 #: Seconds a node of the same name that ran before a new node process started may take to
@@ -944,14 +599,26 @@ def _relay_echo(fd: int, on_output: Callable[[str, bytes], None]) -> None:
 
 
 def python_node(target: str, *args: str, **kwargs) -> NodeProcess:
-    """Start a Python node with this interpreter and return its running NodeProcess.
+    """Start a Python node with this interpreter (python_command) and return its running NodeProcess.
+
+    Args:
+        target, *args: as python_command.
+        **kwargs: passed to NodeProcess (name, domain_id, env, cwd, limits).
+    """
+    process = NodeProcess(python_command(target, *args), **kwargs)
+    if kwargs.get("name") is None:  # a label only: two nodes of one module may run side by side
+        process.name = target.partition(":")[0].rsplit(".", 1)[-1]
+    return process.start()
+
+
+def python_command(target: str, *args: str) -> list[str]:
+    """The command line that runs a Python node with this interpreter.
 
     Args:
         target: "package.module" (run like ``python -m package.module``) or
             "package.module:function" (import it and call ``function()``, like a setup.py
             console-script entry point such as ``talker = demo.talker:main``).
         *args: command-line arguments for the node (sys.argv[1:]), e.g. "--ros-args", "-r", ...
-        **kwargs: passed to NodeProcess (name, domain_id, env, cwd, limits).
 
     Raises:
         ValueError: the target is not in one of the two forms.
@@ -970,10 +637,7 @@ def python_node(target: str, *args: str, **kwargs) -> NodeProcess:
         command = [sys.executable, "-c", code, *args]
     else:
         command = [sys.executable, "-m", module, *args]
-    process = NodeProcess(command, **kwargs)
-    if kwargs.get("name") is None:  # a label only: two nodes of one module may run side by side
-        process.name = module.rsplit(".", 1)[-1]
-    return process.start()
+    return command
 
 
 def stop_all(timeout: float = 5.0) -> None:
@@ -1011,56 +675,13 @@ atexit.register(stop_all)
 os.register_at_fork(after_in_child=_disown_after_fork)
 
 
-def _start_error(event: dict, command: list[str], cwd: str | None, user: str | None) -> OSError:
+def _start_error(event: dict, command: list[str], cwd: str | None) -> OSError:
     number = event.get("errno")
     if number == errno.ENOENT:
         where = f" (working directory {cwd})" if cwd else ""
         return FileNotFoundError(number, f"Cannot run {command[0]!r}{where}: no such file or program on PATH; "
                                  f"check the spelling or give a full path", command[0])
     if number in (errno.EACCES, errno.EPERM):
-        if user is not None:
-            fix = (f"user {user!r} (Limits.user) needs read and execute access to it, to the interpreter "
-                   f"it runs and to every directory above them (a virtual environment under /root is not)")
-        else:
-            fix = "make it executable (chmod +x) or run it through its interpreter"
+        fix = "make it executable (chmod +x) or run it through its interpreter"
         return PermissionError(number, f"Cannot run {command[0]!r}: permission denied; {fix}", command[0])
     return OSError(number, f"Cannot run {command!r}: {event.get('message')}")
-
-
-def _home_for(user: str | int) -> Path:
-    """A fresh home directory owned by `user`, for a child that runs as that user."""
-    import pwd
-
-    if isinstance(user, int):
-        uid = gid = user
-    else:
-        try:
-            entry = pwd.getpwnam(user)
-        except KeyError:
-            raise ValueError(f"Limits.user {user!r} does not exist on this machine; use an existing "
-                             f"unprivileged account such as 'nobody'") from None
-        uid, gid = entry.pw_uid, entry.pw_gid
-    if os.geteuid() != 0 and uid != os.geteuid():
-        raise PermissionError(f"Limits.user={user!r} needs the caller to run as root; "
-                              "leave user=None when not running as root")
-    home = Path(tempfile.mkdtemp(prefix="course_lib-home-"))
-    os.chown(home, uid, gid)
-    return home
-
-
-def _read_log(directory: Path, chunk: int) -> bytes:
-    """Join the head and the newest tail chunks the supervisor wrote (see _BoundedLog)."""
-    for _attempt in range(5):
-        try:
-            head = (directory / "head").read_bytes() if (directory / "head").exists() else b""
-            tails = sorted(directory.glob("tail.*"))[-2:]
-            if not tails:
-                return head
-            first = int(tails[0].suffix[1:])
-            data = b"".join(path.read_bytes() for path in tails)
-        except FileNotFoundError:  # rotated while we read: read again
-            continue
-        omitted = first * chunk
-        marker = f"\n[... {omitted} bytes of output omitted ...]\n".encode() if omitted else b""
-        return head + marker + data
-    return b""

@@ -39,13 +39,14 @@ from __future__ import annotations
 
 import atexit
 import functools
+import math
 import sys
 import threading
 import time
 import traceback
 from typing import Callable
 
-from course_lib import node_logs, rosenv
+from course_lib import node_logs, rosenv, waiting
 
 #: Name of the session's hidden helper node (a leading "_" hides it from node listings).
 TOOL_NODE_NAME = "_course_tools"
@@ -472,19 +473,17 @@ def wait_for(predicate: Callable[[], bool], timeout: float | None = 10.0,
     if timeout is None:
         timeout = time_limit(None)
     start()
-    deadline = None if timeout is None else time.monotonic() + timeout
-    while True:
-        if predicate():
-            return True
-        if deadline is not None and time.monotonic() >= deadline:
-            return False
+
+    def still_running():
         if not is_running():
             raise RuntimeError("The ROS session stopped while waiting (session.stop() or "
                                "rclpy.shutdown() was called): run session.start() again")
-        # Interrupting the kernel raises KeyboardInterrupt here, in the cell's thread; the
-        # background thread holds no state of this wait, so nothing needs undoing.
-        remaining = poll if deadline is None else max(0.0, min(poll, deadline - time.monotonic()))
-        time.sleep(remaining)
+
+    # The background thread spins, so this thread only polls. Interrupting the kernel raises
+    # KeyboardInterrupt here, in the cell's thread; the background thread holds no state of
+    # this wait, so nothing needs undoing.
+    return waiting.spin_until(predicate, math.inf if timeout is None else max(0.0, timeout), poll=poll,
+                              between=still_running)
 
 
 def spin_for(seconds: float | None = None) -> float:

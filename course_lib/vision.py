@@ -1,9 +1,9 @@
 """Pictures for the vision lessons: detected markers drawn over a frame, image grids, time plots.
 
 These helpers explain; they do not detect or crop anything themselves. A lesson detects
-markers (with ``scenes.detector()`` or step by step) and passes the result here to look at it::
+markers (with ``marker_board.detector()`` or step by step) and passes the result here to look at it::
 
-    corners, ids, _ = scenes.detector().detectMarkers(frame)
+    corners, ids, _ = marker_board.detector().detectMarkers(frame)
     annotated = vision.draw_markers(frame, corners, ids)       # outlines, ids, corner numbers
     vision.show_images([frame, annotated], ["camera", "markers"])
 """

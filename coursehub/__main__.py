@@ -21,7 +21,7 @@ def create_course(roster_csv: Path, instructor_name: str, hub_dir: Path, group: 
                   port: int, hub_port: int, ip: str) -> course_settings.Course:
     """Accounts, exchange, settings and the instructor's nbgrader course from a roster; run again
     with a longer roster to add students (nobody is removed, no password changes)."""
-    from autograder import config, grading, roster
+    from autograder import config, release, roster
 
     students = [row["id"] for row in roster.read_roster(roster_csv)[0]]
     for name in [instructor_name, group, *students]:
@@ -48,7 +48,7 @@ def create_course(roster_csv: Path, instructor_name: str, hub_dir: Path, group: 
             shutil.copytree(REPO / "notebooks", home / "notebooks",
                             ignore=shutil.ignore_patterns(".ipynb_checkpoints", "__pycache__"))
             accounts.chown_tree(home / "notebooks", student)
-    course_dir = grading.prepare_course(course.course_dir)
+    course_dir = release.prepare_course(course.course_dir)
     roster.import_roster(course_dir, roster_csv)
     accounts.chown_tree(course_dir, instructor_name)
     os.chmod(course_dir, 0o700)  # the gradebook holds the hidden tests

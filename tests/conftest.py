@@ -1,10 +1,11 @@
-"""Fixtures shared by the browser test modules."""
+"""Fixtures shared by the test modules: a browser, a marker for a test's own processes."""
 
 import contextlib
 
 import pytest
 
 from browser_support import ChromiumUnavailable, launched_chromium
+from process_support import marker, processes_with
 
 
 @pytest.fixture(scope="module")
@@ -16,3 +17,12 @@ def browser(tmp_path_factory):
         except ChromiumUnavailable as why:
             pytest.skip(f"browser tests need Chromium: {why}")
         yield context
+
+
+@pytest.fixture
+def token():
+    """A unique marker for the test's processes; survivors of a failed test are killed."""
+    value = marker()
+    yield value
+    for leftover in processes_with(value):
+        leftover.kill()

@@ -12,8 +12,8 @@ import pytest
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import zoo  # noqa: E402
-from autograder import grading, packages, reference  # noqa: E402
-from course_lib.checks import harness, validate  # noqa: E402
+from autograder import grading, packages, reference, release, sandbox  # noqa: E402
+from course_lib.checks import registry, runner, validate  # noqa: E402
 
 ASSIGNMENTS = ["brightness", "pubsub", "catdog_warp"]
 REPO = Path(__file__).resolve().parent.parent
@@ -22,7 +22,7 @@ REPO = Path(__file__).resolve().parent.parent
 @pytest.mark.parametrize("assignment", ASSIGNMENTS)
 def test_every_check_has_points_timeout_and_description(assignment):
     """Each check declares positive points, a timeout and a one-line description."""
-    checks = harness.checks_of(assignment)
+    checks = registry.checks_of(assignment)
     assert checks
     for spec in checks.values():
         assert spec.points > 0 and spec.timeout > 0 and spec.description and "\n" not in spec.description
@@ -35,7 +35,7 @@ def test_test_cells_match_the_checks(assignment):
     nb = nbformat.read(REPO / "assignments" / "source" / assignment / f"{assignment}.ipynb", as_version=4)
     graded = {c.metadata["nbgrader"]["grade_id"]: c for c in nb.cells
               if c.metadata.get("nbgrader", {}).get("grade") and not c.metadata["nbgrader"].get("solution")}
-    checks = harness.checks_of(assignment)
+    checks = registry.checks_of(assignment)
     assert set(graded) == {f"check_{name}" for name in checks}
     for name, spec in checks.items():
         cell = graded[f"check_{name}"]
@@ -65,9 +65,9 @@ def test_cell_timeouts_give_graded_cells_longer():
 
 def test_sandbox_hides_directories_and_keeps_the_command():
     """As root the command runs under unshare with a network and mount namespace."""
-    command = grading.sandbox_command(["python", "-V"], [Path("/somewhere/course")])
+    command = sandbox.sandbox_command(["python", "-V"], [Path("/somewhere/course")])
     assert command[-3:] == ["--", "python", "-V"]
-    if grading.isolation() == "root":
+    if sandbox.isolation() == "root":
         assert command[:3] == ["unshare", "--net", "--mount"] and "/somewhere/course" in command
 
 
@@ -96,7 +96,7 @@ def test_brightness_typical_mistake_gets_its_score_and_reason(tmp_path, monkeypa
     for check in ("values", "node"):
         if entry[check] is None:
             continue  # the entry is about the other check
-        result = harness.execute("brightness", check, 11, workdir=workdir, mode="graded")
+        result = runner.execute("brightness", check, 11, workdir=workdir, mode="graded")
         texts.extend(result.verdict_lines())
         first_failures.extend([line for line in result.verdict_lines() if line.startswith("  ✘ ")][:1])
         expected = entry[check]
@@ -115,13 +115,13 @@ def test_brightness_typical_mistake_gets_its_score_and_reason(tmp_path, monkeypa
 WARP = "crop = cv2.warpPerspective(frame, homography, (width, height), flags=cv2.INTER_LINEAR)"
 CATDOG_MISTAKES = {
     "bgr_swapped": ([(WARP, WARP + "\n        crop = cv2.cvtColor(crop, cv2.COLOR_BGR2RGB)")], "red and blue are swapped"),
-    "mirrored": ([("target = scenes.crop_corners((width, height))",
+    "mirrored": ([("target = marker_board.crop_corners((width, height))",
                    "target = np.float32([[width - 1, 0], [0, 0], [0, height - 1], [width - 1, height - 1]])")],
                  "mirrored left-right"),
     # Each marker's corner 0 instead of the corner that touches the picture.
-    "corner_order": ([("corners = scenes.picture_corners(markers, name)",
-                       "corners = (np.float32([markers[m][0] for m in scenes.PICTURES[name]])\n"
-                       "                   if all(m in markers for m in scenes.PICTURES[name]) else None)")], "similarity"),
+    "corner_order": ([("corners = marker_board.picture_corners(markers, name)",
+                       "corners = (np.float32([markers[m][0] for m in marker_board.PICTURES[name]])\n"
+                       "                   if all(m in markers for m in marker_board.PICTURES[name]) else None)")], "similarity"),
     "size_swapped": ([("(width, height), flags=cv2.INTER_LINEAR)", "(height, width), flags=cv2.INTER_LINEAR)")],
                      "size is (width, height)"),
 }
@@ -131,7 +131,7 @@ CATDOG_MISTAKES = {
 def test_catdog_typical_mistake_loses_points_with_its_reason(tmp_path, mistake):
     """Typical warp mistakes score below full on easy scenes, and the verdict names the mistake."""
     edits, reason = CATDOG_MISTAKES[mistake]
-    result = harness.execute("catdog_warp", "easy", 3, workdir=_module_dir(tmp_path, "catdog_warp", edits),
+    result = runner.execute("catdog_warp", "easy", 3, workdir=_module_dir(tmp_path, "catdog_warp", edits),
                               mode="graded")
     assert result.points < result.max_points
     assert reason in "\n".join(result.verdict_lines())
@@ -140,14 +140,14 @@ def test_catdog_typical_mistake_loses_points_with_its_reason(tmp_path, mistake):
 def test_catdog_picture_reported_from_its_first_marker_loses_points_in_every_grading(tmp_path):
     """Each of a picture's four markers is hidden in turn in every grading, not left to a random
     draw: a crop_pictures that reports a picture whenever its first marker is seen always loses."""
-    edits = [("corners = scenes.picture_corners(markers, name)",
-              "first = scenes.PICTURES[name][0]\n"
-              "        corners = scenes.picture_corners({m: markers.get(m, markers.get(first)) for m in scenes.PICTURES[name]}\n"
+    edits = [("corners = marker_board.picture_corners(markers, name)",
+              "first = marker_board.PICTURES[name][0]\n"
+              "        corners = marker_board.picture_corners({m: markers.get(m, markers.get(first)) for m in marker_board.PICTURES[name]}\n"
               "                                         if first in markers else markers, name)"),
              ("if corners is None or not _is_picture_shape(corners):", "if corners is None:")]
     workdir = _module_dir(tmp_path, "catdog_warp", edits)
     for seed in (3, 4):
-        result = harness.execute("catdog_warp", "missing_and_none", seed, workdir=workdir, mode="graded")
+        result = runner.execute("catdog_warp", "missing_and_none", seed, workdir=workdir, mode="graded")
         assert result.points < result.max_points, result.verdict_lines()
         failed = [item["message"] for item in result.items if not item["ok"]]
         assert len(failed) == 6 and all("although markers" in m for m in failed), result.verdict_lines()
@@ -155,7 +155,7 @@ def test_catdog_picture_reported_from_its_first_marker_loses_points_in_every_gra
 
 def test_catdog_reference_passes_easy_scenes(tmp_path):
     """The reference crop_pictures gets every point on easy scenes (the checks can be passed)."""
-    result = harness.execute("catdog_warp", "easy", 3, workdir=_module_dir(tmp_path, "catdog_warp"), mode="graded")
+    result = runner.execute("catdog_warp", "easy", 3, workdir=_module_dir(tmp_path, "catdog_warp"), mode="graded")
     assert result.points == result.max_points, result.verdict_lines()
 
 
@@ -182,7 +182,7 @@ PUBSUB_MISTAKES = {
 def test_pubsub_typical_mistake_loses_points_with_its_reason(tmp_path, monkeypatch, mistake):
     """Typical publisher/subscriber mistakes score below full, and the verdict names the mistake."""
     edits, check, reason = PUBSUB_MISTAKES[mistake]
-    result = harness.execute("pubsub", check, 5, workdir=_module_dir(tmp_path, "pubsub", edits, monkeypatch),
+    result = runner.execute("pubsub", check, 5, workdir=_module_dir(tmp_path, "pubsub", edits, monkeypatch),
                              mode="graded")
     assert result.points < result.max_points, result.verdict_lines()
     assert reason in "\n".join(result.verdict_lines())
@@ -205,7 +205,7 @@ FULL_RUN_REFERENCES = ["catdog_warp"]
 @pytest.fixture(scope="module")
 def course(tmp_path_factory):
     course = tmp_path_factory.mktemp("course")
-    grading.release(course, ASSIGNMENTS)
+    release.release(course, ASSIGNMENTS)
     for assignment in FULL_RUN_REFERENCES:
         zoo.submit(course, "reference", assignment)
     for assignment, (edits, _reason) in FULL_RUN_MISTAKES.items():

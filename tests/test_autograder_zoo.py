@@ -35,10 +35,10 @@ def _hashes(folder: Path) -> dict[str, str]:
 
 @pytest.fixture(scope="module")
 def graded(tmp_path_factory):
-    from autograder import grading
+    from autograder import grading, release
 
     course = tmp_path_factory.mktemp("zoo_course")
-    grading.release(course, ["brightness", "pubsub"])
+    release.release(course, ["brightness", "pubsub"])
     entries = {k: v for k, v in brightness_zoo.entries(str(course)).items() if v.get("level") != "check"}
     for student, entry in entries.items():
         zoo.submit(course, student, "brightness", entry["edits"])

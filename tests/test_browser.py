@@ -40,8 +40,8 @@ NODE_CELL = "listener = session.add_node(Listener())"
 RERUN_NOTEBOOK = [
     """from rclpy.node import Node
 from std_msgs.msg import String
-from course_lib import graph, session
-graph.SETTLE_SECONDS = 0  # only this kernel's nodes matter: no wait for other processes
+from course_lib import discovery, graph, session
+discovery.SETTLE_SECONDS = 0  # only this kernel's nodes matter: no wait for other processes
 session.start()
 
 class Listener(Node):

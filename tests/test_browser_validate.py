@@ -50,11 +50,11 @@ pytestmark = pytest.mark.browser
 @pytest.fixture(scope="module")
 def course(tmp_path_factory):
     """A course directory with brightness released, to release/brightness/ and to an exchange in exchange/."""
-    from autograder import grading
+    from autograder import nbgrader_cli, release
 
     course = tmp_path_factory.mktemp("validate-course")
-    grading.release(course, [ASSIGNMENT])
-    grading.run_nbgrader(["release_assignment", ASSIGNMENT, f"--Exchange.root={course / 'exchange'}"], course)
+    release.release(course, [ASSIGNMENT])
+    nbgrader_cli.run_nbgrader(["release_assignment", ASSIGNMENT, f"--Exchange.root={course / 'exchange'}"], course)
     return course
 
 

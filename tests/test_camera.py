@@ -11,7 +11,7 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 from sensor_msgs.msg import Image
 
-from course_lib import camera, scenes
+from course_lib import camera, marker_board
 from course_lib.images import msg_to_image
 
 
@@ -53,7 +53,7 @@ def test_simulated_frames_arrive_with_size_encoding_frame_and_rate(domain_id):
     assert frames[0].shape == (240, 320, 3)
     assert not np.array_equal(frames[0], frames[-1]), "the simulated camera moves"
     # Markers are in view: the frames are the marker scenes.
-    _, ids, _ = scenes.detector().detectMarkers(frames[-1])
+    _, ids, _ = marker_board.detector().detectMarkers(frames[-1])
     assert ids is not None and len(ids) >= 4
     intervals = np.diff(stamps(messages))
     assert np.all(intervals > 0), "stamps come from the node clock and increase"

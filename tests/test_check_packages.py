@@ -7,11 +7,12 @@ from pathlib import Path
 
 import pytest
 
-from course_lib.checks import harness, packages
+from course_lib.checks import packages
+from course_lib.checks.context import StudentError
 
 
 class Recorder:
-    """The part of harness.Context these functions use: the work directory and the items."""
+    """The part of context.Context these functions use: the work directory and the items."""
 
     def __init__(self, workdir: Path):
         self.workdir = workdir
@@ -92,7 +93,7 @@ def test_a_message_with_other_fields_costs_an_item(tmp_path, definition, ok):
 
 def test_an_unbuilt_workspace_says_to_run_the_build_cell(tmp_path, monkeypatch):
     monkeypatch.delenv(packages.REPORT_ENV, raising=False)
-    with pytest.raises(harness.StudentError, match="run the notebook's build cell"):
+    with pytest.raises(StudentError, match="run the notebook's build cell"):
         packages.require_build(Recorder(tmp_path))
 
 
@@ -101,5 +102,5 @@ def test_a_failed_grader_build_is_the_reason_of_every_check_that_needs_it(tmp_pa
     report.write_text('{"ok": false, "reason": "colcon build failed in package \'pubsub\':\\nSyntaxError: x", '
                       '"workspace": "/nowhere"}')
     monkeypatch.setenv(packages.REPORT_ENV, str(report))
-    with pytest.raises(harness.StudentError, match="(?s)did not build.*SyntaxError: x"):
+    with pytest.raises(StudentError, match="(?s)did not build.*SyntaxError: x"):
         packages.require_build(Recorder(tmp_path))

@@ -9,7 +9,7 @@ import zipfile
 import pytest
 from traitlets.config import Config
 
-from autograder import collect, grading, roster
+from autograder import collect, release, roster
 
 
 @pytest.mark.parametrize("zone, hour", [("UTC", 9), ("Europe/Berlin", 8)])
@@ -33,7 +33,7 @@ def test_other_files_and_names_are_skipped():
 @pytest.fixture(scope="module")
 def course(tmp_path_factory):
     root = tmp_path_factory.mktemp("course")
-    grading.release(root, ["pubsub"])
+    release.release(root, ["pubsub"])
     (root / "roster.csv").write_text("id\nalice\ncarol\n")
     roster.import_roster(root, root / "roster.csv")
     return root

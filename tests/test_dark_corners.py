@@ -1,6 +1,6 @@
 """Markers touching dark picture corners: the reference crops recover the pictures (issue: dark corners).
 
-scenes.dark_corner_board puts photograph-like pictures with nearly black corners on the board, so
+dark_corners.dark_corner_board puts photograph-like pictures with nearly black corners on the board, so
 every marker touches a dark corner and can merge with it in the detector's threshold image.
 Both reference implementations (readmarker's crop_pictures and the catdog_warp assignment's
 solution cell in assignments/build.py) must recover at least 98 % of the fully framed pictures
@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from course_lib import scenes
+from course_lib import dark_corners, marker_board, scenes
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "assignments" / "reference_ws" / "src" / "readmarker"))
@@ -38,7 +38,7 @@ def assignment_solution():
 
 @pytest.fixture(scope="module")
 def dark_scenes():
-    return [scenes.render_scene(seed, difficulty="hard", board=scenes.dark_corner_board(seed)) for seed in SEEDS]
+    return [scenes.render_scene(seed, difficulty="hard", board=dark_corners.dark_corner_board(seed)) for seed in SEEDS]
 
 
 def recovery(crop, scene_list):
@@ -48,8 +48,8 @@ def recovery(crop, scene_list):
         crops = crop(scene.frame)
         expected = scene.expected_crops()
         visible = set(scene.visible_ids)
-        for name, markers in scenes.PICTURES.items():
-            good = name in crops and scenes.crop_similarity(crops[name], expected[name]) >= scenes.SAME_CROP_THRESHOLD
+        for name, markers in marker_board.PICTURES.items():
+            good = name in crops and marker_board.crop_similarity(crops[name], expected[name]) >= marker_board.SAME_CROP_THRESHOLD
             framed += name in scene.fully_framed
             recovered += name in scene.fully_framed and good
             false += name in crops and (not good or not visible.issuperset(markers))
@@ -57,9 +57,9 @@ def recovery(crop, scene_list):
 
 
 def test_photographs_have_dark_corners_and_are_the_same_for_the_same_seed():
-    photo = scenes.draw_photo(3)
+    photo = dark_corners.draw_photo(3)
     assert photo.shape == (300, 400, 3) and photo.dtype.name == "uint8"
-    assert (photo == scenes.draw_photo(3)).all() and not (photo == scenes.draw_photo(4)).all()
+    assert (photo == dark_corners.draw_photo(3)).all() and not (photo == dark_corners.draw_photo(4)).all()
     assert photo[:4, :4].max() < 40 and photo[-4:, -4:].max() < 40, "corners nearly black"
     assert photo[120:180, 160:240].mean() > 60, "a picture, not a black frame"
 

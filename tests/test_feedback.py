@@ -6,14 +6,15 @@ from __future__ import annotations
 import dataclasses
 import json
 
-from autograder import feedback, grading
+from autograder import feedback, store
+from autograder.result import GradeResult
 
 
 def _recorded(course, student, assignment, **fields):
-    result = grading.GradeResult(student, assignment, "digest", score=0, max_score=10, status="failed", **fields)
-    folder = grading.state_dir(course, student, assignment)
+    result = GradeResult(student, assignment, "digest", score=0, max_score=10, status="failed", **fields)
+    folder = store.state_dir(course, student, assignment)
     folder.mkdir(parents=True)
-    (folder / grading.STATE_FILE).write_text(json.dumps(dataclasses.asdict(result)))
+    (folder / store.STATE_FILE).write_text(json.dumps(dataclasses.asdict(result)))
 
 
 def _course(tmp_path):

@@ -6,16 +6,12 @@ import signal
 import subprocess
 import sys
 
-import numpy as np
 import pytest
-from matplotlib.figure import Figure
-from matplotlib.text import Annotation
 from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
-from sensor_msgs.msg import Image
 from std_msgs.msg import String
 
-from course_lib import graph, rosenv, session
+from course_lib import discovery, graph, message_yaml, rosenv, session
 
 # A talker in another process: a 10 Hz timer publishing "hello N" on /far_chatter.
 FAR_TALKER = """
@@ -83,7 +79,7 @@ def no_session_left():
 @pytest.fixture
 def local_session(domain_id, monkeypatch):
     """A session on a domain of its own; no discovery wait, as all nodes are in this process."""
-    monkeypatch.setattr(graph, "SETTLE_SECONDS", 0.0)
+    monkeypatch.setattr(discovery, "SETTLE_SECONDS", 0.0)
     session.start(domain_id=domain_id)
     return domain_id
 
@@ -121,7 +117,7 @@ def test_topic_echo_receives_the_asked_number_of_messages(far_talker):
     assert all(isinstance(msg, String) for msg in messages)
     numbers = [int(msg.data.split()[1]) for msg in messages]
     assert numbers == list(range(numbers[0], numbers[0] + 3))
-    assert graph.format_messages(messages) == "".join(f"data: hello {n}\n---\n" for n in numbers)
+    assert message_yaml.format_messages(messages) == "".join(f"data: hello {n}\n---\n" for n in numbers)
 
 
 def test_topic_hz_measures_a_10hz_timer_publisher(far_talker):
@@ -203,92 +199,6 @@ def test_topic_echo_without_messages_times_out_with_what_it_got(local_session):
         graph.topic_echo("/silent", timeout=0.3)
 
 
-def test_draw_graph_shows_nodes_and_topics_left_to_right(local_session):
-    """draw_graph() draws talker -> /chatter -> listener, and leaves out /rosout and tool node."""
-    session.add_node(Talker())
-    session.add_node(Listener())
-    figure = graph.draw_graph()
-    assert isinstance(figure, Figure)
-    texts = {t.get_text(): t for t in figure.axes[0].texts if not isinstance(t, Annotation)}
-    assert set(texts) == {"/talker", "/chatter", "/listener"}
-    x = {name: text.get_position()[0] for name, text in texts.items()}
-    assert x["/talker"] < x["/chatter"] < x["/listener"]
-    arrows = [t for t in figure.axes[0].texts if isinstance(t, Annotation)]
-    assert len(arrows) == 2
-    everything = {t.get_text() for t in graph.draw_graph(all=True, hide_topics=()).axes[0].texts}
-    assert {"/rosout", "/parameter_events", "/" + session.TOOL_NODE_NAME} <= everything
-
-
-# --- plain functions --------------------------------------------------------------------
-
-def test_rate_statistics_of_known_arrival_times():
-    """Periods 0.1, 0.1, 0.2 s give 7.5 Hz, min 0.1, max 0.2, and a window of 3 periods."""
-    stats = graph.rate_statistics([0.0, 0.1, 0.2, 0.4])
-    assert stats.rate == pytest.approx(7.5)
-    assert (stats.min_period, stats.max_period) == pytest.approx((0.1, 0.2))
-    assert stats.std_dev == pytest.approx(np.std([0.1, 0.1, 0.2]))
-    assert stats.samples == 3
-    assert graph.rate_statistics([0.0, 0.1, 0.2, 0.4], window=1).rate == pytest.approx(5.0)
-    with pytest.raises(ValueError, match="at least two"):
-        graph.rate_statistics([1.0])
-
-
-def test_layered_layout_is_layered_and_survives_cycles():
-    """Sources sit left of what they feed; a cycle does not stop the layout or make it random."""
-    edges = [("cam", "/image"), ("/image", "detector"), ("detector", "/markers"),
-             ("/markers", "viewer"), ("viewer", "/image")]
-    layout = graph.layered_layout(edges)
-    assert graph.layered_layout(list(reversed(edges))) == layout
-    assert layout["cam"][0] < layout["/image"][0] < layout["detector"][0] < layout["/markers"][0]
-    assert len({position for position in layout.values()}) == len(layout)
-
-
-def test_format_message_prints_like_ros2_topic_echo():
-    """YAML with quoting where needed, nested fields indented, long arrays cut with '...'."""
-    assert graph.format_message(String(data="a: b")) == "data: 'a: b'\n"
-    image = Image(height=1, width=200, encoding="mono8", step=200, data=bytes(range(200)))
-    text = graph.format_message(image, truncate_length=3)
-    assert "header:\n  stamp:\n    sec: 0\n" in text
-    assert "data:\n- 0\n- 1\n- 2\n- '...'\n" in text
-    assert graph.message_to_dict(image, truncate_length=None)["data"] == list(range(200))
-
-
-def test_echo_options_shorten_strings_and_arrays_like_ros2_topic_echo():
-    """Long strings are cut like arrays; --no-arr and --no-str leave only types and lengths."""
-    image = Image(height=1, width=4, encoding="mono8", step=4, data=bytes(4))
-    assert graph.message_to_dict(String(data="abcdef"), truncate_length=3) == {"data": "abc..."}
-    assert graph.message_to_dict(String(data="abcdef"), no_str=True) == {"data": "<string length: <6>>"}
-    assert graph.message_to_dict(image, no_arr=True)["data"] == "<sequence type: uint8, length: 4>"
-    assert graph.message_to_dict(image, no_arr=True)["encoding"] == "mono8"
-
-
-def test_fill_message_reads_values_the_way_ros2_topic_pub_does():
-    """Nested dicts, lists of messages, ints for floats, and `header: auto` become a message."""
-    from geometry_msgs.msg import PolygonStamped
-
-    msg = PolygonStamped()
-    setters = graph.fill_message(msg, {"header": "auto", "polygon": {"points": [{"x": 1, "y": 2.5}, {}]}})
-    assert [(point.x, point.y) for point in msg.polygon.points] == [(1.0, 2.5), (0.0, 0.0)]
-    assert len(setters) == 1
-    setters[0](graph.message_class("builtin_interfaces/msg/Time")(sec=7))
-    assert msg.header.stamp.sec == 7
-    image = Image()
-    graph.fill_message(image, {"data": [1, 2, 3], "encoding": "mono8"})
-    assert list(image.data) == [1, 2, 3] and image.encoding == "mono8"
-
-
-@pytest.mark.parametrize("values, message", [
-    ({"dta": 5}, "has no field 'dta'; its fields are: data"),
-    ({"data": "five"}, "data is a int32 and cannot take 'five'"),
-    ([5], "The message is a std_msgs/msg/Int32 and needs a dictionary of its fields"),
-])
-def test_fill_message_names_the_field_that_does_not_fit(values, message):
-    from std_msgs.msg import Int32
-
-    with pytest.raises(ValueError, match=message):
-        graph.fill_message(Int32(), values)
-
-
 def test_node_info_lists_topics_and_services_like_ros2_node_info(local_session):
     """A talker's info shows its publisher, its parameter services and empty sections."""
     session.add_node(Talker(name="info_talker", topic="info_chatter"))
@@ -301,16 +211,6 @@ def test_node_info_lists_topics_and_services_like_ros2_node_info(local_session):
     assert text.endswith("  Action Servers:\n\n  Action Clients:\n\n")
     with pytest.raises(ValueError, match="Unable to find node '/nobody'"):
         graph.node_info("/nobody", timeout=0.2)
-
-
-def test_message_class_reads_both_name_forms_and_names_the_missing_package():
-    """'std_msgs/msg/String' and 'std_msgs/String' both work; a missing package names its pip."""
-    assert graph.message_class("std_msgs/msg/String") is String
-    assert graph.message_class("std_msgs/String") is String
-    with pytest.raises(ValueError, match="ros-jazzy-nope-msgs"):
-        graph.message_class("nope_msgs/msg/Thing")
-    with pytest.raises(ValueError, match="package/msg/Type"):
-        graph.message_class("String")
 
 
 def test_wait_for_publisher_says_plainly_that_nothing_publishes(local_session):

@@ -9,8 +9,8 @@ import sys
 
 import pytest
 
-from autograder import config, grading, guard
-from course_lib.checks import harness
+from autograder import config, guard, release
+from course_lib.checks import runner
 
 
 @pytest.fixture(scope="module")
@@ -20,7 +20,7 @@ def course(tmp_path_factory):
     from autograder import gradebook
 
     root = tmp_path_factory.mktemp("course")
-    grading.release(root, ["pubsub"])
+    release.release(root, ["pubsub"])
     for folder in ("submitted", "autograded"):
         (root / folder / "alice" / "pubsub").mkdir(parents=True)
         shutil.copy(root / "release" / "pubsub" / "pubsub.ipynb", root / folder / "alice" / "pubsub")
@@ -57,8 +57,8 @@ def test_formgrader_autograde_button_refuses(course):
 
 def test_exporter_works_under_the_graders_flag(monkeypatch):
     """With the flag the grader sets for its sandboxed run, nbgrader gets a working exporter."""
-    monkeypatch.setenv(harness.OUTSIDE_ENV, "1")
+    monkeypatch.setenv(runner.OUTSIDE_ENV, "1")
     assert guard.GraderOnlyExporter().file_extension == ".ipynb"
-    monkeypatch.delenv(harness.OUTSIDE_ENV)
+    monkeypatch.delenv(runner.OUTSIDE_ENV)
     with pytest.raises(Exception, match="python -m autograder grade"):
         guard.GraderOnlyExporter()

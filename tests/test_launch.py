@@ -19,7 +19,7 @@ from pathlib import Path
 import psutil
 import pytest
 
-from course_lib import graph, launch, rosenv, session, workspace
+from course_lib import colcon, graph, launch, pkg_create, rosenv, rqt_graph, session, workspace
 from launch_demo import CHATTER_NODE, CHATTER_SOURCE, make_prefix
 
 EVERY_TAG = """\
@@ -166,7 +166,7 @@ def test_every_tag_brings_up_the_expected_graph_and_ctrl_c_ends_it(prefix, ros_d
         nodes = graph.node_list(wait_for=["/r2/talker", "/other/listener"], timeout=40)
         assert nodes == ["/other/listener", "/r2/talker"], f"nodes: {nodes}"
         topics = graph.topic_list(types=True, wait_for=["/r2/chatter", "/r2/answers", "/other/heard"], timeout=20)
-        assert [(name, kinds) for name, kinds in topics if name not in graph.DEFAULT_HIDDEN_TOPICS] == [
+        assert [(name, kinds) for name, kinds in topics if name not in rqt_graph.DEFAULT_HIDDEN_TOPICS] == [
             ("/other/heard", ["std_msgs/msg/String"]), ("/r2/answers", ["std_msgs/msg/String"]),
             ("/r2/chatter", ["std_msgs/msg/String"])]
         assert parameters_of("/r2/talker", ["gain", "rate", "camera.width", "camera.frame"]) == {
@@ -298,7 +298,7 @@ def tutorial_ws(tmp_path_factory):
     """An ament_python package with a talker (launch_demo's node) and the same launch file as XML
     and YAML, installed to share/launch_tutorial/launch by setup.py, built once with the real colcon."""
     ws = tmp_path_factory.mktemp("launch_ws")
-    package = workspace.create_package(ws, "launch_tutorial", dependencies=["rclpy", "std_msgs"], node_name="talker")
+    package = pkg_create.create_package(ws, "launch_tutorial", dependencies=["rclpy", "std_msgs"], node_name="talker")
     (package / "launch_tutorial" / "talker.py").write_text(CHATTER_SOURCE)
     (package / "launch").mkdir()
     (package / "launch" / "talk.launch.xml").write_text(TALK_XML)
@@ -308,7 +308,7 @@ def tutorial_ws(tmp_path_factory):
     assert installed in setup
     launch_files = "('share/' + package_name + '/launch', ['launch/talk.launch.xml', 'launch/talk.launch.yaml']),"
     (package / "setup.py").write_text(setup.replace(installed, f"{installed}\n        {launch_files}"))
-    workspace.build(ws, timeout=600)
+    colcon.build(ws, timeout=600)
     return ws
 
 

@@ -11,13 +11,15 @@ files (its %%writefile cells).
 from __future__ import annotations
 
 import json
+import os
 import re
 import subprocess
 from pathlib import Path
 
+import lesson_answers
 import pytest
 
-from course_lib import processes, workspace
+from course_lib import colcon, pkg_create, processes, rosenv, session, workspace
 
 NOTEBOOKS = Path(__file__).resolve().parents[1] / "notebooks"
 LESSON = "02b_packages_launch_parameters.ipynb"
@@ -62,6 +64,39 @@ COMMANDS_00 = {
 }
 
 
+LESSON_02 = "02_images_and_brightness.ipynb"
+
+#: Lesson 02's commands, in order (its exercise builds the package brightness in the same
+#: workspace as lesson 02b's image_stats; the node file is a right answer to the exercise).
+COMMANDS_02 = {
+    "ros2 topic info -v /brightness": r"^Type: std_msgs/msg/UInt8\n\nPublisher count: 1\n\n"
+                                      r"((?!Subscription count).*\n)*  Reliability: BEST_EFFORT\n",
+    "cd {WS}/src && ros2 pkg create --build-type ament_python brightness --dependencies rclpy sensor_msgs std_msgs":
+        r"package name: brightness\n(.*\n)*dependencies: \['rclpy', 'sensor_msgs', 'std_msgs'\]",
+    'grep "<depend>" {WS}/src/brightness/package.xml': r"^  <depend>rclpy</depend>\n  <depend>sensor_msgs</depend>\n"
+                                                       r"  <depend>std_msgs</depend>\n$",
+    "cd {WS} && colcon build --symlink-install --packages-select brightness 2>&1 | tail -n 3":
+        r"Summary: 1 package finished",
+    "ros2 pkg executables brightness": r"^brightness brightness_node\n$",
+    "ros2 run brightness brightness_node --ros-args -r /image:=/camera/image_raw": None,
+    "ros2 topic echo /brightness --once": r"^data: \d+\n---\n$",
+}
+
+LESSON_01 = "01_publisher_subscriber.ipynb"
+
+#: Lesson 01's commands, in order, while its talker (a process) and listener (in the notebook) run.
+COMMANDS_01 = {
+    "ros2 node list": r"^/listener\n/talker\n$",
+    "ros2 topic info /chatter": r"^Type: std_msgs/msg/String\nPublisher count: 1\nSubscription count: 1\n$",
+    "ros2 interface show geometry_msgs/msg/Twist": r"^Vector3  linear\n\tfloat64 x\n(.*\n)*Vector3  angular\n",
+}
+
+#: Lesson 01b's commands are not run here: they need its interface package, whose colcon build
+#: (ament_cmake and rosidl) takes about 35 s on its own; tests/test_workspace.py builds the same
+#: message and runs its nodes.
+UNCHECKED_01B = ["ros2 interface show tutorial_interfaces/msg/MsgTutorial", "ros2 node list", "ros2 topic list -t"]
+
+
 def shown_commands(notebook: str) -> list[str]:
     """The `!` lines of the code cells and the lines of the ```bash blocks, in order; repeats get #2, #3..."""
     commands = []
@@ -97,6 +132,19 @@ def run_shell(command: str, ws: Path, env: dict) -> str:
     return done.stdout + done.stderr  # what the terminal shows (ros2 param set prints a refusal to stderr)
 
 
+def run_together(commands, ws: Path, env: dict) -> dict[str, str]:
+    """{command: output} of commands started at once (most of a `ros2` command's time is waiting for
+    discovery, so side by side they take little longer than one)."""
+    running = {command: subprocess.Popen(["bash", "-c", command.split("#")[0].replace("{WS}", str(ws))], env=env,
+                                         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                                         stdin=subprocess.DEVNULL) for command in commands}
+    outputs = {}
+    for command, process in running.items():
+        outputs[command], _ = process.communicate(timeout=120)
+        assert process.returncode == 0, f"{command}\n{outputs[command]}"
+    return outputs
+
+
 def check(command: str, output: str, commands: dict = COMMANDS_02B) -> None:
     pattern = commands[command]
     assert re.search(pattern, output, re.M), f"`{command}` printed:\n{output}"
@@ -105,8 +153,6 @@ def check(command: str, output: str, commands: dict = COMMANDS_02B) -> None:
 @pytest.fixture(scope="module")
 def built(tmp_path_factory):
     """The lesson's workspace built by the lesson's own commands and files: (ws, sourced environment)."""
-    import os
-
     root = tmp_path_factory.mktemp("lesson02b")
     ws = root / "packages_ws"
     (ws / "src").mkdir(parents=True)
@@ -119,19 +165,34 @@ def built(tmp_path_factory):
                 (root / path).parent.mkdir(parents=True, exist_ok=True)
                 (root / path).write_text(text)
         outputs[command] = run_shell(command, ws, env)
+    # Lesson 02's exercise: the package brightness, in the same workspace, with a right answer.
+    files = lesson_files(LESSON_02)
+    files["brightness_ws/src/brightness/brightness/brightness_node.py"] = lesson_answers.brightness_node()
+    files["brightness_ws/src/brightness/setup.py"] = lesson_answers.brightness_setup(
+        files["brightness_ws/src/brightness/setup.py"])
+    for command in shown_commands(LESSON_02)[1:5]:
+        if command.startswith("cd {WS} && colcon"):
+            for path, text in files.items():
+                (ws / Path(path).relative_to("brightness_ws")).write_text(text)
+        if command.startswith("ros2 pkg executables"):
+            env = workspace.workspace_environment(ws)
+        outputs[command] = run_shell(command, ws, env)
     return ws, workspace.workspace_environment(ws), outputs
 
 
 def test_every_command_shown_is_checked():
     assert shown_commands(LESSON) == list(COMMANDS_02B)
     assert shown_commands(LESSON_00) == list(COMMANDS_00)
+    assert shown_commands(LESSON_01) == list(COMMANDS_01)
+    assert shown_commands("01b_custom_messages.ipynb") == UNCHECKED_01B
+    assert shown_commands(LESSON_02) == list(COMMANDS_02)
     assert shown_commands("03_aruco_and_homography.ipynb") == []
 
 
 def test_create_and_build_commands(built):
     ws, env, outputs = built
     for command, output in outputs.items():
-        check(command, output)
+        check(command, output, COMMANDS_02B if command in COMMANDS_02B else COMMANDS_02)
     command = "ros2 pkg executables image_stats"
     check(command, run_shell(command, ws, env))
 
@@ -141,16 +202,21 @@ def start(command: str, env: dict) -> processes.NodeProcess:
 
 
 def test_ros2_run_with_remapping_and_topic_echo(built):
+    """Lesson 02b's nodes, and lesson 02's brightness node on the same camera."""
     ws, env, _ = built
     camera = start("ros2 run image_stats camera --ros-args -r image:=/camera/image_raw -p rate:=10.0", env)
     node = start("ros2 run image_stats dark_fraction --ros-args -r /image:=/camera/image_raw", env)
+    brightness = start(next(c for c in COMMANDS_02 if c.startswith("ros2 run")), env)
     try:
         node.wait_for_node("dark_fraction", timeout=30)
         camera.wait_for_node("image_publisher", timeout=30)
-        for command in ("ros2 topic list -t", "ros2 topic echo /dark_fraction --once"):
-            check(command, run_shell(command, ws, env))
+        brightness.wait_for_node("brightness_node", timeout=30)
+        outputs = run_together(["ros2 topic list -t", "ros2 topic echo /dark_fraction --once",
+                                "ros2 topic echo /brightness --once", "ros2 topic info -v /brightness"], ws, env)
+        for command, output in outputs.items():
+            check(command, output, COMMANDS_02B if command in COMMANDS_02B else COMMANDS_02)
     finally:
-        processes.stop_together([camera, node])
+        processes.stop_together([camera, node, brightness])
 
 
 def test_launch_file_and_parameter_commands(built):
@@ -171,14 +237,35 @@ def test_launch_file_and_parameter_commands(built):
 def test_lesson_00_commands(tmp_path):
     """The lesson's package built as the lesson builds it, its node running: the ! lines print what it shows."""
     ws = tmp_path / "ros2_ws"
-    workspace.create_package(ws, "my_package", dependencies=["rclpy"], node_name="my_node")
+    pkg_create.create_package(ws, "my_package", dependencies=["rclpy"], node_name="my_node")
     (ws / "src/my_package/my_package/my_node.py").write_text(lesson_files(LESSON_00)["ros2_ws/src/my_package/my_package/my_node.py"])
-    workspace.build(ws, ["my_package"])
+    colcon.build(ws, ["my_package"])
     env = workspace.workspace_environment(ws)
     node = workspace.run(ws, "my_package", "my_node")
     try:
         node.wait_for_node("my_node", timeout=30)
-        for command in COMMANDS_00:
-            check(command, run_shell(command, ws, env), COMMANDS_00)
+        for command, output in run_together(COMMANDS_00, ws, env).items():
+            check(command, output, COMMANDS_00)
     finally:
         node.stop()
+
+
+def test_lesson_01_commands(tmp_path):
+    """The lesson's talker (its own file, as a process) and a listener in this process, as in the
+    notebook: the ! lines print what the lesson shows."""
+    from rclpy.node import Node
+    from std_msgs.msg import String
+
+    (tmp_path / "talker.py").write_text(lesson_files(LESSON_01)["nodes_01/talker.py"])
+    talker = processes.python_node("talker:main", name="talker", cwd=tmp_path)
+    session.start()
+    try:
+        heard = []
+        listener = session.add_node(Node("listener"))
+        listener.create_subscription(String, "chatter", heard.append, 10)
+        session.wait_for(lambda: heard, timeout=30)  # as the lesson: the listener has heard the talker
+        for command, output in run_together(COMMANDS_01, tmp_path, rosenv.ros_environment()).items():
+            check(command, output, COMMANDS_01)
+    finally:
+        session.stop()
+        talker.stop()

@@ -24,7 +24,11 @@ def _classes_and_functions(sources: list[str]) -> str:
     """The class and function definitions of these cells (without the cells' other statements)."""
     kept = []
     for source in sources:
-        source = "\n".join(line for line in source.splitlines() if not line.startswith(("%", "!")))
+        if source.startswith("%%writefile"):  # a file of a package, not the notebook's code
+            continue
+        # IPython's ! and % lines are no Python: a `pass` in their place keeps an `if` around them valid.
+        source = "\n".join(line[:len(line) - len(line.lstrip())] + "pass" if line.lstrip().startswith(("%", "!"))
+                           else line for line in source.splitlines())
         tree = ast.parse(source)
         kept += [ast.get_source_segment(source, node) for node in tree.body
                  if isinstance(node, (ast.ClassDef, ast.FunctionDef, ast.Import, ast.ImportFrom))]
@@ -56,3 +60,32 @@ def test_lesson_02_states_the_light_period_of_its_camera():
     assert stated == round(period)
     low, high = map(int, re.search(r"period of (\d+) to (\d+) seconds", text).groups())
     assert low <= period <= high
+
+
+def test_every_lesson_ends_with_a_summary_that_links_the_next_lesson_and_names_its_assignment():
+    lessons = sorted(NOTEBOOKS.glob("*.ipynb"))
+    for lesson, following in zip(lessons, lessons[1:] + [None]):
+        last = _cells(lesson, "markdown")[-1]
+        assert last.startswith("## Summary"), lesson.name
+        if following is not None:
+            assert f"]({following.name})" in last, f"{lesson.name} does not link {following.name}"
+        else:
+            assert "the last lesson" in last, lesson.name
+        assert re.search(r"[*`](pubsub|brightness|catdog_warp)[*`]|has none", last), f"{lesson.name} names no assignment"
+
+
+def test_lesson_02_exercise_uses_the_names_its_self_check_and_the_brightness_assignment_use():
+    """Package brightness, executable brightness_node, started on a remapped /image, echoing /brightness."""
+    from course_lib import selfcheck
+
+    package, executable = selfcheck.BRIGHTNESS_PACKAGE, selfcheck.BRIGHTNESS_EXECUTABLE
+    code = "\n".join(_cells(LESSON_02, "code"))
+    assert f"%%writefile brightness_ws/src/{package}/{package}/{executable}.py" in code
+    assert f"%%writefile brightness_ws/src/{package}/setup.py" in code
+    assert (f"ros2 pkg create --build-type ament_python {package} --dependencies rclpy sensor_msgs std_msgs"
+            in code)
+    assert f'["ros2", "run", "{package}", "{executable}",\n' in code
+    assert '"--ros-args", "-r", "/image:=/camera/image_raw"]' in code
+    assert "!ros2 topic echo /brightness --once" in code
+    text = "\n".join(_cells(LESSON_02, "markdown"))
+    assert f"ros2 run {package} {executable} --ros-args -r /image:=/camera/image_raw" in text

@@ -5,7 +5,7 @@ import yaml
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.node import Node
 
-from course_lib import graph, parameters, session
+from course_lib import discovery, parameters, session
 
 
 class Tunable(Node):
@@ -28,7 +28,7 @@ class Tunable(Node):
 
 @pytest.fixture
 def tunable(domain_id, monkeypatch):
-    monkeypatch.setattr(graph, "SETTLE_SECONDS", 0.0)
+    monkeypatch.setattr(discovery, "SETTLE_SECONDS", 0.0)
     session.start(domain_id=domain_id)
     try:
         yield session.add_node(Tunable())

@@ -8,14 +8,13 @@ import os
 import signal
 import subprocess
 import sys
-import time
-import uuid
 
-import psutil
 import pytest
+from process_support import marker, processes_with, sleeper, wait_until
 
 from course_lib import processes
 from course_lib.processes import Limits, NodeProcess, python_node
+
 
 TALKER = '''
 import rclpy
@@ -49,45 +48,6 @@ def main(args=None):
         rclpy.try_shutdown()
         print("talker shut down cleanly", flush=True)
 '''
-
-
-def marker() -> str:
-    """A token that appears only in the command lines of one test's processes."""
-    return f"course-lib-test-{uuid.uuid4().hex}"
-
-
-def processes_with(token: str) -> list[psutil.Process]:
-    found = []
-    for process in psutil.process_iter(["cmdline", "status"]):
-        try:
-            if process.info["status"] != psutil.STATUS_ZOMBIE and any(
-                    token in part for part in process.info["cmdline"] or ()):
-                found.append(process)
-        except (psutil.NoSuchProcess, psutil.AccessDenied):
-            pass
-    return found
-
-
-def wait_until(condition, timeout: float = 10.0) -> bool:
-    """Poll `condition` until it holds or `timeout` passes; return its last value."""
-    deadline = time.monotonic() + timeout
-    while not (result := condition()) and time.monotonic() < deadline:
-        time.sleep(0.05)
-    return result
-
-
-def sleeper(token: str, seconds: int = 100) -> list[str]:
-    """A python child that sleeps and carries `token` in its command line."""
-    return [sys.executable, "-c", f"import time; print('ready', flush=True); time.sleep({seconds})", token]
-
-
-@pytest.fixture
-def token():
-    """A unique marker for the test's processes; survivors of a failed test are killed."""
-    value = marker()
-    yield value
-    for leftover in processes_with(value):
-        leftover.kill()
 
 
 @pytest.fixture
@@ -202,41 +162,6 @@ def test_missing_program_raises_file_not_found():
         NodeProcess(["course-lib-no-such-program"]).start()
 
 
-def test_child_that_ignores_sigint_is_killed_after_the_timeout(token):
-    code = "import signal, time; signal.signal(signal.SIGINT, signal.SIG_IGN); print('ready', flush=True); time.sleep(100)"
-    process = NodeProcess([sys.executable, "-c", code, token]).start()
-    assert wait_until(lambda: "ready" in process.log), process.log
-    assert process.stop(timeout=0.5) == -signal.SIGKILL
-    assert "SIGKILL" in process.describe_exit()
-    assert processes_with(token) == []
-
-
-def sleeper_script(token: str) -> str:
-    """A shell line that runs a sleeping python carrying `token` (python -S starts fast)."""
-    return f"{sys.executable} -S -c 'import time; time.sleep(100)' {token}"
-
-
-def sleepers(token: str) -> list[psutil.Process]:
-    return [p for p in processes_with(token) if p.info["cmdline"][-1] == token]
-
-
-def test_grandchildren_are_killed_by_stop_even_if_they_left_the_group(token):
-    """sh's background children, one in its process group and one in a new session, die with it."""
-    run = sleeper_script(token)
-    process = NodeProcess(["sh", "-c", f"{run} & setsid {run} & echo started; exec {run}"]).start()
-    assert wait_until(lambda: len(sleepers(token)) == 3), process.log
-    process.stop(timeout=2)
-    assert processes_with(token) == []
-
-
-def test_leftovers_die_when_the_child_exits_on_its_own(token):
-    """A child that exits normally does not leave its background processes running."""
-    process = NodeProcess(["sh", "-c", f"{sleeper_script(token)} & echo started"]).start()
-    assert process.wait(timeout=30) == 0
-    assert "started" in process.log
-    assert processes_with(token) == []
-
-
 def test_wait_for_node_names_the_exit_code_of_a_crashing_child(domain_id):
     code = "import sys; print('about to fail', flush=True); sys.exit(3)"
     process = NodeProcess([sys.executable, "-c", code], domain_id=domain_id).start()
@@ -251,50 +176,6 @@ def test_wait_for_node_times_out_with_the_log_tail(domain_id, token):
             process.wait_for_node("talker", timeout=0.5)
         assert process.running()
     assert processes_with(token) == []
-
-
-def test_loud_child_does_not_block_and_its_log_is_bounded():
-    """64 MB of output: the child finishes, the log keeps head and tail, memory stays small."""
-    code = ("import sys\nsys.stdout.write('first line\\n')\nline = 'x' * 1023 + '\\n'\n"
-            "for _ in range(64 * 1024):\n    sys.stdout.write(line)\nsys.stdout.write('last line\\n')\n")
-    process = NodeProcess([sys.executable, "-c", code]).start()
-    assert process.wait(timeout=120) == 0
-    log = process.log
-    assert log.startswith("first line\n") and log.endswith("last line\n")
-    assert "bytes of output omitted" in log
-    assert len(log) <= processes.LOG_HEAD_BYTES + processes.LOG_TAIL_BYTES + 100
-    assert process.usage["supervisor_max_rss_kb"] < 100 * 1024  # it streamed, it did not buffer
-
-
-def test_on_output_gets_stdout_and_stderr_apart_as_they_arrive():
-    """on_output sees each stream's own bytes; the log still has both."""
-    pieces = []
-    code = "import sys\nprint('to out', flush=True)\nprint('to err', file=sys.stderr, flush=True)\n"
-    process = NodeProcess([sys.executable, "-c", code],
-                          on_output=lambda stream, data: pieces.append((stream, data))).start()
-    assert process.wait(timeout=10) == 0
-    assert wait_until(lambda: len(pieces) >= 2)
-    assert b"".join(data for stream, data in pieces if stream == "stdout") == b"to out\n"
-    assert b"".join(data for stream, data in pieces if stream == "stderr") == b"to err\n"
-    assert "to out" in process.log and "to err" in process.log
-
-
-def test_a_slow_on_output_never_blocks_the_child():
-    """A callback that stalls loses echoed output (and is told how much), not the child's time."""
-    pieces = []
-
-    def slow(stream, data):
-        if not pieces:
-            time.sleep(1.0)
-        pieces.append(data)
-
-    code = ("import sys, time\nstart = time.monotonic()\nfor _ in range(4096):\n"
-            "    sys.stdout.write('x' * 1023 + '\\n')\nprint(f'took {time.monotonic() - start:.3f}')\n")
-    process = NodeProcess([sys.executable, "-c", code], on_output=slow).start()
-    assert process.wait(timeout=20) == 0
-    took = float(process.log.rsplit("took ", 1)[1])
-    assert took < 0.9  # it wrote 4 MB without waiting for the stalled callback
-    assert wait_until(lambda: b"bytes of output not shown" in b"".join(pieces), timeout=5)
 
 
 def test_log_survives_stop_and_its_files_are_removed():
@@ -350,99 +231,10 @@ def test_starting_a_named_process_again_replaces_the_old_one():
         second.stop()
 
 
-CALLER = """
-import os, signal, sys, time
-import rclpy
-from course_lib.processes import NodeProcess
-# Like a notebook kernel, the caller runs DDS threads. Without rclpy's signal handlers, so that
-# SIGTERM ends it (rclpy's handler would only shut the context down and keep the caller alive).
-rclpy.init(signal_handler_options=rclpy.signals.SignalHandlerOptions.NO)
-node = rclpy.create_node("caller")
-process = NodeProcess([sys.executable, "-c", "import time; time.sleep(100)", sys.argv[2]]).start()
-print("started", flush=True)
-if sys.argv[1] == "exit":
-    sys.exit(0)  # no stop(): atexit must do it
-if sys.argv[1] == "exception":
-    with process:
-        raise KeyboardInterrupt
-time.sleep(100)
-"""
-
-
-@pytest.mark.parametrize("ending", ["exit", "exception", "SIGTERM", "SIGKILL"])
-def test_children_never_outlive_their_caller(ending, token):
-    """However a caller running rclpy ends (exit, KeyboardInterrupt, SIGTERM, SIGKILL), its child dies."""
-    caller = subprocess.Popen([sys.executable, "-c", CALLER, ending, token], stdout=subprocess.PIPE,
-                              stderr=subprocess.PIPE, text=True)
-    try:
-        assert caller.stdout.readline() == "started\n", caller.stderr.read()
-        if ending.startswith("SIG"):
-            assert processes_with(token)
-            caller.send_signal(getattr(signal, ending))
-        caller.wait(timeout=30)
-        assert wait_until(lambda: not processes_with(token), timeout=10), processes_with(token)
-    finally:
-        caller.kill()
-        caller.wait()
-
-
-def test_wall_limit_stops_a_sleeper(token):
-    process = NodeProcess(sleeper(token), limits=Limits(wall_seconds=0.5, grace_seconds=1)).start()
-    code = process.wait(timeout=30)
-    assert process.exit_reason == "wall_seconds"
-    assert code != 0 and "wall-time limit of 0.5 s" in process.describe_exit()
-    assert processes_with(token) == []
-
-
-def test_memory_limit_stops_a_child_that_allocates_too_much():
-    code = "block = bytearray(400 * 1024 * 1024); print('allocated', flush=True)"
-    process = NodeProcess([sys.executable, "-c", code], limits=Limits(memory_mb=200)).start()
-    assert process.wait(timeout=30) != 0
-    assert "MemoryError" in process.log and "allocated" not in process.log
-
-
-def test_cpu_limit_ends_a_busy_loop_with_sigxcpu():
-    process = NodeProcess([sys.executable, "-c", "while True: pass"], limits=Limits(cpu_seconds=1)).start()
-    assert process.wait(timeout=60) == -signal.SIGXCPU
-    assert "CPU time limit" in process.describe_exit()
-
-
 @pytest.mark.parametrize("field", ["wall_seconds", "memory_mb", "max_processes"])
 def test_limits_refuse_non_positive_values(field):
     with pytest.raises(ValueError, match=f"Limits.{field}.*positive"):
         Limits(**{field: 0})
-
-
-needs_root = pytest.mark.skipif(os.geteuid() != 0, reason="dropping to another user needs root")
-
-
-@needs_root
-def test_child_runs_as_the_limits_user_with_a_process_limit():
-    """As root, Limits.user makes RLIMIT_NPROC bite: the child cannot fork past it."""
-    import pwd
-
-    nobody = pwd.getpwnam("nobody")
-    script = "id -u; for i in 1 2 3 4 5 6 7 8; do sleep 1 & done; wait; echo done"
-    process = NodeProcess(["sh", "-c", script], cwd="/",
-                          limits=Limits(user="nobody", max_processes=4)).start()
-    process.wait(timeout=60)
-    lines = process.log.splitlines()
-    assert lines[0] == str(nobody.pw_uid)
-    assert "fork" in process.log.lower() or "resource temporarily unavailable" in process.log.lower(), process.log
-
-
-@needs_root
-def test_child_runs_as_a_bare_uid_without_a_passwd_entry():
-    """Limits.user may be a number with no account behind it: the child gets that uid and gid."""
-    import pwd
-
-    uid = 61999
-    with pytest.raises(KeyError):
-        pwd.getpwuid(uid)
-    process = NodeProcess(["sh", "-c", "id -u; id -g; touch \"$HOME/written\" && echo home-ok"], cwd="/",
-                          limits=Limits(user=uid)).start()
-    process.wait(timeout=30)
-    assert process.log.split() == [str(uid), str(uid), "home-ok"], process.log
 
 
 def test_wait_for_output_sees_a_line_and_reports_an_early_exit():

@@ -25,11 +25,11 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 from sensor_msgs.msg import Image
 
-from course_lib import images, rosenv, scenes, workspace
+from course_lib import images, marker_board, pictures, rosenv, scenes, workspace
 
 SOURCE = Path(__file__).resolve().parents[1] / "assignments" / "reference_ws" / "src"
 PACKAGES = ("webcam", "readmarker")
-BOARD_IDS = tuple(i for ids in scenes.PICTURES.values() for i in ids)
+BOARD_IDS = tuple(i for ids in marker_board.PICTURES.values() for i in ids)
 
 sys.path.insert(0, str(SOURCE / "readmarker"))  # the package's modules, as colcon would install them
 from readmarker.crop import crop_pictures, find_markers  # noqa: E402
@@ -75,9 +75,9 @@ def test_crops_match_the_expected_crops_on_easy_and_hard_scenes():
                 assert crop.shape == (240, 320, 3) and crop.dtype == np.uint8
                 # Markers a little smaller than scenes.MIN_MARKER_SIDE are often found too; then
                 # they must at least be printed, uncovered and in the frame.
-                assert set(scenes.PICTURES[name]) <= set(scene.visible_ids), f"{difficulty} seed {seed} {name}"
-                score = scenes.crop_similarity(crop, expected[name])
-                assert score >= scenes.SAME_CROP_THRESHOLD, f"{difficulty} seed {seed} {name}: {score:.3f}"
+                assert set(marker_board.PICTURES[name]) <= set(scene.visible_ids), f"{difficulty} seed {seed} {name}"
+                score = marker_board.crop_similarity(crop, expected[name])
+                assert score >= marker_board.SAME_CROP_THRESHOLD, f"{difficulty} seed {seed} {name}: {score:.3f}"
     # The sample really exercises the claim (it has 16 easy and 18 hard fully framed pictures).
     assert framed["easy"] >= 12 and framed["hard"] >= 12 and found >= sum(framed.values()), (framed, found)
 
@@ -89,7 +89,7 @@ def test_crop_size_is_width_by_height():
     assert sorted(crops) == ["cat", "dog"]
     for name, crop in crops.items():
         assert crop.shape == (90, 160, 3)
-        assert scenes.crop_similarity(crop, expected[name]) >= scenes.SAME_CROP_THRESHOLD
+        assert marker_board.crop_similarity(crop, expected[name]) >= marker_board.SAME_CROP_THRESHOLD
 
 
 @pytest.mark.parametrize("marker_id", BOARD_IDS)
@@ -98,7 +98,7 @@ def test_a_picture_missing_one_marker_is_absent(marker_id, how):
     option = {"missing_markers" if how == "missing" else "occluded_markers": (marker_id,)}
     scene = scenes.render_scene(20 + marker_id, **option)
     crops = crop_pictures(scene.frame)
-    incomplete = next(name for name, ids in scenes.PICTURES.items() if marker_id in ids)
+    incomplete = next(name for name, ids in marker_board.PICTURES.items() if marker_id in ids)
     assert incomplete not in crops
     for name in scene.fully_framed:
         assert name in crops
@@ -107,12 +107,12 @@ def test_a_picture_missing_one_marker_is_absent(marker_id, how):
 @pytest.mark.parametrize("printed", range(9))
 def test_boards_with_zero_to_eight_markers_give_the_complete_pictures(printed):
     scene = scenes.render_scene(6, missing_markers=BOARD_IDS[printed:])
-    complete = [name for name, ids in scenes.PICTURES.items() if set(ids) <= set(BOARD_IDS[:printed])]
+    complete = [name for name, ids in marker_board.PICTURES.items() if set(ids) <= set(BOARD_IDS[:printed])]
     assert sorted(crop_pictures(scene.frame)) == sorted(complete)
 
 
 def test_of_a_duplicated_id_the_largest_instance_counts():
-    marker = cv2.aruco.generateImageMarker(scenes.dictionary(), 3, 60)
+    marker = cv2.aruco.generateImageMarker(marker_board.dictionary(), 3, 60)
     frame = np.full((300, 400), 255, np.uint8)
     frame[40:100, 40:100] = marker
     frame[120:240, 200:320] = cv2.resize(marker, (120, 120), interpolation=cv2.INTER_NEAREST)
@@ -127,7 +127,7 @@ def test_of_a_duplicated_id_the_largest_instance_counts():
 def test_duplicated_marker_ids_do_not_crash(seed, difficulty, duplicates):
     scene = scenes.render_scene(seed, difficulty=difficulty, duplicate_markers=duplicates)
     crops = crop_pictures(scene.frame)
-    assert set(crops) <= set(scenes.PICTURES)
+    assert set(crops) <= set(marker_board.PICTURES)
     for crop in crops.values():
         assert crop.shape == (240, 320, 3) and crop.dtype == np.uint8
 
@@ -140,7 +140,7 @@ def test_tiny_and_full_hd_frames(size):
     expected = scene.expected_crops()
     for name, crop in crops.items():
         assert crop.shape == (240, 320, 3)
-        assert scenes.crop_similarity(crop, expected[name]) >= scenes.SAME_CROP_THRESHOLD
+        assert marker_board.crop_similarity(crop, expected[name]) >= marker_board.SAME_CROP_THRESHOLD
     if size == (1920, 1080):
         assert sorted(crops) == ["cat", "dog"]
 
@@ -162,7 +162,7 @@ def test_grey_frames_give_bgr_crops_of_the_same_pictures():
         assert sorted(crops) == ["cat", "dog"]
         for name, crop in crops.items():
             assert crop.shape == (240, 320, 3)
-            assert scenes.crop_similarity(crop, expected[name]) >= scenes.SAME_CROP_THRESHOLD
+            assert marker_board.crop_similarity(crop, expected[name]) >= marker_board.SAME_CROP_THRESHOLD
 
 
 @pytest.mark.parametrize("frame, size, message", [
@@ -210,7 +210,7 @@ def test_marker_reader_accepts_bgr_rgb_mono_and_skips_bad_images(built_ws, domai
     for index, (_, msg) in enumerate(sequence):
         msg.header.stamp.sec = index + 1
 
-    received = {name: [] for name in scenes.PICTURES}
+    received = {name: [] for name in marker_board.PICTURES}
     context = rclpy.Context()
     rclpy.init(context=context, domain_id=domain_id)
     try:
@@ -249,8 +249,8 @@ def test_marker_reader_accepts_bgr_rgb_mono_and_skips_bad_images(built_ws, domai
         mono = crops["mono8"]
         assert np.array_equal(mono[:, :, 0], mono[:, :, 1]), "a grey image gives a grey crop"
         for encoding, crop in crops.items():
-            score = scenes.crop_similarity(crop, expected[name])
-            assert score >= scenes.SAME_CROP_THRESHOLD, f"{name} from {encoding}: {score:.3f}"
+            score = marker_board.crop_similarity(crop, expected[name])
+            assert score >= marker_board.SAME_CROP_THRESHOLD, f"{name} from {encoding}: {score:.3f}"
 
 
 def test_an_unknown_dictionary_is_refused_with_the_choices(built_ws, domain_id):
@@ -300,7 +300,7 @@ class Pipeline:
 
     def __init__(self):
         self.camera = self.reader = self.context = None
-        self.crops = {name: [] for name in scenes.PICTURES}
+        self.crops = {name: [] for name in marker_board.PICTURES}
         self.input_stamps = set()
 
     def start(self, ws, domain_id):
@@ -357,7 +357,7 @@ def test_built_nodes_deliver_png_crops_stamped_like_their_frames(pipeline):
     def stamped_crops(name):
         return [msg for msg in pipeline.crops[name] if stamp_of(msg) in pipeline.input_stamps]
 
-    assert pipeline.spin_until(lambda: all(len(stamped_crops(name)) >= 3 for name in scenes.PICTURES)), (
+    assert pipeline.spin_until(lambda: all(len(stamped_crops(name)) >= 3 for name in marker_board.PICTURES)), (
         f"crops received: { {n: len(m) for n, m in pipeline.crops.items()} }, frames: {len(pipeline.input_stamps)}"
         f"\nmarker_reader log:\n{pipeline.reader.log_tail()}")
     first_frame = min(pipeline.input_stamps)
@@ -369,8 +369,8 @@ def test_built_nodes_deliver_png_crops_stamped_like_their_frames(pipeline):
         crop = images.compressed_to_image(messages[-1])
         assert crop.shape == (240, 320, 3) and crop.dtype == np.uint8
         # The simulated camera films the drawn board: the crop shows the drawn picture.
-        drawn = scenes.draw_cat() if name == "cat" else scenes.draw_dog()
-        assert scenes.crop_similarity(crop, drawn) >= scenes.SAME_CROP_THRESHOLD
+        drawn = pictures.draw_cat() if name == "cat" else pictures.draw_dog()
+        assert marker_board.crop_similarity(crop, drawn) >= marker_board.SAME_CROP_THRESHOLD
 
 
 @pytest.mark.slow

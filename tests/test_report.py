@@ -7,14 +7,15 @@ import csv
 import dataclasses
 import json
 
-from autograder import grading, report
+from autograder import report, store
+from autograder.result import GradeResult
 
 
 def _recorded(course, student, assignment, score, **fields):
-    result = grading.GradeResult(student, assignment, "digest", score=score, max_score=10, **fields)
-    folder = grading.state_dir(course, student, assignment)
+    result = GradeResult(student, assignment, "digest", score=score, max_score=10, **fields)
+    folder = store.state_dir(course, student, assignment)
     folder.mkdir(parents=True)
-    (folder / grading.STATE_FILE).write_text(json.dumps(dataclasses.asdict(result)))
+    (folder / store.STATE_FILE).write_text(json.dumps(dataclasses.asdict(result)))
     return result
 
 
@@ -49,9 +50,9 @@ def test_reason_for_the_student_and_note_for_the_instructor(tmp_path):
 
 def test_results_of_an_older_grader_are_read(tmp_path):
     """A state file without the newer fields (detail) and with a field no longer known still reads."""
-    folder = grading.state_dir(tmp_path, "alice", "pubsub")
+    folder = store.state_dir(tmp_path, "alice", "pubsub")
     folder.mkdir(parents=True)
-    (folder / grading.STATE_FILE).write_text(json.dumps({"student": "alice", "assignment": "pubsub", "digest": "d",
+    (folder / store.STATE_FILE).write_text(json.dumps({"student": "alice", "assignment": "pubsub", "digest": "d",
                                                           "score": 5.0, "max_score": 10.0, "retired": 1}))
     report.write_report(tmp_path)
     assert _rows(tmp_path)["alice", "pubsub"]["score"] == "5"

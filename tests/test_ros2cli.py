@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from course_lib import processes, rosenv, workspace
+from course_lib import colcon, processes, rosenv, workspace
 
 ROS2 = Path(sys.executable).parent / "ros2"
 
@@ -325,7 +325,7 @@ def test_pkg_create_build_and_run(tmp_path, domain_id):
     setup.write_text(setup.read_text().replace("'hello = demo_pkg.hello:main',",
                                                "'hello = demo_pkg.hello:main',\n"
                                                "            'spinner = demo_pkg.spinner:main',"))
-    workspace.build(tmp_path / "ws", timeout=300)
+    colcon.build(tmp_path / "ws", timeout=300)
     env = workspace.workspace_environment(tmp_path / "ws", domain_id=domain_id)
     assert ros2("pkg", "executables", "demo_pkg", env=env).stdout == "demo_pkg hello\ndemo_pkg spinner\n"
     assert ros2("run", "demo_pkg", "hello", env=env).stdout == "Hi from demo_pkg.\n"

@@ -9,7 +9,7 @@ import rclpy
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 
-from course_lib import graph, rosenv, session
+from course_lib import discovery, graph, rosenv, session
 
 
 class Counter(Node):
@@ -50,7 +50,7 @@ def no_session_left():
 @pytest.fixture
 def quick_graph(monkeypatch):
     """graph queries without the discovery wait: these tests only look at in-process nodes."""
-    monkeypatch.setattr(graph, "SETTLE_SECONDS", 0.0)
+    monkeypatch.setattr(discovery, "SETTLE_SECONDS", 0.0)
 
 
 def test_start_twice_is_idempotent(domain_id):

@@ -19,8 +19,9 @@ from pathlib import Path
 import nbformat
 import pytest
 
-from autograder import grading, reference
-from course_lib.checks import harness
+import autograder.release
+from autograder import reference
+from course_lib.checks import registry, runner
 
 REPO = Path(__file__).resolve().parent.parent
 ASSIGNMENTS = ["brightness", "pubsub", "catdog_warp"]
@@ -104,7 +105,7 @@ def _text(data: bytes) -> str | None:
 @pytest.fixture(scope="module")
 def release(tmp_path_factory) -> Path:
     course = tmp_path_factory.mktemp("course")
-    grading.release(course, ASSIGNMENTS)
+    autograder.release.release(course, ASSIGNMENTS)
     return course / "release"
 
 
@@ -173,8 +174,8 @@ def test_untouched_release_earns_nothing(release, tmp_path, monkeypatch, assignm
     packages.build_here(assignment, tmp_path)
     monkeypatch.setenv(packages.REPORT_ENV, str(packages.report_path(tmp_path)))
     verdicts = []
-    for name in harness.checks_of(assignment):
-        result = harness.execute(assignment, name, 7, workdir=tmp_path, mode="graded")
+    for name in registry.checks_of(assignment):
+        result = runner.execute(assignment, name, 7, workdir=tmp_path, mode="graded")
         verdicts.append("\n".join(result.verdict_lines()))
         assert result.points == 0, verdicts[-1]
     assert "NotImplementedError" in "\n".join(verdicts)

@@ -68,7 +68,7 @@ def _rows(path: Path, key=("student_id", "assignment")) -> dict:
 
 @pytest.fixture(scope="module")
 def term(tmp_path_factory):
-    from autograder import config, grading
+    from autograder import config, store
 
     course = tmp_path_factory.mktemp("term") / "course"
     downloads = tmp_path_factory.mktemp("downloads")
@@ -86,7 +86,7 @@ def term(tmp_path_factory):
     collected = _run("collect", str(course), "pubsub", str(pubsub)).stdout
     _run("collect", str(course), "brightness", str(brightness))
     graded = _run("grade", str(course), "--workers", "2")
-    results = {(r.student, r.assignment): r for r in grading.recorded_results(course)}
+    results = {(r.student, r.assignment): r for r in store.recorded_results(course)}
     return {"course": course, "collected": collected, "results": results, "grade_output": graded.stdout + graded.stderr}
 
 

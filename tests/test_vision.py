@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from course_lib import scenes, vision
+from course_lib import marker_board, scenes, vision
 
 SQUARE = np.array([[20, 20], [60, 20], [60, 60], [20, 60]], dtype=np.float32)
 
@@ -25,7 +25,7 @@ def test_draw_markers_colours_each_corner_number_differently():
 
 def test_draw_markers_accepts_detector_output_of_a_real_scene():
     scene = scenes.render_scene(1)
-    corners, ids, _ = scenes.detector().detectMarkers(scene.frame)
+    corners, ids, _ = marker_board.detector().detectMarkers(scene.frame)
     annotated = vision.draw_markers(scene.frame, corners, ids)
     assert (annotated != scene.frame).any()
 

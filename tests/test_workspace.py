@@ -1,11 +1,10 @@
-"""Tests for course_lib.workspace: package layout, real colcon builds, nodes run from a workspace.
+"""Tests for course_lib.workspace: a built workspace sourced and its nodes run (and the real colcon build of it).
 
 The slow tests share one workspace, built once per test run by the `built_ws` fixture: the
 interface package tutorial_interfaces (msg/MsgTutorial.msg) and the ament_python package
 tutorial_nodes that uses it.
 """
 
-import ast
 import os
 import re
 import signal
@@ -13,12 +12,11 @@ import subprocess
 import sys
 import threading
 import time
-import xml.etree.ElementTree as ElementTree
 from pathlib import Path
 
 import pytest
 
-from course_lib import rosenv, workspace
+from course_lib import colcon, pkg_create, rosenv, workspace
 
 MSG_TUTORIAL = "builtin_interfaces/Time stamp\nint32 data\n"
 
@@ -95,8 +93,8 @@ def main(args=None):
 
 
 def make_tutorial_workspace(ws: Path) -> None:
-    workspace.create_interface_package(ws, "tutorial_interfaces", {"MsgTutorial": MSG_TUTORIAL})
-    package = workspace.create_package(ws, "tutorial_nodes", dependencies=["rclpy", "tutorial_interfaces"],
+    pkg_create.create_interface_package(ws, "tutorial_interfaces", {"MsgTutorial": MSG_TUTORIAL})
+    package = pkg_create.create_package(ws, "tutorial_nodes", dependencies=["rclpy", "tutorial_interfaces"],
                                        node_name=["hello_node", "topic_publisher", "topic_subscriber"])
     (package / "tutorial_nodes" / "topic_publisher.py").write_text(PUBLISHER)
     (package / "tutorial_nodes" / "topic_subscriber.py").write_text(SUBSCRIBER)
@@ -107,7 +105,7 @@ def built_ws(tmp_path_factory):
     """A workspace with tutorial_interfaces and tutorial_nodes, built once with the real colcon."""
     ws = tmp_path_factory.mktemp("tutorial_ws")
     make_tutorial_workspace(ws)
-    result = workspace.build(ws, timeout=600)
+    result = colcon.build(ws, timeout=600)
     print(f"\ncolcon built {result.finished} in {result.seconds:.1f} s")
     return ws
 
@@ -122,100 +120,7 @@ def wait_for_log(process, pattern: str, count: int, timeout: float) -> list[re.M
         time.sleep(0.1)
 
 
-# --- layout (fast) -----------------------------------------------------------------------------
-
-def test_create_package_lays_out_an_ament_python_package(tmp_path):
-    package = workspace.create_package(tmp_path, "my_nodes", dependencies=["rclpy", "std_msgs"],
-                                       node_name="talker")
-    assert package == tmp_path / "src" / "my_nodes"
-    for relative in ["package.xml", "setup.py", "setup.cfg", "resource/my_nodes", "my_nodes/__init__.py",
-                     "my_nodes/talker.py", "test/test_copyright.py", "test/test_flake8.py",
-                     "test/test_pep257.py"]:
-        assert (package / relative).is_file(), relative
-    assert (package / "resource/my_nodes").read_text() == ""
-
-    root = ElementTree.parse(package / "package.xml").getroot()
-    assert root.tag == "package" and root.get("format") == "3"
-    assert root.findtext("name") == "my_nodes"
-    assert [d.text for d in root.findall("depend")] == ["rclpy", "std_msgs"]
-    assert [d.text for d in root.findall("test_depend")] == ["ament_copyright", "ament_flake8", "ament_pep257",
-                                                             "python3-pytest"]
-    assert root.findtext("export/build_type") == "ament_python"
-
-    setup = ast.parse((package / "setup.py").read_text())
-    call = next(node for node in ast.walk(setup) if isinstance(node, ast.Call)
-                and getattr(node.func, "id", None) == "setup")
-    keywords = {k.arg: k.value for k in call.keywords}
-    entry_points = ast.literal_eval(keywords["entry_points"])
-    assert entry_points == {"console_scripts": ["talker = my_nodes.talker:main"]}
-    assert "resource/" in ast.unparse(keywords["data_files"]) and "package.xml" in ast.unparse(keywords["data_files"])
-
-    cfg = (package / "setup.cfg").read_text()
-    assert "[develop]\nscript_dir=$base/lib/my_nodes" in cfg and "[install]\ninstall_scripts=$base/lib/my_nodes" in cfg
-    node = (package / "my_nodes/talker.py").read_text()
-    compile(node, "talker.py", "exec")
-    assert "Node started!" in node and "rclpy.try_shutdown()" in node and "with rclpy.init" not in node
-
-
-def test_create_package_refuses_to_overwrite_but_can_rerun(tmp_path):
-    package = workspace.create_package(tmp_path, "my_nodes", dependencies=["rclpy"], node_name="talker")
-    (package / "my_nodes/talker.py").write_text("# my own work\n")
-    with pytest.raises(FileExistsError, match="exist_ok=True"):
-        workspace.create_package(tmp_path, "my_nodes")
-    workspace.create_package(tmp_path, "my_nodes", dependencies=["rclpy", "std_msgs"], node_name="talker",
-                             exist_ok=True)
-    assert (package / "my_nodes/talker.py").read_text() == "# my own work\n"
-    assert "<depend>std_msgs</depend>" in (package / "package.xml").read_text()
-
-
-def test_write_python_package_puts_the_package_where_asked_with_ros2_pkg_creates_node(tmp_path):
-    """Any folder, the files written listed in order, and the plain main of `ros2 pkg create`."""
-    written = workspace.write_python_package(tmp_path / "here", "demo", dependencies=["rclpy"],
-                                             node_name="hello", rclpy_node=False)
-    assert written[0] == tmp_path / "here" / "package.xml"
-    assert written[-1] == tmp_path / "here" / "demo" / "hello.py"
-    assert "print('Hi from demo.')" in written[-1].read_text()
-    assert "<depend>rclpy</depend>" in written[0].read_text()
-
-
-@pytest.mark.parametrize("name", ["MyNodes", "2nodes", "my-nodes", ""])
-def test_invalid_package_names_are_refused_with_the_rule(tmp_path, name):
-    with pytest.raises(ValueError, match="lower case"):
-        workspace.create_package(tmp_path, name)
-
-
-def test_only_ament_python_packages_are_created_by_create_package(tmp_path):
-    with pytest.raises(ValueError, match="create_interface_package"):
-        workspace.create_package(tmp_path, "my_nodes", build_type="ament_cmake")
-
-
-def test_create_interface_package_declares_the_generators(tmp_path):
-    package = workspace.create_interface_package(tmp_path, "tutorial_interfaces", {"MsgTutorial": MSG_TUTORIAL})
-    assert (package / "msg/MsgTutorial.msg").read_text() == MSG_TUTORIAL
-    cmake = (package / "CMakeLists.txt").read_text()
-    assert "find_package(rosidl_default_generators REQUIRED)" in cmake
-    assert "find_package(builtin_interfaces REQUIRED)" in cmake
-    assert re.search(r'rosidl_generate_interfaces\(\$\{PROJECT_NAME\}\s+"msg/MsgTutorial.msg"\s+'
-                     r"DEPENDENCIES builtin_interfaces\s*\)", cmake), cmake
-    assert "ament_export_dependencies(rosidl_default_runtime)" in cmake
-    root = ElementTree.parse(package / "package.xml").getroot()
-    assert root.get("format") == "3"
-    assert [d.text for d in root.findall("buildtool_depend")] == ["ament_cmake", "rosidl_default_generators"]
-    assert [d.text for d in root.findall("exec_depend")] == ["rosidl_default_runtime"]
-    assert [d.text for d in root.findall("depend")] == ["builtin_interfaces"]
-    assert root.findtext("member_of_group") == "rosidl_interface_packages"
-    assert root.findtext("export/build_type") == "ament_cmake"
-
-
-def test_message_names_must_be_camel_case(tmp_path):
-    with pytest.raises(ValueError, match="CamelCase"):
-        workspace.create_interface_package(tmp_path, "my_interfaces", {"msg_tutorial": "int32 data"})
-
-
-def test_build_without_src_names_the_fix(tmp_path):
-    with pytest.raises(FileNotFoundError, match="create_package"):
-        workspace.build(tmp_path)
-
+# --- running (fast) ----------------------------------------------------------------------------
 
 def _fake_install(ws: Path) -> None:
     lib = ws / "install" / "demo" / "lib" / "demo"
@@ -310,7 +215,7 @@ def test_use_workspace_imports_messages_in_a_running_interpreter(built_ws):
     # A fresh interpreter whose LD_LIBRARY_PATH knows nothing of the workspace, like a kernel
     # started before the build.
     code = ("import sys\n"
-            "from course_lib import workspace\n"
+            "from course_lib import colcon, pkg_create, workspace\n"
             f"print(workspace.use_workspace({str(built_ws)!r}))\n"
             "from tutorial_interfaces.msg import MsgTutorial\n"
             "from rclpy.serialization import serialize_message, deserialize_message\n"
@@ -354,33 +259,3 @@ def test_command_line_build_prints_what_to_source(built_ws):
     assert done.returncode == 0, done.stdout + done.stderr
     assert "Finished <<< tutorial_nodes" in done.stdout
     assert f"source {built_ws / 'install' / 'setup.bash'}" in done.stdout
-
-
-@pytest.mark.slow
-def test_broken_package_gives_a_build_error_with_the_log_tail(tmp_path):
-    package = workspace.create_interface_package(tmp_path, "broken_interfaces", {"Broken": "int32 data"})
-    cmake = package / "CMakeLists.txt"
-    # Early in the file, so that CMake fails within seconds instead of after generating code.
-    cmake.write_text(cmake.read_text().replace("find_package(ament_cmake REQUIRED)",
-                                               "find_package(ament_cmake REQUIRED)\nthis_command_does_not_exist()"))
-    with pytest.raises(workspace.BuildError) as caught:
-        workspace.build(tmp_path, timeout=300)
-    message = str(caught.value)
-    assert "failed in package 'broken_interfaces'" in message
-    assert "this_command_does_not_exist" in message  # from the tail of the package's log
-    assert caught.value.result.failed == ["broken_interfaces"] and caught.value.result.returncode != 0
-
-
-@pytest.mark.slow
-def test_command_line_build_failure_exits_nonzero(tmp_path):
-    package = workspace.create_package(tmp_path, "bad_python_pkg")
-    (package / "setup.py").write_text("raise SystemExit('setup.py is broken on purpose')\n")
-    done = subprocess.run([sys.executable, "-m", "course_lib", "build", str(tmp_path)],
-                          capture_output=True, text=True, timeout=300, env=rosenv.ros_environment())
-    assert done.returncode == 1
-    assert "failed in package 'bad_python_pkg'" in done.stderr
-
-
-def test_build_errors_name_a_missing_cmake_package_and_its_wheel():
-    log = ('Could not find a package configuration file provided by "rosidl_core_generators" with any')
-    assert "pip install ros-jazzy-rosidl-core-generators==0.2.0" in workspace._hint(log)

@@ -1,7 +1,7 @@
 """The answers a check compares a student's results with: the grader's, or recorded from the grader's.
 
 A check asks ``ctx.expected("average_brightness", image)``. Where the answer comes from depends on
-how the check runs (MODE_ENV, set by harness.execute):
+how the check runs (MODE_ENV, set by runner.execute):
 
 - ``graded`` (the grader, fresh seeds): the grader's answer key, the function of that name in
   ``autograder.answers.<assignment>``. It lives only on the instructor's side: students'

@@ -22,8 +22,10 @@ import time
 
 import numpy as np
 
-from course_lib.checks import harness, packages
-from course_lib.checks.harness import check
+from course_lib.checks import packages, runner
+from course_lib.checks.context import Context
+from course_lib.checks.registry import check
+from course_lib.checks.student_processes import student_env
 
 ASSIGNMENT = "brightness"
 #: The package and executable of the node: ``ros2 run brightness brightness_node``.
@@ -32,12 +34,12 @@ PACKAGE, EXECUTABLE = "brightness", "brightness_node"
 
 def selfcheck(name: str):
     """Run check `name` with the self-check seed and print what is right and wrong."""
-    return harness.selfcheck(ASSIGNMENT, name)
+    return runner.selfcheck(ASSIGNMENT, name)
 
 
 def grade(name: str):
     """Run check `name` with a fresh seed (grading)."""
-    return harness.grade(ASSIGNMENT, name)
+    return runner.grade(ASSIGNMENT, name)
 
 
 def _test_images(rng: np.random.Generator) -> list[tuple[str, np.ndarray]]:
@@ -55,7 +57,7 @@ def _test_images(rng: np.random.Generator) -> list[tuple[str, np.ndarray]]:
 
 
 @check(points=4, timeout=45)
-def values(ctx: harness.Context) -> None:
+def values(ctx: Context) -> None:
     """average_brightness returns the floor of the mean byte, as an int, for colour and grey images."""
     cases = _test_images(ctx.rng)
     outcomes = ctx.call("average_brightness", [((image,), {}) for _, image in cases])
@@ -235,7 +237,7 @@ def _consequences(ctx, cause: str, done: int) -> None:
 
 
 @check(points=7, timeout=90)
-def node(ctx: harness.Context) -> None:
+def node(ctx: Context) -> None:
     """BrightnessNode: name my_node, /image -> /brightness with sensor-data QoS, bgr8 and mono8, 30 Hz at 1080p, remappable."""
     # Every input is drawn first: what is drawn must not depend on how the run goes (the
     # self-check's answers were recorded for exactly these inputs).
@@ -345,7 +347,7 @@ def _start_yardstick(ctx):
 
     return processes.python_node("course_lib.checks.brightness:yardstick_main", "--ros-args",
                                  "-r", "frames:=/image", "-r", f"answers:={YARDSTICK_ANSWERS}",
-                                 name="brightness-yardstick", domain_id=ctx.domain_id, env=harness._student_env())
+                                 name="brightness-yardstick", domain_id=ctx.domain_id, env=student_env())
 
 
 def yardstick_main(args=None) -> None:

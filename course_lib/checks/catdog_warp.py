@@ -1,9 +1,9 @@
 """Checks of the catdog_warp assignment: ``crop_pictures`` and ``MarkerReader``, on generated scenes.
 
 The contract (also in the notebook and in assignments/README.md); the board convention is
-course_lib.scenes' (markers of DICT_4X4_50; "cat" framed by markers 1-4, "dog" by 5-8, in the
+course_lib.marker_board's (markers of DICT_4X4_50; "cat" framed by markers 1-4, "dog" by 5-8, in the
 order top-left, top-right, bottom-right, bottom-left; the picture's corners are those marker
-corners that touch it, scenes.CORNER_OF_MARKER):
+corners that touch it, marker_board.CORNER_OF_MARKER):
 
 - ``crop_pictures(frame_bgr, size=(320, 240)) -> dict``: ``{"cat": crop, "dog": crop}`` with a
   key only when all four of that picture's markers are found; each crop is a BGR uint8 image of
@@ -20,7 +20,7 @@ The packages (``ros2_ws/src``): ``catdog_interfaces`` (the message), ``webcam`` 
 ``launch/catdog_warp.launch.xml`` starting both nodes).
 
 Crops are compared with the ground truth of the generated scene (Scene.expected_crops) by
-scenes.crop_similarity, passing at scenes.SAME_CROP_THRESHOLD; colours are checked separately
+marker_board.crop_similarity, passing at marker_board.SAME_CROP_THRESHOLD; colours are checked separately
 (crop_similarity compares grey levels, so a red/blue swap would pass it).
 """
 
@@ -30,8 +30,9 @@ import time
 
 import numpy as np
 
-from course_lib.checks import harness, packages
-from course_lib.checks.harness import check
+from course_lib.checks import packages, runner
+from course_lib.checks.context import Context, clip
+from course_lib.checks.registry import check
 
 ASSIGNMENT = "catdog_warp"
 #: The message of a crop: which picture (CAT = 1, DOG = 2) and the crop.
@@ -44,12 +45,12 @@ COLOUR_TOLERANCE = 20.0
 
 def selfcheck(name: str):
     """Run check `name` with the self-check seed and print what is right and wrong."""
-    return harness.selfcheck(ASSIGNMENT, name)
+    return runner.selfcheck(ASSIGNMENT, name)
 
 
 def grade(name: str):
     """Run check `name` with a fresh seed (grading)."""
-    return harness.grade(ASSIGNMENT, name)
+    return runner.grade(ASSIGNMENT, name)
 
 
 def _seed(ctx) -> int:
@@ -58,7 +59,7 @@ def _seed(ctx) -> int:
 
 def compare_crop(ctx, label: str, crop, expected, show: bool = False) -> bool:
     """One item: the student's crop is the expected picture (shape, dtype, content, colours)."""
-    from course_lib import scenes
+    from course_lib import marker_board
 
     if not isinstance(crop, np.ndarray):
         return ctx.item(False, f"{label}: the crop is a {type(crop).__name__}, not a numpy image")
@@ -66,18 +67,18 @@ def compare_crop(ctx, label: str, crop, expected, show: bool = False) -> bool:
     if crop.shape != want or crop.dtype != np.uint8:
         hint = " (size is (width, height): warpPerspective(frame, H, size))" if crop.shape[:2] == want[1::-1] else ""
         return ctx.item(False, f"{label}: crop has shape {crop.shape} {crop.dtype}, expected {want} uint8{hint}")
-    similarity = scenes.crop_similarity(crop, expected)
+    similarity = marker_board.crop_similarity(crop, expected)
     if show:
         ctx.image(f"{label}: yours ({similarity:.2f})", crop)
         ctx.image(f"{label}: expected", expected)
-    if similarity < scenes.SAME_CROP_THRESHOLD:
+    if similarity < marker_board.SAME_CROP_THRESHOLD:
         hints = []
         for name, variant in (("mirrored left-right", crop[:, ::-1]), ("upside down", crop[::-1, ::-1]),
                               ("flipped top-bottom", crop[::-1])):
-            if scenes.crop_similarity(variant, expected) >= scenes.SAME_CROP_THRESHOLD:
+            if marker_board.crop_similarity(variant, expected) >= marker_board.SAME_CROP_THRESHOLD:
                 hints.append(f"it is the expected picture {name}: check the order of the four corners "
                              "(top-left, top-right, bottom-right, bottom-left) on both sides of the warp")
-        return ctx.item(False, f"{label}: similarity {similarity:.2f} < {scenes.SAME_CROP_THRESHOLD}"
+        return ctx.item(False, f"{label}: similarity {similarity:.2f} < {marker_board.SAME_CROP_THRESHOLD}"
                                + (f"; {hints[0]}" if hints else ""))
     mine, theirs = crop.reshape(-1, 3).mean(axis=0), expected.reshape(-1, 3).mean(axis=0)
     if np.abs(mine - theirs).max() > COLOUR_TOLERANCE:
@@ -88,7 +89,7 @@ def compare_crop(ctx, label: str, crop, expected, show: bool = False) -> bool:
 
 
 def _check_scene(ctx, label: str, scene, outcome, show: bool = False) -> None:
-    from course_lib import scenes
+    from course_lib import marker_board
 
     if not outcome.ok:
         hint = " (replace `raise NotImplementedError()` with your code)" if outcome.error.startswith("NotImplementedError") else ""
@@ -98,13 +99,13 @@ def _check_scene(ctx, label: str, scene, outcome, show: bool = False) -> None:
     if not isinstance(result, dict):
         ctx.item(False, f"{label}: crop_pictures returned a {outcome.pytype}, not a dict like {{'cat': crop}}")
         return
-    unknown = sorted(set(result) - set(scenes.PICTURES))
+    unknown = sorted(set(result) - set(marker_board.PICTURES))
     if unknown:
         ctx.item(False, f"{label}: unexpected keys {unknown}; the keys are 'cat' and 'dog'")
     expected = scene.expected_crops(SIZE) if scene is not None else {}
     framed = scene.fully_framed if scene is not None else ()
     visible = set(scene.visible_ids) if scene is not None else set()
-    for name, markers in scenes.PICTURES.items():
+    for name, markers in marker_board.PICTURES.items():
         if name in framed:
             if name not in result:
                 ctx.item(False, f"{label}: no '{name}' although its markers {markers} are all in view")
@@ -125,7 +126,7 @@ def _run_scenes(ctx, cases, show_first: bool = True) -> None:
 
 
 @check(points=3, timeout=60)
-def easy(ctx: harness.Context) -> None:
+def easy(ctx: Context) -> None:
     """crop_pictures finds and warps both pictures on easy (mildly tilted) views."""
     from course_lib import scenes
 
@@ -133,7 +134,7 @@ def easy(ctx: harness.Context) -> None:
 
 
 @check(points=2, timeout=60)
-def hard(ctx: harness.Context) -> None:
+def hard(ctx: Context) -> None:
     """crop_pictures on hard views: steep, rotated, partly off-frame; only fully framed pictures."""
     from course_lib import scenes
 
@@ -148,15 +149,15 @@ def hard(ctx: harness.Context) -> None:
 
 
 @check(points=2, timeout=60)
-def missing_and_none(ctx: harness.Context) -> None:
+def missing_and_none(ctx: Context) -> None:
     """A picture with any one of its markers missing is left out; frames without markers give an empty dict."""
-    from course_lib import scenes
+    from course_lib import marker_board, scenes
 
     # Every marker is the missing one once, in every grading: scene k lacks the k-th marker of
     # each picture (so a solution that looks at only some of a picture's markers always loses).
     cases = []
     for k in range(4):
-        gone = [ids[k] for ids in scenes.PICTURES.values()]
+        gone = [ids[k] for ids in marker_board.PICTURES.values()]
         cases.append((f"markers {gone} missing", scenes.render_scene(_seed(ctx), difficulty="easy", missing_markers=gone)))
     cases.append(("no markers on the board", scenes.render_scene(_seed(ctx), difficulty="easy",
                                                                  missing_markers=list(range(1, 9)))))
@@ -172,12 +173,12 @@ def missing_and_none(ctx: harness.Context) -> None:
 
 
 @check(points=1, timeout=60)
-def noisy(ctx: harness.Context) -> None:
+def noisy(ctx: Context) -> None:
     """crop_pictures copes with sensor noise, blur and JPEG artefacts, and with another crop size."""
-    from course_lib import scenes
+    from course_lib import camera_views, scenes
 
     base = scenes.render_scene(_seed(ctx), difficulty="easy")
-    look = scenes.Look(noise=7.0, blur=1.0, jpeg_quality=60, gain=0.9)
+    look = camera_views.Look(noise=7.0, blur=1.0, jpeg_quality=60, gain=0.9)
     scene = scenes.render_scene(_seed(ctx), difficulty="easy", pose=base.pose, look=look)
     small = (200, 150)
     outcomes = ctx.call("crop_pictures", [((scene.frame,), {"size": list(SIZE)}),
@@ -194,7 +195,7 @@ def noisy(ctx: harness.Context) -> None:
 
 
 @check(points=3, timeout=90)
-def node(ctx: harness.Context) -> None:
+def node(ctx: Context) -> None:
     """marker_reader: node marker_reader turns frames on image into CroppedPicture messages on cropped_img."""
     from course_lib import images, scenes
     from rclpy.qos import QoSProfile, ReliabilityPolicy
@@ -219,7 +220,7 @@ def node(ctx: harness.Context) -> None:
             names = lambda: {n for n, _ in probe.node.get_node_names_and_namespaces()}  # noqa: E731
             probe.spin_until(lambda: "marker_reader" in names() or not proc.running(), 25.0)
             if not proc.running():
-                ctx.item(False, f"the node process ended ({proc.describe_exit()}):\n{harness.clip(proc.log_tail(6))}")
+                ctx.item(False, f"the node process ended ({proc.describe_exit()}):\n{clip(proc.log_tail(6))}")
                 return
             if not ctx.precondition("marker_reader" in names(), "node marker_reader runs" if "marker_reader" in names() else
                             f"no node named marker_reader (nodes: {sorted(names())})"):
@@ -242,7 +243,7 @@ def node(ctx: harness.Context) -> None:
             ctx.item(False, f"no {name} (picture = {PICTURE_NUMBERS[name]}) arrived on /cropped_img within 8 s" +
                      (f" (it carries {seen}; the contract says {wanted[0]})" if seen and seen != wanted else
                       "" if seen else f" (topics: {sorted(t for t in types if not t.startswith(('/rosout', '/parameter')))})") +
-                     "; the node's output:\n" + harness.clip(proc.log_tail(4)))
+                     "; the node's output:\n" + clip(proc.log_tail(4)))
             continue
         try:
             crop = images.compressed_to_image(got[name][-1], want="bgr8")

@@ -4,7 +4,7 @@ An assignment's work is a colcon workspace beside the notebook (``ros2_ws/src/<p
 written by the notebook's ``%%writefile`` cells). The checks
 
 - call plain functions (``average_brightness``, ``crop_pictures``) from the package's source,
-  without a build (harness.Context.call, with the module named in :data:`FUNCTION_MODULES`);
+  without a build (course_lib.checks.context.Context.call, with the module named in :data:`FUNCTION_MODULES`);
 - start executables as ``ros2 run <package> <executable>`` would: the console script colcon
   installed in ``ros2_ws/install/<package>/lib/<package>/``, in the environment of
   ``source ros2_ws/install/setup.bash`` (:func:`run`);
@@ -24,7 +24,8 @@ import os
 import xml.etree.ElementTree as ElementTree
 from pathlib import Path
 
-from course_lib.checks import harness
+from course_lib.checks.context import StudentError
+from course_lib.checks.student_processes import student_env as _student_env
 
 #: The workspace folder beside the notebook.
 WORKSPACE = "ros2_ws"
@@ -59,35 +60,34 @@ def package_dir(ctx, package: str) -> Path:
 
 
 def require_build(ctx) -> Path:
-    """The built workspace; raises harness.StudentError with the reason when it is not built."""
+    """The built workspace; raises StudentError with the reason when it is not built."""
     ws = workspace_dir(ctx)
     report = os.environ.get(REPORT_ENV)
     if report:
         data = json.loads(Path(report).read_text())
         if not data["ok"]:
-            raise harness.StudentError(f"your workspace did not build, so this cannot run. {data['reason']}")
+            raise StudentError(f"your workspace did not build, so this cannot run. {data['reason']}")
         return Path(data["workspace"])
     if not (ws / "install" / "setup.bash").is_file():
-        raise harness.StudentError(f"{WORKSPACE} is not built yet: run the notebook's build cell "
+        raise StudentError(f"{WORKSPACE} is not built yet: run the notebook's build cell "
                                    f"(in a terminal: cd {WORKSPACE} && colcon build --symlink-install)")
     return ws
 
 
 def student_env(ctx, ws: Path) -> dict:
     """The environment of the student's processes: ``source ros2_ws/install/setup.bash`` on top of
-    the course's, with harness's removals (the seed, the grader's variables)."""
+    the course's, PYTHONPATH ending with course_lib's (student_processes.student_env)."""
     from course_lib import workspace
 
     if getattr(ctx, "_workspace_env", None) is None:
         try:
             ctx._workspace_env = workspace.workspace_environment(ws, domain_id=ctx.domain_id)
         except (FileNotFoundError, RuntimeError) as error:
-            raise harness.StudentError(str(error)) from None
+            raise StudentError(str(error)) from None
     env = dict(ctx._workspace_env)
-    removals = harness._student_env()
     paths = [p for p in env.get("PYTHONPATH", "").split(os.pathsep) if p]
-    env.update(removals)
-    env["PYTHONPATH"] = os.pathsep.join(paths + [removals["PYTHONPATH"]])
+    env.update(_student_env())
+    env["PYTHONPATH"] = os.pathsep.join(paths + [env["PYTHONPATH"]])
     env[REPORT_ENV] = None
     return env
 
@@ -100,23 +100,22 @@ def run(ctx, package: str, executable: str, *ros_args: str, tag: str = ""):
         The started course_lib.processes.NodeProcess.
 
     Raises:
-        harness.StudentError: the workspace is not built, or has no such package or executable
+        StudentError: the workspace is not built, or has no such package or executable
             (the message lists the executables there are: an entry point missing from setup.py).
     """
-    from course_lib import processes, workspace
+    from course_lib import workspace
 
     ws = require_build(ctx)
     try:
         command = workspace.executable_command(ws, package, executable, ros_args=ros_args)
     except FileNotFoundError as error:
-        raise harness.StudentError(f"`ros2 run {package} {executable}` cannot start: {error}") from None
-    limits = harness._student_limits(ctx.remaining() + 5)
-    return processes.NodeProcess(command, name=f"student-{package}-{executable}{tag}", cwd=ctx.workdir,
-                                 domain_id=ctx.domain_id, limits=limits, env=student_env(ctx, ws)).start()
+        raise StudentError(f"`ros2 run {package} {executable}` cannot start: {error}") from None
+    return ctx.students.start(command, name=f"student-{package}-{executable}{tag}", cwd=ctx.workdir,
+                              domain_id=ctx.domain_id, wall_seconds=ctx.remaining() + 5, env=student_env(ctx, ws))
 
 
 def endpoints(ctx, module: str, class_name: str) -> dict:
-    """harness.Context.endpoints for a class of a built package (its messages need the build)."""
+    """Context.endpoints for a class of a built package (its messages need the build)."""
     ws = require_build(ctx)
     return ctx.endpoints(class_name, module=module, env=student_env(ctx, ws))
 
@@ -199,7 +198,7 @@ def use_interfaces(ctx) -> None:
         else:
             workspace.use_workspace(require_build(ctx))
     except (FileNotFoundError, RuntimeError) as error:
-        raise harness.StudentError(f"the messages of your workspace cannot be loaded: {error}") from None
+        raise StudentError(f"the messages of your workspace cannot be loaded: {error}") from None
 
 
 def message_fields(path: Path) -> list[tuple[str, str]]:

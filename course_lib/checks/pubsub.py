@@ -22,8 +22,9 @@ from __future__ import annotations
 import re
 import time
 
-from course_lib.checks import harness, packages
-from course_lib.checks.harness import check
+from course_lib.checks import packages, runner
+from course_lib.checks.context import Context, StudentError, clip
+from course_lib.checks.registry import check
 
 ASSIGNMENT = "pubsub"
 PACKAGE = "pubsub"
@@ -40,12 +41,12 @@ HEARD = re.compile(r"I heard:.*?stamp\D{0,4}(\d+)(?:\.(\d+))?.*?data\D{0,4}(-?\d
 
 def selfcheck(name: str):
     """Run check `name` with the self-check seed and print what is right and wrong."""
-    return harness.selfcheck(ASSIGNMENT, name)
+    return runner.selfcheck(ASSIGNMENT, name)
 
 
 def grade(name: str):
     """Run check `name` with a fresh seed (grading)."""
-    return harness.grade(ASSIGNMENT, name)
+    return runner.grade(ASSIGNMENT, name)
 
 
 def _stamp_seconds(stamp) -> float:
@@ -58,7 +59,7 @@ def _queue_depth(ctx, module: str, class_name: str, kind: str) -> None:
     class is constructed in a student process of its own and asked."""
     try:
         found = [e for e in packages.endpoints(ctx, module, class_name)[kind] if e["topic"] == TOPIC]
-    except harness.StudentError as error:
+    except StudentError as error:
         ctx.item(False, f"queue depth: {error}")
         return
     if not found:
@@ -75,7 +76,7 @@ def _wait_node(ctx, probe, proc, name: str) -> bool:
                              or not proc.running(), 25.0)
     if not proc.running():
         ctx.item(False, f"the process ended ({proc.describe_exit()}) before node {name} appeared:\n"
-                        f"{harness.clip(proc.log_tail(6))}")
+                        f"{clip(proc.log_tail(6))}")
         return False
     if not found:
         names = sorted(n for n, _ in probe.node.get_node_names_and_namespaces() if not n.startswith("autograder"))
@@ -90,7 +91,7 @@ def _start(ctx, executable: str, tag: str = ""):
 
 
 @check(points=5, timeout=90)
-def publisher(ctx: harness.Context) -> None:
+def publisher(ctx: Context) -> None:
     """topic_publisher: MsgTutorial on ros_tutorial_msg at 10 Hz, data +1 per message, increasing stamps."""
     proc = _start(ctx, "topic_publisher")
     packages.use_interfaces(ctx)
@@ -136,7 +137,7 @@ def publisher(ctx: harness.Context) -> None:
 
 
 @check(points=3, timeout=90)
-def subscriber(ctx: harness.Context) -> None:
+def subscriber(ctx: Context) -> None:
     """topic_subscriber: node topic_subscriber hears every MsgTutorial on ros_tutorial_msg and logs its stamp and data."""
     proc = _start(ctx, "topic_subscriber")
     packages.use_interfaces(ctx)
@@ -181,7 +182,7 @@ def _heard(log: str) -> list[tuple[int, int]]:
 
 
 @check(points=2, timeout=60)
-def together(ctx: harness.Context) -> None:
+def together(ctx: Context) -> None:
     """The subscriber receives what the publisher publishes: consecutive data, none lost."""
     pub = _start(ctx, "topic_publisher")
     sub = _start(ctx, "topic_subscriber")

@@ -1,11 +1,11 @@
-"""Runs a student's code in a process of its own, for a check (autograder.harness.Context).
+"""Runs a student's code in a process of its own, for a check (course_lib.checks.context.Context).
 
 ``python -m course_lib.checks.student call MODULE FUNCTION JOB`` calls a function;
 ``python -m course_lib.checks.student endpoints MODULE CLASS JOB`` constructs a node class and reports
 the QoS of its publishers and subscriptions (what DDS discovery does not tell another process,
 such as the queue depth).
 
-The check that starts it (harness.Context.call) wrote JOB/calls.json and JOB/inputs.npz. This
+The check that starts it (Context.call) wrote JOB/calls.json and JOB/inputs.npz. This
 process imports the student's module from its working directory, touches JOB/imported, then for
 call i writes JOB/i.json (how the value was encoded, or the error) and JOB/i.npz (its arrays)
 as soon as the call returns, so results of earlier calls survive a later hang or crash.

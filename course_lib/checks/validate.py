@@ -14,7 +14,7 @@ from __future__ import annotations
 CELL_TIMEOUT = 30
 
 #: Seconds a graded test cell may run: the longest check plus its start-up. Each check also
-#: bounds itself (harness.Check.timeout); this is the backstop when a kernel stops answering.
+#: bounds itself (registry.Check.timeout); this is the backstop when a kernel stops answering.
 TEST_CELL_TIMEOUT = 150
 
 

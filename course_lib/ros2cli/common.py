@@ -17,7 +17,7 @@ DEFAULT_SPIN_TIME = 0.5
 QUIET_SECONDS = 0.2
 
 #: Seconds after its start up to which a listing verb waits for the nodes of the other ROS
-#: processes on this machine (course_lib.graph.wait_for_discovery counts them).
+#: processes on this machine (course_lib.discovery.wait_for_discovery counts them).
 COMPLETE_SECONDS = 4.0
 
 #: Seconds a verb that names a node or topic waits for discovery to show it, after --spin-time.
@@ -112,17 +112,17 @@ def wait_for_whole_graph(spin_time: float) -> None:
     the nodes of every other ROS process on this machine show (on a busy machine a new process
     can take seconds to discover them all).
     """
-    from course_lib import graph
+    from course_lib import discovery
 
-    graph.wait_for_discovery(minimum=spin_time, quiet=min(QUIET_SECONDS, spin_time),
-                             complete_within=COMPLETE_SECONDS)
+    discovery.wait_for_discovery(minimum=spin_time, quiet=min(QUIET_SECONDS, spin_time),
+                                 complete_within=COMPLETE_SECONDS)
 
 
 def wait_for_named_only() -> None:
     """Before a verb that names its node or topic: no general wait, it waits for that name."""
-    from course_lib import graph
+    from course_lib import discovery
 
-    graph.wait_for_discovery(minimum=0.0, quiet=0.0)
+    discovery.wait_for_discovery(minimum=0.0, quiet=0.0)
 
 
 # --- QoS options (ros2 topic echo / pub) -------------------------------------------------

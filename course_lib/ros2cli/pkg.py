@@ -42,7 +42,7 @@ def _git_email() -> str:
 
 
 def _create(args) -> str | None:
-    from course_lib import workspace
+    from course_lib import pkg_create
 
     if args.build_type != "ament_python":
         default = " (the default)" if args.build_type == "ament_cmake" else ""
@@ -69,7 +69,7 @@ def _create(args) -> str | None:
     print("dependencies:", list(args.dependencies))
     if args.node_name:
         print("node_name:", args.node_name)
-    written = workspace.write_python_package(
+    written = pkg_create.write_python_package(
         package_path, args.package_name, dependencies=args.dependencies, node_name=args.node_name,
         rclpy_node=False, description=args.description, maintainer=args.maintainer_name,
         maintainer_email=email, license=args.license)

@@ -98,7 +98,7 @@ def _echo_arguments(parser) -> None:
 
 
 def _echo(args) -> int | str | None:
-    from course_lib import graph
+    from course_lib import graph, message_yaml
 
     wait_for_named_only()
     field = None if args.field is None else [part for part in args.field.split(".") if part]
@@ -119,7 +119,7 @@ def _echo(args) -> int | str | None:
                 return
         seen["messages"] += 1
         if hasattr(msg, "get_fields_and_field_types"):
-            print(graph.format_message(msg, truncate, args.no_arr, args.no_str), end="---\n")
+            print(message_yaml.format_message(msg, truncate, args.no_arr, args.no_str), end="---\n")
         else:
             print(msg, end="\n---\n")
 
@@ -147,7 +147,7 @@ def _hz_arguments(parser) -> None:
 def _hz(args) -> None:
     from rclpy.qos import qos_profile_sensor_data
 
-    from course_lib import graph
+    from course_lib import graph, rates
 
     wait_for_named_only()
     arrivals: list[float] = []
@@ -161,7 +161,7 @@ def _hz(args) -> None:
         if printed_at[0] is None:
             printed_at[0] = arrivals[0]
         if arrivals[-1] >= printed_at[0] + 1.0:
-            print(graph.rate_statistics(list(arrivals)))
+            print(rates.rate_statistics(list(arrivals)))
             printed_at[0] = arrivals[-1]
         return False
 
@@ -230,14 +230,14 @@ def _pub_arguments(parser) -> None:
 def _pub(args) -> str | None:
     import yaml
 
-    from course_lib import graph, session
+    from course_lib import message_yaml, session
 
     times = 1 if args.once else args.times
     wanted = args.wait_matching_subscriptions
     wanted = int(times != 0) if wanted is None else wanted
     if wanted == 0 and args.max_wait_time_secs is not None:
         return "--max-wait-time-secs option is only effective with --wait-matching-subscriptions, --once or --times"
-    message_class = graph.message_class(args.message_type)  # ValueError names the fix
+    message_class = message_yaml.message_class(args.message_type)  # ValueError names the fix
     try:
         values = yaml.safe_load(args.values)
     except yaml.YAMLError as error:
@@ -246,7 +246,7 @@ def _pub(args) -> str | None:
         return "The passed value needs to be a dictionary in YAML format"
     msg = message_class()
     try:  # before waiting for subscribers (ros2cli fills after): a mistake shows at once
-        stamp_setters = graph.fill_message(msg, values)
+        stamp_setters = message_yaml.fill_message(msg, values)
     except ValueError as error:
         return f"Failed to populate field: {error}"
     node = session.tool_node()

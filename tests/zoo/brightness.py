@@ -81,11 +81,12 @@ def hostile(course_dir: str):
 
 CHEAT = """
 # Fakes the hidden tests from inside the kernel: every check "earns" its full points.
-import course_lib.checks.harness as harness_module
+import course_lib.checks.registry as registry_module
+import course_lib.checks.runner as runner_module
 def full_points(assignment, name, *args, **kwargs):
-    return harness_module.get_check(assignment, name).points
-harness_module.grade = full_points
-harness_module.run_check = full_points
+    return registry_module.get_check(assignment, name).points
+runner_module.grade = full_points
+runner_module.run_check = full_points
 checks.grade = lambda name: full_points("brightness", name)
 print("CHEAT: installed")
 """

@@ -1,13 +1,13 @@
 """Crop the cat and dog pictures out of a camera frame: a plain function of numpy arrays.
 
 The marker convention (dictionary, marker ids per picture, which marker corner touches the
-picture, crop corners) is course_lib.scenes'; this module only applies it:
+picture, crop corners) is course_lib.marker_board's; this module only applies it:
 
 1. detect the ArUco markers in the frame, and look again for board markers that merged with a
    dark picture corner (find_board_markers);
 2. for each picture whose four markers were all found, take the picture's four corners from
-   the markers (scenes.picture_corners);
-3. warp that quadrilateral onto a width x height crop (scenes.crop_corners).
+   the markers (marker_board.picture_corners);
+3. warp that quadrilateral onto a width x height crop (marker_board.crop_corners).
 
 Example::
 
@@ -18,16 +18,16 @@ Example::
 import cv2
 import numpy as np
 
-from course_lib import scenes
+from course_lib import boards, marker_board
 
 _DEFAULT_DETECTOR = None
 
 
 def default_detector():
-    """The course's ArucoDetector (scenes.detector()), made once and reused."""
+    """The course's ArucoDetector (marker_board.detector()), made once and reused."""
     global _DEFAULT_DETECTOR
     if _DEFAULT_DETECTOR is None:
-        _DEFAULT_DETECTOR = scenes.detector()
+        _DEFAULT_DETECTOR = marker_board.detector()
     return _DEFAULT_DETECTOR
 
 
@@ -62,7 +62,7 @@ def find_markers(frame, detector=None):
     ### END SOLUTION
 
 
-_BOARD_IDS = tuple(i for ids in scenes.PICTURES.values() for i in ids)
+_BOARD_IDS = tuple(i for ids in marker_board.PICTURES.values() for i in ids)
 
 #: (scale, kernel) of the second looks: lighten the frame with a kernel x kernel maximum filter
 #: at that scale, which thins every dark area by kernel // 2 / scale pixels.
@@ -117,14 +117,14 @@ def find_board_markers(frame, detector=None, erode_passes=ERODE_PASSES, paint_pi
 
 def _markers_beside_painted_pictures(grey, found, known, detector):
     ### BEGIN SOLUTION
-    board = scenes.default_board()  # only its geometry (board units) is used, the same for any pictures
+    board = boards.default_board()  # only its geometry (board units) is used, the same for any pictures
     square = np.concatenate([board.marker_square(i) for i in known])
     seen = np.concatenate([found[i] for i in known])
     homography, _ = cv2.findHomography(square.astype(np.float32), seen.astype(np.float32))
     if homography is None:
         return {}
     painted = grey.copy()
-    for name in scenes.PICTURES:
+    for name in marker_board.PICTURES:
         slot = cv2.perspectiveTransform(board.picture_slot(name)[None].astype(np.float32), homography)[0]
         cv2.fillConvexPoly(painted, np.round(slot * 16).astype(np.int32), 255, cv2.LINE_AA, shift=4)
     new = {i: c for i, c in find_markers(painted, detector).items() if i in _BOARD_IDS and i not in found}
@@ -158,7 +158,7 @@ def _check_size(size):
     try:
         width, height = (int(value) for value in size)
     except (TypeError, ValueError):
-        raise ValueError(f'size must be (width, height), e.g. {scenes.DEFAULT_SIZE}, '
+        raise ValueError(f'size must be (width, height), e.g. {marker_board.DEFAULT_SIZE}, '
                          f'not {size!r}') from None
     if width < 2 or height < 2:
         raise ValueError(f'size must be at least 2x2 pixels (width, height), not {size!r}')
@@ -178,7 +178,7 @@ def _check_frame(frame_bgr):
     return frame
 
 
-def crop_pictures(frame_bgr, size=scenes.DEFAULT_SIZE, detector=None, second_look=True):
+def crop_pictures(frame_bgr, size=marker_board.DEFAULT_SIZE, detector=None, second_look=True):
     """The pictures of the board that are fully framed in this frame, cropped and straightened.
 
     Args:
@@ -202,10 +202,10 @@ def crop_pictures(frame_bgr, size=scenes.DEFAULT_SIZE, detector=None, second_loo
     frame = _check_frame(frame_bgr)
     width, height = _check_size(size)
     markers = find_board_markers(frame, detector) if second_look else find_markers(frame, detector)
-    target = scenes.crop_corners((width, height))
+    target = marker_board.crop_corners((width, height))
     crops = {}
-    for name in scenes.PICTURES:
-        corners = scenes.picture_corners(markers, name)
+    for name in marker_board.PICTURES:
+        corners = marker_board.picture_corners(markers, name)
         if corners is None or not _is_picture_shape(corners):
             continue
         homography = cv2.getPerspectiveTransform(corners, target)

@@ -16,7 +16,7 @@ from rclpy.node import Node
 from rclpy.qos import qos_profile_sensor_data
 from sensor_msgs.msg import Image
 
-from course_lib import images, scenes
+from course_lib import images, marker_board
 from readmarker.crop import crop_pictures
 
 #: Seconds between two warnings about bad input images.
@@ -39,8 +39,8 @@ def make_detector(dictionary_name):
         names = ', '.join(sorted(name for name in dir(cv2.aruco) if name.startswith('DICT_')))
         raise ValueError(f'Unknown ArUco dictionary {dictionary_name!r}; use one of {names} '
                          '(the course board uses DICT_4X4_50)')
-    if code == scenes.ARUCO_DICTIONARY:
-        return scenes.detector()
+    if code == marker_board.ARUCO_DICTIONARY:
+        return marker_board.detector()
     return cv2.aruco.ArucoDetector(cv2.aruco.getPredefinedDictionary(code),
                                    cv2.aruco.DetectorParameters())
 
@@ -60,8 +60,8 @@ class MarkerReader(Node):
 
     def __init__(self, **kwargs):
         super().__init__('marker_reader', **kwargs)
-        width = int(self.declare_parameter('width', scenes.DEFAULT_SIZE[0]).value)
-        height = int(self.declare_parameter('height', scenes.DEFAULT_SIZE[1]).value)
+        width = int(self.declare_parameter('width', marker_board.DEFAULT_SIZE[0]).value)
+        height = int(self.declare_parameter('height', marker_board.DEFAULT_SIZE[1]).value)
         dictionary = str(self.declare_parameter('dictionary', 'DICT_4X4_50').value)
         image_topic = str(self.declare_parameter('image_topic', 'image').value)
         output_topic = str(self.declare_parameter('output_topic', 'cropped_img').value)

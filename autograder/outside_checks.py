@@ -1,0 +1,80 @@
+"""The hidden checks, run by the grader outside the student's kernel, and their verdicts in the notebook."""
+
+from __future__ import annotations
+
+import json
+import os
+import sys
+from pathlib import Path
+
+from autograder.result import GradeResult
+from autograder.sandbox import run_sandboxed
+from autograder.submissions import Submission
+from course_lib.checks import registry, runner
+from course_lib.checks.result import Result, images_html, verdict_text
+
+
+def grade_outside(sub: Submission, result: GradeResult, work: Path, autograded: Path, workdir: Path,
+                   domain_id: int, env: dict, hide: list[Path]) -> None:
+    """Run the hidden checks of the graded cells in processes of the grader, not in the student's
+    kernel, against the module the notebook wrote in `workdir`; their points replace the cells'
+    scores and their verdicts replace the outputs of the cells of the notebooks in `autograded`
+    (runner.grade only said "graded outside").
+
+    The check runs as root in a fresh sandbox (network and mount namespaces); the student's
+    processes it starts run as the worker's uid, so they cannot touch the check or its results.
+    """
+    from course_lib import processes
+
+    try:
+        checks = registry.checks_of(sub.assignment)
+    except ModuleNotFoundError:  # an assignment of the instructor's own, graded by nbgrader alone
+        return
+    names = [name for name in (check_of(c["cell"]) for c in result.cells) if name in checks]
+    if not names:
+        return
+    out = work / "checks"
+    out.mkdir(mode=0o700)
+    command = [sys.executable, "-m", "autograder.checks_outside", sub.assignment, *names,
+               "--workdir", str(workdir), "--out", str(out)]
+    wall = sum(checks[name].timeout + 30 for name in names)
+    env = {**env, runner.SEED_ENV: None, "AUTOGRADER_SEED": os.environ.get("AUTOGRADER_SEED")}
+    proc = run_sandboxed(command, hide, f"checks {sub.key}", domain_id, env, out,
+                          processes.Limits(wall_seconds=wall, grace_seconds=5.0))
+    verdicts = {}
+    for name in names:
+        try:
+            verdicts[name] = Result(**json.loads((out / f"{name}.json").read_text()))
+        except (OSError, ValueError, TypeError):
+            verdicts[name] = Result(sub.assignment, name, 0.0, checks[name].points, 0,
+                                            error=f"The grader could not run this check ({proc.describe_exit()}):\n"
+                                                  f"{proc.log_tail(8)}")
+    for cell in result.cells:
+        if check_of(cell["cell"]) in verdicts:
+            cell["auto_score"] = min(verdicts[check_of(cell["cell"])].points, cell["max_score"])
+    _write_verdicts(autograded, verdicts)
+
+
+
+def check_of(grade_id: str) -> str | None:
+    """The check a graded cell runs: grade id "check_<name>" (assignments/build.py names them so)."""
+    return grade_id.removeprefix("check_") if grade_id.startswith("check_") else None
+
+
+def _write_verdicts(folder: Path, verdicts: dict) -> None:
+    """Replace the outputs of the graded cells of the notebooks in `folder` by the verdicts."""
+    import nbformat
+
+    for path in sorted(folder.glob("*.ipynb")):
+        nb = nbformat.read(path, as_version=4)
+        for cell in nb.cells:
+            name = check_of(cell.get("metadata", {}).get("nbgrader", {}).get("grade_id", ""))
+            if cell.cell_type != "code" or name not in verdicts:
+                continue
+            verdict = verdicts[name]
+            cell.outputs = [nbformat.v4.new_output("stream", name="stdout", text=verdict_text(verdict, True))]
+            html = images_html(verdict)
+            if html:
+                cell.outputs.append(nbformat.v4.new_output("display_data", data={"text/html": html}))
+        nbformat.write(nb, path)
+

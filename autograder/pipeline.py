@@ -1,0 +1,272 @@
+"""Grading one submission with nbgrader in the sandbox (autograder.sandbox).
+
+One submission is graded like this (:func:`grade_submission`, run by a worker thread; its steps
+are listed in :data:`STEPS`):
+
+1. A private work directory gets a course root of its own: nbgrader_config.py, a copy of the
+   gradebook (root-only, 0600: it holds the hidden tests) and a copy of the submission. The
+   submitted files themselves are only read.
+2. ``nbgrader autograde`` runs there, through course_lib.processes (wall time per notebook,
+   address space, file size; every descendant is killed at the end) and, as root, inside
+   ``unshare --net --mount``: a network namespace with only loopback (no connection leaves the
+   machine; DDS traffic stays in it), a private /dev/shm (Fast DDS shared memory), and the course
+   directory and the repository's assignments/ and tests/ hidden under empty tmpfs mounts.
+3. nbgrader starts the kernel through autograder.kernel, which drops to a uid of this worker
+   (61000 + its ROS domain id) with RLIMIT_NPROC, in a subfolder of its own. The notebook's
+   hidden test cells only say that the grader runs them (AUTOGRADER_CHECKS_OUTSIDE=1): a check
+   run in the student's kernel could be faked by the student's code (patch checks.grade and
+   every test cell "passes").
+4. The hidden checks run after the notebook, in a fresh sandbox of the same kind, as processes
+   of the grader (``python -m autograder.checks_outside``, root), against the module the
+   notebook wrote; the student's code they start runs as the worker's uid, with the same limits.
+   Their points replace nbgrader's scores of those cells, and their verdicts (seed, what passed
+   and failed, pictures) replace the cells' outputs in the autograded notebook.
+5. The trusted grader reads the other cells' scores from the private gradebook, copies the
+   autograded notebook to COURSE_DIR/autograded/ (without the grader's temporary paths), and
+   records the scores in the course gradebook as nbgrader's autograde would (autograder.gradebook:
+   graded cells are not "needs manual grading", the submission time and late penalty are kept).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import os
+import shutil
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+from autograder import config, gradebook, intake, kernel, packages, student_uid
+from autograder.nbgrader_cli import env_for_tools
+from autograder.outputs import keep_autograded, keep_log, scrub_paths
+from autograder.outside_checks import grade_outside
+from autograder.result import GradeResult
+from autograder.sandbox import HIDDEN_FROM_STUDENTS, interpreter_exposure, isolation, run_sandboxed
+from autograder.staging import private_copy, stage_grader
+from autograder.submissions import Submission, submission_digest
+from course_lib.checks import runner
+
+
+#: Seconds one notebook may take under grading, everything included.
+NOTEBOOK_TIMEOUT = 420.0
+#: Address space of each process of a submission (MB). Fast DDS + numpy + OpenCV need ~1 GB.
+MEMORY_MB = 4096
+#: Largest file a submission may write (MB).
+FILE_MB = 256
+#: Processes and threads of one worker's uid (root only). A kernel, a check and a node need ~100.
+NPROC = 384
+#: Base of the per-worker uids (root only): uid = KERNEL_UID_BASE + reserved ROS domain id.
+KERNEL_UID_BASE = 61000
+
+
+def _cell_scores(root: Path, sub: Submission) -> list[dict]:
+    """The scores nbgrader gave the submission's cells in the gradebook of the course root `root`."""
+    with gradebook.open_gradebook(root) as gb:
+        submission = gb.find_submission(sub.assignment, sub.student)
+        cells = []
+        for notebook in submission.notebooks:
+            for grade in notebook.grades:
+                cells.append({"notebook": notebook.name, "cell": grade.name,
+                              "auto_score": grade.auto_score, "max_score": grade.max_score})
+        return cells
+
+
+@dataclasses.dataclass
+class Grading:
+    """One submission's grading while the steps run: what they share."""
+    sub: Submission
+    course: Path
+    domain_id: int
+    result: GradeResult
+    work: Path                 # the private work folder, removed at the end
+    env: dict = dataclasses.field(default_factory=dict)  # for every sandboxed process
+    notebook_run: object = None  # the nbgrader autograde process (course_lib.processes.NodeProcess)
+
+    @property
+    def root(self) -> Path:
+        """The private course root nbgrader grades in."""
+        return self.work / "course"
+
+    @property
+    def autograded(self) -> Path:
+        return self.root / "autograded" / self.sub.student / self.sub.assignment
+
+    @property
+    def workdir(self) -> Path:
+        """Where the notebook wrote the student's files: as root the kernel ran in a subfolder of
+        its own uid (autograder.kernel)."""
+        return self.autograded / kernel.WORK_SUBDIR if self.result.kernel_uid is not None else self.autograded
+
+    @property
+    def hide(self) -> list[Path]:
+        """What the sandbox hides: the course directory and the repository's instructor folders."""
+        return [self.course, *HIDDEN_FROM_STUDENTS]
+
+    @property
+    def failed(self) -> bool:
+        return self.result.status == "failed"
+
+
+def stage_course_root(g: Grading) -> None:
+    """A course root of its own in the work folder (config, a root-only copy of the
+    gradebook and of the submission) and the sandbox's kernelspec."""
+    os.chmod(g.work, 0o711)
+    root = g.root
+    root.mkdir(mode=0o711)
+    config.write_config(root)
+    shutil.copyfile(g.course / "gradebook.db", root / "gradebook.db")
+    os.chmod(root / "gradebook.db", 0o600)
+    private_copy(g.sub.path, root / "submitted" / g.sub.student / g.sub.assignment)
+    os.chmod(root / "submitted", 0o711)
+    os.chmod(root / "submitted" / g.sub.student, 0o711)
+    kernels = g.work / "jupyter" / "kernels" / "python3"
+    kernels.mkdir(parents=True)
+    (kernels / "kernel.json").write_text(json.dumps({
+        "argv": [sys.executable, "-m", "autograder.kernel", "{connection_file}"],
+        "display_name": "Python 3 (autograder sandbox)", "language": "python"}))
+    for folder in (g.work / "jupyter", g.work / "runtime", g.work / "kernel-tmp"):
+        folder.mkdir(exist_ok=True)
+        os.chmod(folder, 0o711)
+
+
+def choose_environment(g: Grading) -> None:
+    """A root-only copy of the grader (autograder.staging) and the sandboxed processes'
+    environment: grading flags, Jupyter's folders, that copy first on PYTHONPATH; as root the
+    worker's uid and process limit for the student's code."""
+    work = g.work
+    grader = stage_grader(work)
+    g.env = {"COURSE_LIB_GRADING": "1", "COURSE_LIB_UNDER_TEST": None, "AUTOGRADER_SEED": None,
+             runner.OUTSIDE_ENV: "1",
+             "JUPYTER_PATH": str(work / "jupyter"), "JUPYTER_RUNTIME_DIR": str(work / "runtime"),
+             "JUPYTER_CONFIG_DIR": str(work / "jupyter-config"), "AUTOGRADER_KERNEL_TMP": str(work / "kernel-tmp"),
+             "PYTHONPATH": os.pathsep.join([str(grader), env_for_tools()["PYTHONPATH"]]), "HOME": str(work),
+             "PYDEVD_DISABLE_FILE_VALIDATION": "1"}
+    if g.result.isolation == "root":
+        g.result.kernel_uid = KERNEL_UID_BASE + g.domain_id
+        g.env.update(AUTOGRADER_KERNEL_UID=str(g.result.kernel_uid), AUTOGRADER_KERNEL_NPROC=str(NPROC))
+        g.env.update({student_uid.STUDENT_UID_ENV: str(g.result.kernel_uid), student_uid.STUDENT_NPROC_ENV: str(NPROC)})
+        exposure = interpreter_exposure()
+        if exposure:
+            (work / "stage").mkdir()
+            g.env.update(exposure, AUTOGRADER_STAGE=str(work / "stage"))
+
+
+def run_notebook(g: Grading) -> None:
+    """``nbgrader autograde`` in the sandbox, within the notebook's limits."""
+    from course_lib import processes
+
+    command = [sys.executable, "-m", "nbgrader", "autograde", g.sub.assignment, "--student", g.sub.student,
+               "--force", f"--CourseDirectory.root={g.root}"]
+    limits = processes.Limits(wall_seconds=NOTEBOOK_TIMEOUT, memory_mb=MEMORY_MB, file_size_mb=FILE_MB,
+                              grace_seconds=5.0)
+    g.notebook_run = run_sandboxed(command, g.hide, f"autograde {g.sub.key}", g.domain_id, g.env, g.root, limits)
+
+
+def read_scores(g: Grading) -> None:
+    """The cells' scores from the private gradebook; a run that did not finish fails the
+    submission with a reason for the student and nbgrader's log for the instructor."""
+    proc, result = g.notebook_run, g.result
+    try:
+        result.cells = _cell_scores(g.root, g.sub)
+    except Exception as error:  # no submission in the gradebook: nbgrader did not get that far
+        result.cells = []
+        result.status = "failed"
+        result.reason = f"nbgrader autograde did not finish ({proc.describe_exit()}): {error}"
+    if proc.returncode != 0 and result.status != "failed":
+        result.status = "failed"
+        result.reason = f"nbgrader autograde ended with {proc.describe_exit()}"
+    if result.status == "failed":
+        # The student reads the first line; nbgrader's log is for the instructor.
+        result.detail = result.reason.strip() + "\n" + "\n".join(proc.log.strip().splitlines()[-15:])
+        result.reason = _explain_failure(proc.log, proc)
+
+
+def build_workspace(g: Grading) -> None:
+    """The student's ROS 2 workspace built with colcon in the sandbox, interface packages from the
+    course's cache (autograder.packages); the checks read its report."""
+    if g.failed or not packages.needed(g.sub.assignment, g.workdir):
+        return
+    built = packages.build_for_checks(g.sub.assignment, g.course, g.work, g.workdir, g.result.kernel_uid,
+                                      g.domain_id, g.env, g.hide, run_sandboxed)
+    g.env.update(built)
+    g.result.detail += packages.instructor_note(built)
+
+
+def run_hidden_checks(g: Grading) -> None:
+    """The hidden checks, outside the kernel (autograder.outside_checks)."""
+    if g.failed:
+        return
+    grade_outside(g.sub, g.result, g.work, g.autograded, g.workdir, g.domain_id, g.env, g.hide)
+
+
+def remove_grader_paths(g: Grading) -> None:
+    """The grader's folders out of the graded notebooks (autograder.outputs.scrub_paths)."""
+    if not g.failed:
+        scrub_paths(g.autograded, g.work)
+
+
+def note_manual_grading(g: Grading) -> None:
+    """Tell the instructor when cells are left to grade by hand."""
+    if any(c["auto_score"] is None for c in g.result.cells):
+        g.result.detail += "\nSome cells need manual grading (the formgrader lists them)."
+
+
+def keep_outputs(g: Grading) -> None:
+    """The graded notebooks into COURSE_DIR/autograded/ (an empty folder when failed) and
+    nbgrader's log beside the recorded result."""
+    keep_autograded(g.course, g.sub, g.autograded if not g.failed else None)
+    keep_log(g.course, g.sub, g.notebook_run.log)
+
+
+#: Grading one submission, in order (each step sees what the earlier ones left in Grading).
+STEPS = (stage_course_root, choose_environment, run_notebook, read_scores, build_workspace, run_hidden_checks,
+         remove_grader_paths, note_manual_grading, keep_outputs)
+
+
+def grade_submission(sub: Submission, course: Path, domain_id: int) -> GradeResult:
+    """Autograde one submission in a sandbox, step by step (STEPS; see the module docstring). Never
+    raises for the student's faults: a submission that breaks its notebook run gets 0 and the reason."""
+    started = time.monotonic()
+    result = GradeResult(sub.student, sub.assignment, submission_digest(sub, course), isolation=isolation())
+    problem = intake.check(course, sub.student, sub.assignment, sub.path)
+    if problem is not None:  # nothing to run: say why and how to fix it
+        result.status, result.reason, result.detail = "failed", problem.reason, problem.fix
+        keep_autograded(course, sub, None)
+        keep_log(course, sub, problem.fix + "\n")
+        result.seconds = round(time.monotonic() - started, 1)
+        return result
+    grading = Grading(sub, course, domain_id, result, Path(tempfile.mkdtemp(prefix="autograder-work-")))
+    try:
+        for step in STEPS:
+            step(grading)
+    finally:
+        _remove_tree(grading.work)
+    result.score = round(sum(c["auto_score"] or 0 for c in result.cells), 3) if result.status != "failed" else 0.0
+    result.seconds = round(time.monotonic() - started, 1)
+    return result
+
+
+def _explain_failure(log: str, proc) -> str:
+    """A failed submission's reason, in the student's terms."""
+    if "Kernel died" in log or "DeadKernelError" in log:
+        return ("The notebook's Python kernel died while running your code (a crash such as a segfault, "
+                "os._exit() or sys.exit() at the top level, or being killed for using too much memory): "
+                "no cell after it could run, so every check scores 0.")
+    if proc.exit_reason == "wall_seconds":
+        return (f"The notebook did not finish within {NOTEBOOK_TIMEOUT:g} s: something in it runs forever "
+                "or waits for input.")
+    return (f"The grader could not run your notebook to its end ({proc.describe_exit()}); your instructor has "
+            "the details.")
+
+
+def _remove_tree(path: Path) -> None:
+    def retry(function, name, _exc):
+        try:
+            os.chmod(os.path.dirname(name), 0o700)
+            function(name)
+        except OSError:
+            pass
+    shutil.rmtree(path, onerror=retry)
+

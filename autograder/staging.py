@@ -1,0 +1,29 @@
+"""Private copies for a submission's grading: the grader itself and the submitted files."""
+
+from __future__ import annotations
+
+import os
+import shutil
+from pathlib import Path
+
+
+def stage_grader(work: Path) -> Path:
+    """Copy the autograder package into `work`/grader, readable by root only, and return that
+    folder (first on the sandbox's PYTHONPATH). The sandbox hides the repository's autograder/;
+    the grader's own processes (nbgrader's config, the kernel launcher, the checks' answer keys)
+    import this copy, while the student's uid cannot enter it."""
+    folder = work / "grader"
+    shutil.copytree(Path(__file__).resolve().parent, folder / "autograder",
+                    ignore=shutil.ignore_patterns("__pycache__"))
+    os.chmod(folder, 0o700)
+    return folder
+
+
+def private_copy(source: Path, target: Path) -> None:
+    """Copy a directory tree readable by root only (other workers' uids cannot read it)."""
+    shutil.copytree(source, target, ignore=shutil.ignore_patterns(".ipynb_checkpoints"))
+    for directory, dirs, files in os.walk(target):
+        os.chmod(directory, 0o711)
+        for name in files:
+            os.chmod(os.path.join(directory, name), 0o600)
+

@@ -1,0 +1,62 @@
+"""The submissions in COURSE_DIR/submitted/ and the digest that says when one must be graded again."""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+from pathlib import Path
+
+from course_lib.checks import registry
+
+
+@dataclasses.dataclass
+class Submission:
+    student: str
+    assignment: str
+    path: Path
+
+    @property
+    def key(self) -> str:
+        return f"{self.student}/{self.assignment}"
+
+
+def find_submissions(course: Path, assignment: str | None = None, student: str | None = None) -> list[Submission]:
+    """COURSE_DIR/submitted/<student>/<assignment>/ holding at least one notebook, sorted (only one
+    assignment's, one student's, when given)."""
+    found = []
+    submitted = course / "submitted"
+    if not submitted.is_dir():
+        return found
+    for folder_of_student in sorted(p for p in submitted.iterdir() if p.is_dir()):
+        if student is not None and folder_of_student.name != student:
+            continue
+        for folder in sorted(p for p in folder_of_student.iterdir() if p.is_dir()):
+            if (assignment is None or folder.name == assignment) and any(folder.glob("*.ipynb")):
+                found.append(Submission(folder_of_student.name, folder.name, folder))
+    return found
+
+
+def _tree_digest(paths: list[Path], digest) -> None:
+    for base in paths:
+        files = [base] if base.is_file() else sorted(p for p in base.rglob("*") if p.is_file())
+        for path in files:
+            digest.update(str(path.relative_to(base.parent)).encode() + b"\0" + path.read_bytes() + b"\0")
+
+
+#: The modules of course_lib.checks that run every assignment's checks (a change regrades).
+CHECK_MODULES = ["registry", "result", "runner", "check_process", "context", "student_calls", "student_processes",
+                 "probe", "student", "answers", "packages"]
+
+
+def submission_digest(sub: Submission, course: Path) -> str:
+    """Changes when the submission, the assignment's source or the grading code changes."""
+    digest = hashlib.sha256()
+    _tree_digest([sub.path, course / "source" / sub.assignment], digest)
+    here, checks = Path(__file__).resolve().parent, Path(registry.__file__).resolve().parent
+    code = [here / "kernel.py", here / "config.py", here / "checks_outside.py", here / "student_uid.py", here / "run_as.py",
+            here / "packages.py",
+            here / "answers" / f"{sub.assignment}.py",
+            *(checks / f"{name}.py" for name in CHECK_MODULES), checks / f"{sub.assignment}.py"]
+    _tree_digest([path for path in code if path.exists()], digest)
+    return digest.hexdigest()
+

@@ -1,0 +1,130 @@
+"""The printed board: the cat and dog pictures side by side, each framed by its four markers.
+
+Lengths are in board units; the marker layout follows :mod:`course_lib.marker_board`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import cv2
+import numpy as np
+
+from course_lib.marker_board import PICTURES, dictionary
+from course_lib.pictures import draw_cat, draw_dog
+
+class Board:
+    """The flat board: the cat and dog pictures side by side, each framed by its four markers.
+
+    Lengths are in board units: a picture slot is 320x240 units, a marker 96 units (16 per cell)
+    with at least 24 units (1.5 cells) of white paper around it.
+
+    Args:
+        cat, dog: BGR (or grey) images to show instead of the drawn cat and dog; any size, they
+            are stretched to the 4:3 slot. Picture pixels in Scene homographies are pixels of
+            these images.
+
+    Raises:
+        ValueError: an image is not 2-D/3-D uint8 with at least one pixel.
+    """
+
+    PICTURE_SIZE = (320, 240)
+    MARKER = 96
+    QUIET = 24
+    GAP = 48
+    PAPER = (236, 240, 242)
+
+    def __init__(self, cat: np.ndarray | None = None, dog: np.ndarray | None = None):
+        self.pictures: dict[str, np.ndarray] = {
+            "cat": draw_cat() if cat is None else _as_bgr(cat, "cat"),
+            "dog": draw_dog() if dog is None else _as_bgr(dog, "dog"),
+        }
+        m, q, (pw, ph) = self.MARKER, self.QUIET, self.PICTURE_SIZE
+        left = q + m
+        self._slots = {"cat": (left, q + m, left + pw, q + m + ph)}
+        left = left + pw + m + self.GAP + m
+        self._slots["dog"] = (left, q + m, left + pw, q + m + ph)
+        self.size = (left + pw + m + q, q + m + ph + m + q)  # (width, height) in units
+        self._textures: dict[frozenset, list[tuple[float, np.ndarray]]] = {}
+
+    def picture_slot(self, picture: str) -> np.ndarray:
+        """The picture's corners in board units (top-left, top-right, bottom-right, bottom-left)."""
+        x0, y0, x1, y1 = self._slots[picture]
+        return np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]], dtype=np.float64)
+
+    def marker_square(self, marker_id: int) -> np.ndarray:
+        """A board marker's corners in board units, in OpenCV order (0 top-left ... 3 bottom-left)."""
+        for name, ids in PICTURES.items():
+            if marker_id in ids:
+                index = ids.index(marker_id)
+                corner = self.picture_slot(name)[index]
+                # The marker lies diagonally outside the picture corner it touches.
+                dx, dy = ((-1, -1), (1, -1), (1, 1), (-1, 1))[index]
+                x0 = corner[0] if dx > 0 else corner[0] - self.MARKER
+                y0 = corner[1] if dy > 0 else corner[1] - self.MARKER
+                return _square(x0, y0, self.MARKER)
+        raise KeyError(f"Marker {marker_id} is not on the board: board markers are "
+                       f"{sorted(i for ids in PICTURES.values() for i in ids)}")
+
+    def picture_homography(self, picture: str) -> np.ndarray:
+        """Picture pixels (OpenCV centres) -> board units."""
+        image_h, image_w = self.pictures[picture].shape[:2]
+        x0, y0, x1, y1 = self._slots[picture]
+        sx, sy = (x1 - x0) / image_w, (y1 - y0) / image_h
+        return np.array([[sx, 0, x0 + 0.5 * sx], [0, sy, y0 + 0.5 * sy], [0, 0, 1]])
+
+    def texture(self, missing: Sequence[int] = ()) -> list[tuple[float, np.ndarray]]:
+        """The printed board as images at several resolutions (pixels per unit, image), finest first."""
+        key = frozenset(missing)
+        if key not in self._textures:
+            if len(self._textures) >= 4:  # each set of levels takes ~40 MB
+                self._textures.pop(next(iter(self._textures)))
+            scale = 4
+            width, height = self.size
+            image = np.empty((height * scale, width * scale, 4), np.uint8)
+            image[:] = (*self.PAPER, 255)  # BGRA: the alpha channel gives the board anti-aliased edges
+            for name, picture in self.pictures.items():
+                x0, y0, x1, y1 = (v * scale for v in self._slots[name])
+                image[y0:y1, x0:x1, :3] = cv2.resize(picture, (x1 - x0, y1 - y0), interpolation=cv2.INTER_AREA
+                                                 if picture.shape[1] > x1 - x0 else cv2.INTER_CUBIC)
+            for marker_id in sorted(i for ids in PICTURES.values() for i in ids):
+                if marker_id not in key:
+                    x0, y0 = (int(v) * scale for v in self.marker_square(marker_id)[0])
+                    _paste_marker(image, marker_id, x0, y0, self.MARKER * scale)
+            levels = [(float(scale), image)]
+            while levels[-1][1].shape[1] > 64:
+                levels.append((levels[-1][0] / 2, cv2.pyrDown(levels[-1][1])))
+            self._textures[key] = levels
+        return self._textures[key]
+
+
+def _square(x0: float, y0: float, side: float) -> np.ndarray:
+    return np.array([[x0, y0], [x0 + side, y0], [x0 + side, y0 + side], [x0, y0 + side]], dtype=np.float64)
+
+
+def _paste_marker(image: np.ndarray, marker_id: int, x0: int, y0: int, side: int) -> None:
+    marker = cv2.aruco.generateImageMarker(dictionary(), marker_id, side)
+    image[y0:y0 + side, x0:x0 + side, :3] = marker[:, :, None]
+
+
+def _as_bgr(image, name: str) -> np.ndarray:
+    image = np.asarray(image)
+    if image.dtype != np.uint8 or image.ndim not in (2, 3) or 0 in image.shape[:2]:
+        raise ValueError(f"The {name} picture must be a uint8 image (height, width[, 3]), not "
+                         f"{image.dtype} {image.shape}; load one with cv2.imread")
+    if image.ndim == 2 or image.shape[2] == 1:
+        return cv2.cvtColor(image.reshape(image.shape[:2]), cv2.COLOR_GRAY2BGR)
+    if image.shape[2] == 4:
+        return cv2.cvtColor(image, cv2.COLOR_BGRA2BGR)
+    return image.copy()
+
+
+_DEFAULT_BOARD: Board | None = None
+
+
+def default_board() -> Board:
+    """The board with the drawn cat and dog (made once, then shared)."""
+    global _DEFAULT_BOARD
+    if _DEFAULT_BOARD is None:
+        _DEFAULT_BOARD = Board()
+    return _DEFAULT_BOARD

@@ -1,0 +1,72 @@
+"""The process a check runs in: ``python -m course_lib.checks.check_process run ASSIGNMENT CHECK
+--workdir DIR --out DIR`` (started by course_lib.checks.runner.execute)."""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import os
+import sys
+import traceback
+from pathlib import Path
+
+from course_lib.checks.context import Context, StudentError
+from course_lib.checks.registry import get_check
+from course_lib.checks.result import Result
+from course_lib.checks.runner import SEED_ENV, SELFCHECK_SEED
+from course_lib.checks.student_processes import StudentProcesses
+
+
+def run_in_this_process(assignment: str, name: str, seed: int, workdir: Path, out: Path,
+                        students: StudentProcesses | None = None) -> Result:
+    """Run a check here (the check process) and return its Result; `students` starts the student's
+    processes (default: as this process's user, course_lib.checks.student_processes)."""
+    spec = get_check(assignment, name)
+    ctx = Context(spec, seed, workdir, out, students)
+    error = None
+    try:
+        spec.function(ctx)
+    except StudentError as failure:
+        error = str(failure)
+    except Exception:  # a bug in the check, not the student's fault: say so plainly
+        error = "The checker itself failed (tell your instructor):\n" + traceback.format_exc(limit=4)
+    finally:
+        ctx.close()
+    total = sum(item["weight"] for item in ctx.items)
+    if error and not any(item["ok"] for item in ctx.items):
+        points = 0.0
+    else:
+        passed = sum(item["weight"] for item in ctx.items if item["ok"])
+        points = spec.points * passed / total if total else 0.0
+    return Result(assignment, name, round(points, 3), spec.points, seed, ctx.items, ctx.notes, ctx.images, error)
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m course_lib.checks.check_process", description="Run one graded check.")
+    sub = parser.add_subparsers(dest="command", required=True)
+    run = sub.add_parser("run")
+    run.add_argument("assignment")
+    run.add_argument("check")
+    run.add_argument("--seed", type=int, default=None, help=f"default: ${SEED_ENV}, else {SELFCHECK_SEED}")
+    run.add_argument("--workdir", default=".")
+    run.add_argument("--out", required=True)
+    args = parser.parse_args(argv)
+    out = Path(args.out)
+    seed = args.seed if args.seed is not None else int(os.environ.get(SEED_ENV, SELFCHECK_SEED))
+    result = run_in_this_process(args.assignment, args.check, seed, Path(args.workdir).resolve(), out)
+    write_json(out / "result.json", dataclasses.asdict(result))
+    return 0
+
+
+def write_json(path: Path, data) -> None:
+    """Write `data` as JSON so that a reader never sees half a file (a temporary file, renamed)."""
+    path.with_suffix(".tmp").write_text(json.dumps(data))
+    os.replace(path.with_suffix(".tmp"), path)
+
+
+if __name__ == "__main__":
+    # Run through the imported module, so that the checks register where they are looked up.
+    from course_lib.checks.check_process import main as _main
+
+    sys.exit(_main())

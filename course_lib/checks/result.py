@@ -1,0 +1,70 @@
+"""What a check found (:class:`Result`), and how its verdict reads as text and as HTML."""
+
+from __future__ import annotations
+
+import dataclasses
+
+from course_lib.checks.registry import get_check
+
+
+@dataclasses.dataclass
+class Result:
+    """What a check found: its items, the points earned, and pictures to show."""
+
+    assignment: str
+    name: str
+    points: float
+    max_points: float
+    seed: int
+    items: list[dict] = dataclasses.field(default_factory=list)
+    notes: list[str] = dataclasses.field(default_factory=list)
+    images: list[dict] = dataclasses.field(default_factory=list)
+    error: str | None = None
+    seconds: float = 0.0
+
+    def verdict_lines(self) -> list[str]:
+        """The points, then what failed (each cause followed by its consequences), then what passed."""
+        lines = [f"{self.name}: {points_text(self.points)} of {points_text(self.max_points)} points"]
+        for item in self.items:
+            if not item["ok"] and not item.get("consequence"):
+                lines.append("  ✘ " + item["message"])
+        for item in self.items:
+            if item.get("consequence"):
+                lines.append("    ↳ ✘ " + item["message"])
+        for item in self.items:
+            if item["ok"]:
+                lines.append("  ✔ " + item["message"])
+        lines.extend("  · " + note for note in self.notes)
+        if self.error:
+            lines.append("  ! " + self.error)
+        return lines
+
+
+def points_text(value: float) -> str:
+    """Points as a verdict writes them: 4, 2.5, 0.333."""
+    return f"{value:g}"
+
+
+def verdict_text(result: Result, graded: bool) -> str:
+    """What a check cell shows: the seed, the check's description, and what passed and failed."""
+    header = (f"[{'graded' if graded else 'self-check'} · seed {result.seed}] "
+              f"{get_check(result.assignment, result.name).description}")
+    lines = [header, *result.verdict_lines()]
+    if graded:
+        lines.append(f"  (reproduce with AUTOGRADER_SEED={result.seed})")
+    return "\n".join(lines)
+
+
+
+def images_html(result: Result) -> str:
+    """The check's pictures as one HTML block ("" when it has none)."""
+    cells = "".join(
+        f"<figure style='display:inline-block;margin:4px'><img src='data:image/png;base64,{image['png']}'/>"
+        f"<figcaption style='font-size:small'>{_escape(image['label'])}</figcaption></figure>"
+        for image in result.images if "png" in image)
+    return f"<div class='autograder-images'>{cells}</div>" if cells else ""
+
+
+
+def _escape(text: str) -> str:
+    return text.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")

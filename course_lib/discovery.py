@@ -1,0 +1,100 @@
+"""Discovery: wait, briefly and boundedly, until the graph a new tool node sees has settled.
+
+Another process's nodes become visible only after DDS discovery (up to a few seconds). The
+first query of :mod:`course_lib.graph` on the session's tool node waits here; ``ros2 ...
+--spin-time`` is the plain ROS 2 equivalent.
+"""
+
+from __future__ import annotations
+
+import time
+
+from course_lib import session, waiting
+
+#: Seconds a newly started tool node waits for discovery before its first answer. Fast DDS
+#: took about 2 s to show another process's node on the course machines; lower it for a
+#: quicker first answer when only this kernel's nodes matter.
+SETTLE_SECONDS = 2.5
+# After SETTLE_SECONDS the graph must also have stayed the same for _SETTLE_QUIET s (things
+# found late bring more with them), but the wait never lasts longer than _SETTLE_MAX s.
+_SETTLE_POLL = 0.05
+_SETTLE_QUIET = 0.3
+_SETTLE_MAX = 5.0
+_settled_node = None
+
+
+# --- the tool node and the settling wait -------------------------------------------------
+
+def _graph_node():
+    """The session's tool node, after a bounded wait for discovery on its first use."""
+    node = session.tool_node()
+    if _settled_node is not node:
+        wait_for_discovery()
+    return node
+
+
+def wait_for_discovery(minimum: float | None = None, quiet: float = _SETTLE_QUIET,
+                       complete_within: float = 0.0) -> None:
+    """Wait until discovery has shown the graph to the tool node; later queries do not wait.
+
+    The functions of this module call it on the tool node's first use, with the defaults;
+    the ``ros2`` command calls it first with its own (--spin-time, or no wait at all for a
+    verb that waits for the name it is given).
+
+    Args:
+        minimum: seconds after the tool node's creation to wait at least (default
+            SETTLE_SECONDS).
+        quiet: then wait until the graph has not changed for this long.
+        complete_within: also wait, up to this many seconds after the tool node's creation,
+            while the graph shows fewer nodes of other processes than there are other DDS
+            participants on this machine in this domain (each ROS process has one, holding its
+            nodes). On a busy machine some of them take seconds to be discovered.
+
+    The wait never lasts longer than 5 s after the tool node's creation.
+    """
+    global _settled_node
+    node = session.tool_node()
+    minimum = SETTLE_SECONDS if minimum is None else minimum
+    others_here = _participants_here(node.context.get_domain_id()) - 1 if complete_within else 0
+    ours = 1 + len(session.nodes())  # the nodes of this process share its participant
+    seen = {"graph": _snapshot(node), "since": time.monotonic(), "checks": 0}
+
+    def settled():
+        if seen["checks"]:  # after each wait, look again; a change restarts the quiet time
+            current = _snapshot(node)
+            if current != seen["graph"]:
+                seen["graph"], seen["since"] = current, time.monotonic()
+        seen["checks"] += 1
+        now = time.monotonic()
+        age = now - node.created_at
+        missing = age < complete_within and len(seen["graph"][0]) - ours < others_here
+        return age >= minimum and now - seen["since"] >= quiet and not missing
+
+    waiting.spin_until(settled, max(0.0, _SETTLE_MAX - (time.monotonic() - node.created_at)), poll=_SETTLE_POLL)
+    _settled_node = node
+
+
+def _participants_here(domain_id: int) -> int:
+    """How many DDS participants run on this machine in a domain.
+
+    Each binds the UDP port 7400 + 250 * domain + 10 + 2 * (its participant id) for discovery
+    traffic (the RTPS standard port mapping), so /proc/net/udp tells. 0 when it cannot.
+    """
+    first = 7410 + 250 * domain_id
+    ports = set()
+    for table in ("/proc/net/udp", "/proc/net/udp6"):
+        try:
+            with open(table) as handle:
+                rows = handle.read().splitlines()[1:]
+        except OSError:
+            continue
+        for row in rows:
+            port = int(row.split()[1].rsplit(":", 1)[1], 16)
+            if first <= port < first + 240 and (port - first) % 2 == 0:
+                ports.add(port)
+    return len(ports)
+
+
+def _snapshot(node):
+    return (sorted(node.get_fully_qualified_node_names()),
+            sorted((name, tuple(types)) for name, types in node.get_topic_names_and_types()))

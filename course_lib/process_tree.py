@@ -1,0 +1,93 @@
+"""Signal and stop a process tree: the process group a process leads, and what left that group.
+
+The one place that ends process trees in the course:
+
+- course_lib.supervisor (under every NodeProcess) signals its node's tree with :func:`signal_tree`,
+  and kills what was re-parented to it with :func:`kill_children`;
+- NodeProcess.stop and stop_together ask the supervisor to do that; when the supervisor itself is
+  gone, :func:`signal_group` kills what its node's group left;
+- a plain subprocess.Popen started with ``start_new_session=True`` (a build) is stopped with
+  :func:`stop_group`: SIGINT, then SIGTERM, then SIGKILL, each given its time.
+
+The plain-terminal equivalent is ``kill -INT -- -PGID`` (a negative pid names a process group).
+Standard library only: the supervisor runs without site-packages.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import time
+
+#: How stop_group escalates: (signal, seconds to wait for the leader after it).
+STOP_STEPS = ((signal.SIGINT, 5.0), (signal.SIGTERM, 5.0), (signal.SIGKILL, 5.0))
+
+
+def signal_group(pgid: int, sig: int) -> None:
+    """Send `sig` to every process of process group `pgid`; nothing when the group has gone."""
+    try:
+        os.killpg(pgid, sig)
+    except (ProcessLookupError, PermissionError):
+        pass
+
+
+def signal_tree(pid: int, sig: int) -> None:
+    """Signal the process group `pid` leads, and `pid` itself only if it left that group.
+
+    Signalling a group member twice would deliver SIGINT twice: the second one can land in the
+    node's own clean-up (its finally block) and turn a clean exit into a traceback.
+    """
+    signal_group(pid, sig)
+    try:
+        if os.getpgid(pid) != pid:
+            os.kill(pid, sig)
+    except ProcessLookupError:
+        pass
+
+
+def children_of(pid: int) -> list[int]:
+    """Direct children of process `pid` (read from /proc; exact when `pid` has a single thread)."""
+    try:
+        with open(f"/proc/{pid}/task/{pid}/children") as handle:
+            return [int(p) for p in handle.read().split()]
+    except FileNotFoundError:  # kernel without CONFIG_PROC_CHILDREN: scan /proc
+        found = []
+        for entry in os.listdir("/proc"):
+            if entry.isdigit():
+                try:
+                    with open(f"/proc/{entry}/stat") as handle:
+                        stat = handle.read()
+                except OSError:
+                    continue
+                if int(stat.rsplit(")", 1)[1].split()[1]) == pid:
+                    found.append(int(entry))
+        return found
+
+
+def kill_children(timeout: float = 5.0) -> None:
+    """SIGKILL and reap every child of this process until none is left or `timeout` seconds pass
+    (a child subreaper's leftovers: descendants that left their group were re-parented to it)."""
+    deadline = time.monotonic() + timeout
+    while (orphans := children_of(os.getpid())) and time.monotonic() < deadline:
+        for pid in orphans:
+            try:
+                os.kill(pid, signal.SIGKILL)
+                os.waitpid(pid, 0)
+            except (ProcessLookupError, ChildProcessError):
+                pass
+
+
+def stop_group(process: subprocess.Popen, steps=STOP_STEPS) -> int | None:
+    """Stop a Popen started with ``start_new_session=True`` and its process group: each signal of
+    `steps` in turn to the whole group, until the leader has exited. Returns its returncode (None
+    if it outlived every step)."""
+    for sig, wait in steps:
+        if process.poll() is not None:
+            break
+        signal_group(process.pid, sig)
+        try:
+            process.wait(timeout=wait)
+        except subprocess.TimeoutExpired:
+            continue
+    return process.poll()

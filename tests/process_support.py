@@ -1,0 +1,47 @@
+"""Helpers of the process tests: find a test's own processes by a unique marker in their command
+line (psutil), so that a test only sees the processes it started itself."""
+
+import sys
+import time
+import uuid
+
+import psutil
+
+
+def marker() -> str:
+    """A token that appears only in the command lines of one test's processes."""
+    return f"course-lib-test-{uuid.uuid4().hex}"
+
+
+def processes_with(token: str) -> list[psutil.Process]:
+    found = []
+    for process in psutil.process_iter(["cmdline", "status"]):
+        try:
+            if process.info["status"] != psutil.STATUS_ZOMBIE and any(
+                    token in part for part in process.info["cmdline"] or ()):
+                found.append(process)
+        except (psutil.NoSuchProcess, psutil.AccessDenied):
+            pass
+    return found
+
+
+def wait_until(condition, timeout: float = 10.0) -> bool:
+    """Poll `condition` until it holds or `timeout` passes; return its last value."""
+    deadline = time.monotonic() + timeout
+    while not (result := condition()) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    return result
+
+
+def sleeper(token: str, seconds: int = 100) -> list[str]:
+    """A python child that sleeps and carries `token` in its command line."""
+    return [sys.executable, "-c", f"import time; print('ready', flush=True); time.sleep({seconds})", token]
+
+
+def sleeper_script(token: str) -> str:
+    """A shell line that runs a sleeping python carrying `token` (python -S starts fast)."""
+    return f"{sys.executable} -S -c 'import time; time.sleep(100)' {token}"
+
+
+def sleepers(token: str) -> list[psutil.Process]:
+    return [p for p in processes_with(token) if p.info["cmdline"][-1] == token]

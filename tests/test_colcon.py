@@ -1,0 +1,47 @@
+"""Tests for course_lib.colcon: the real colcon build, its errors and its command line.
+
+The builds of a working workspace are tested in tests/test_workspace.py, which builds one once
+per test run for all its tests.
+"""
+
+import subprocess
+import sys
+
+import pytest
+
+from course_lib import colcon, pkg_create, rosenv
+
+
+def test_build_without_src_names_the_fix(tmp_path):
+    with pytest.raises(FileNotFoundError, match="create_package"):
+        colcon.build(tmp_path)
+
+
+@pytest.mark.slow
+def test_broken_package_gives_a_build_error_with_the_log_tail(tmp_path):
+    package = pkg_create.create_interface_package(tmp_path, "broken_interfaces", {"Broken": "int32 data"})
+    cmake = package / "CMakeLists.txt"
+    # Early in the file, so that CMake fails within seconds instead of after generating code.
+    cmake.write_text(cmake.read_text().replace("find_package(ament_cmake REQUIRED)",
+                                               "find_package(ament_cmake REQUIRED)\nthis_command_does_not_exist()"))
+    with pytest.raises(colcon.BuildError) as caught:
+        colcon.build(tmp_path, timeout=300)
+    message = str(caught.value)
+    assert "failed in package 'broken_interfaces'" in message
+    assert "this_command_does_not_exist" in message  # from the tail of the package's log
+    assert caught.value.result.failed == ["broken_interfaces"] and caught.value.result.returncode != 0
+
+
+@pytest.mark.slow
+def test_command_line_build_failure_exits_nonzero(tmp_path):
+    package = pkg_create.create_package(tmp_path, "bad_python_pkg")
+    (package / "setup.py").write_text("raise SystemExit('setup.py is broken on purpose')\n")
+    done = subprocess.run([sys.executable, "-m", "course_lib", "build", str(tmp_path)],
+                          capture_output=True, text=True, timeout=300, env=rosenv.ros_environment())
+    assert done.returncode == 1
+    assert "failed in package 'bad_python_pkg'" in done.stderr
+
+
+def test_build_errors_name_a_missing_cmake_package_and_its_wheel():
+    log = ('Could not find a package configuration file provided by "rosidl_core_generators" with any')
+    assert "pip install ros-jazzy-rosidl-core-generators==0.2.0" in colcon._hint(log)

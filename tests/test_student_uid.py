@@ -1,0 +1,72 @@
+"""Tests for autograder.student_uid: graded as root, the checks' student processes run as the
+worker's uid, with a HOME of their own, and can reach the check's ROS shared memory."""
+
+import os
+
+import pytest
+
+from autograder import student_uid
+from autograder.student_uid import StudentUid
+from course_lib.checks.student_processes import STUDENT_MEMORY_MB, StudentProcesses
+
+needs_root = pytest.mark.skipif(os.geteuid() != 0, reason="running as the student's uid needs root")
+
+UID = 61997
+
+#: What the student's process reports: uid, gid, HOME = ROS_HOME, HOME's owner, RLIMIT_NPROC,
+#: RLIMIT_AS in MB, the grader's variable (shell and /proc only: no interpreter needed).
+REPORT = ("id -u; id -g; test \"$HOME\" = \"$ROS_HOME\" && echo True; stat -c %u \"$HOME\"; "
+          "grep 'Max processes' /proc/self/limits | awk '{print $3}'; "
+          "grep 'Max address space' /proc/self/limits | awk '{print $4 / 1048576}'; "
+          "echo \"${AUTOGRADER_STUDENT_UID:-None}\"")
+
+
+@needs_root
+def test_the_students_process_runs_as_the_uid_with_a_home_it_owns(tmp_path, monkeypatch):
+    monkeypatch.setenv(student_uid.STUDENT_UID_ENV, str(UID))
+    process = StudentUid(UID, max_processes=64).start(["sh", "-c", REPORT], name="student-test", cwd="/",
+                                                      domain_id=0, wall_seconds=30)
+    process.wait(timeout=30)
+    assert process.log.split() == [str(UID), str(UID), "True", str(UID), "64", str(STUDENT_MEMORY_MB), "None"], process.log
+
+
+@needs_root
+def test_confine_wraps_the_command_and_makes_a_home_that_is_removed_with_the_process(tmp_path):
+    command, env, private = StudentUid(UID).confine(["id", "-u"], {"PATH": os.environ["PATH"]})
+    assert command[-3:] == ["--", "id", "-u"] and str(UID) in command
+    assert env["HOME"] == env["ROS_HOME"] == str(private[0]) and env["ROS_LOG_DIR"] is None
+    assert os.stat(private[0]).st_uid == UID
+    os.rmdir(private[0])
+
+
+@needs_root
+def test_give_hands_a_job_folder_to_the_uid(tmp_path):
+    StudentUid(UID).give(tmp_path)
+    assert os.stat(tmp_path).st_uid == UID
+
+
+def test_without_the_graders_uid_the_student_runs_as_the_check(monkeypatch):
+    monkeypatch.delenv(student_uid.STUDENT_UID_ENV, raising=False)
+    assert type(StudentUid.from_environment()) is StudentProcesses
+
+
+@needs_root
+def test_the_graders_uid_and_process_limit_come_from_the_environment(monkeypatch):
+    monkeypatch.setenv(student_uid.STUDENT_UID_ENV, str(UID))
+    monkeypatch.setenv(student_uid.STUDENT_NPROC_ENV, "99")
+    students = StudentUid.from_environment()
+    assert isinstance(students, StudentUid) and (students.uid, students.max_processes) == (UID, 99)
+
+
+def test_the_checks_shared_memory_files_are_opened_to_the_students_uid():
+    """Fast DDS makes its files 0644; the probe's own ones become 0666, so the student's node can
+    deliver into them."""
+    path = f"/dev/shm/course_lib_test_fastrtps_{os.getpid()}"
+    with open(path, "w"):
+        pass
+    try:
+        os.chmod(path, 0o644)
+        student_uid.share_shared_memory()
+        assert os.stat(path).st_mode & 0o777 == 0o666
+    finally:
+        os.remove(path)
