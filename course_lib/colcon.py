@@ -10,17 +10,15 @@ for that and for the recipe to run colcon by hand. In a terminal::
 from __future__ import annotations
 
 import dataclasses
-import os
 import re
 import shutil
-import signal
 import subprocess
 import sys
 import threading
 import time
 from pathlib import Path
 
-from course_lib import rosenv, wheelfix
+from course_lib import process_tree, rosenv, wheelfix
 
 
 class BuildError(RuntimeError):
@@ -131,9 +129,9 @@ def build(ws_dir, packages=None, *, extra_args=(), timeout: float = 600,
         process.wait(timeout=timeout)
     except subprocess.TimeoutExpired:
         timed_out = True
-        _stop_group(process)
+        process_tree.stop_group(process)
     except BaseException:  # KeyboardInterrupt in a notebook: never leave compilers behind
-        _stop_group(process)
+        process_tree.stop_group(process)
         raise
     reader.join(timeout=10)
     output = "".join(lines)
@@ -147,19 +145,6 @@ def build(ws_dir, packages=None, *, extra_args=(), timeout: float = 600,
     if process.returncode != 0:
         raise BuildError(_failure_message(result), result)
     return result
-
-
-def _stop_group(process: subprocess.Popen) -> None:
-    for sig, wait in ((signal.SIGINT, 5), (signal.SIGTERM, 5), (signal.SIGKILL, 5)):
-        try:
-            os.killpg(process.pid, sig)
-        except ProcessLookupError:
-            return
-        try:
-            process.wait(timeout=wait)
-            return
-        except subprocess.TimeoutExpired:
-            continue
 
 
 def _tail(text: str, lines: int = 30) -> str:

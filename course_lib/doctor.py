@@ -16,7 +16,7 @@ import sys
 import time
 import uuid
 
-from course_lib import rosenv
+from course_lib import rosenv, waiting
 
 SETUP_FIX = "run `make setup` in the course folder, then use the .venv/bin/python it creates"
 ECHO_SUFFIX = "/reply"
@@ -208,17 +208,18 @@ def _check_round_trip(timeout: float) -> Check:
                                  lambda msg: answers.append(time.monotonic() - sent.get(msg.data, started)), 10)
         publisher = node.create_publisher(String, topic, 10)
         echo = processes.python_node("course_lib.doctor:echo_main", topic, name="doctor-echo", domain_id=domain_id)
-        deadline = started + timeout
-        next_ping = 0.0
-        while not answers and time.monotonic() < deadline:
-            if time.monotonic() >= next_ping:  # repeat: the first pings go out before discovery
+        next_ping = [0.0]
+
+        def ping() -> None:  # repeat: the first pings go out before discovery
+            if time.monotonic() >= next_ping[0]:
                 text = f"ping {len(sent)}"
                 sent[text] = time.monotonic()
                 publisher.publish(String(data=text))
-                next_ping = time.monotonic() + 0.2
-            executor.spin_once(timeout_sec=0.05)
-            if not echo.running():
-                break
+                next_ping[0] = time.monotonic() + 0.2
+
+        ping()
+        waiting.spin_until(lambda: answers or not echo.running(), max(0.0, started + timeout - time.monotonic()),
+                           executor=executor, between=ping)
         elapsed = time.monotonic() - started
         if not answers:
             state = f"it exited with code {echo.returncode}" if not echo.running() else "it is running"

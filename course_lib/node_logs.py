@@ -19,6 +19,8 @@ import collections
 import threading
 import time
 
+from course_lib import waiting
+
 #: Lines kept (and shown) per node; older ones are dropped from the view, not from /rosout.
 MAX_LINES = 200
 
@@ -143,12 +145,10 @@ def deliver(timeout: float = 2.0) -> None:
     subscription, tool = _subscription, _subscribed_node
     if subscription is None or tool is None or not in_kernel():
         return
-    deadline = time.monotonic() + timeout
     try:
-        while subscription.get_publisher_count() < tool.count_publishers("/rosout"):
-            if time.monotonic() > deadline:
-                return
-            time.sleep(0.02)
+        if not waiting.spin_until(lambda: subscription.get_publisher_count() >= tool.count_publishers("/rosout"),
+                                  timeout, poll=0.02):
+            return
     except Exception:  # the session is shutting down: nothing to wait for
         return
     time.sleep(0.1)  # the matched writers send what they kept

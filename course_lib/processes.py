@@ -33,7 +33,7 @@ import time
 from pathlib import Path
 from typing import Callable
 
-from course_lib import rosenv
+from course_lib import rosenv, waiting
 from course_lib.bounded_log import LOG_HEAD_BYTES, LOG_TAIL_BYTES, read_log
 from course_lib.process_tree import signal_group
 
@@ -319,20 +319,15 @@ class NodeProcess:
             TimeoutError: `text` did not appear in time (with the last output).
         """
         self._require_started()
-        deadline = time.monotonic() + timeout
-        while True:
-            log = self.log
-            if text in log:
-                return log
-            if not self.running():
-                if text in self.log:
-                    return self.log
-                raise RuntimeError(f"{self.name} ended ({self.describe_exit()}) before printing {text!r}. "
-                                   f"Last output:\n{self.log_tail()}")
-            if time.monotonic() >= deadline:
-                raise TimeoutError(f"{self.name} did not print {text!r} within {timeout} s. "
-                                   f"Last output:\n{self.log_tail()}")
-            time.sleep(0.05)
+        waiting.spin_until(lambda: text in self.log or not self.running(), timeout)
+        log = self.log
+        if text in log:
+            return log
+        if not self.running():
+            raise RuntimeError(f"{self.name} ended ({self.describe_exit()}) before printing {text!r}. "
+                               f"Last output:\n{self.log_tail()}")
+        raise TimeoutError(f"{self.name} did not print {text!r} within {timeout} s. "
+                           f"Last output:\n{self.log_tail()}")
 
     def wait_for_node(self, node_name: str, timeout: float = 10.0, namespace: str | None = None) -> None:
         """Wait until a node of this name is in the ROS graph of the child's domain.
@@ -364,23 +359,22 @@ class NodeProcess:
             watcher = rclpy.create_node(f"_course_lib_wait_{os.getpid()}_{next(_WATCHER_IDS)}",
                                         context=context, enable_rosout=False,
                                         start_parameter_services=False)
-            deadline = time.monotonic() + timeout
-            while True:
+            def appeared() -> bool:
                 # The graph is filled in by DDS discovery threads; no spinning needed to read it.
-                if any(name == node_name and namespace in (None, ns)
-                       for name, ns in watcher.get_node_names_and_namespaces()):
-                    if already_running and not self.warned_duplicate:
-                        _warn_if_still_running(already_running, self)
-                    return
-                if not self.running():
-                    raise RuntimeError(f"{self.name} ended ({self.describe_exit()}) before node {wanted!r} "
-                                       f"appeared. Last output:\n{self.log_tail()}")
-                if time.monotonic() >= deadline:
-                    raise TimeoutError(
-                        f"Node {wanted!r} did not appear in ROS domain {self.domain_id} within {timeout} s, "
-                        f"although {self.name} still runs: check the node name it passes to Node() and "
-                        f"that it calls rclpy.init(). Last output:\n{self.log_tail()}")
-                time.sleep(0.05)
+                return any(name == node_name and namespace in (None, ns)
+                           for name, ns in watcher.get_node_names_and_namespaces())
+
+            if waiting.spin_until(lambda: appeared() or not self.running(), timeout) and appeared():
+                if already_running and not self.warned_duplicate:
+                    _warn_if_still_running(already_running, self)
+                return
+            if not self.running():
+                raise RuntimeError(f"{self.name} ended ({self.describe_exit()}) before node {wanted!r} "
+                                   f"appeared. Last output:\n{self.log_tail()}")
+            raise TimeoutError(
+                f"Node {wanted!r} did not appear in ROS domain {self.domain_id} within {timeout} s, "
+                f"although {self.name} still runs: check the node name it passes to Node() and "
+                f"that it calls rclpy.init(). Last output:\n{self.log_tail()}")
         finally:
             if watcher is not None:
                 watcher.destroy_node()

@@ -8,8 +8,9 @@ import time
 import urllib.request
 from pathlib import Path
 
-
 from browser_support import free_port
+
+from course_lib import process_tree
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -43,12 +44,7 @@ def test_make_lab_serves_the_course_and_prints_its_url(tmp_path):
         prefix = terminal_output(port, token, "ros2 pkg prefix std_msgs", until=str(ROOT / ".venv"))
         assert str(ROOT / ".venv") in prefix
     finally:
-        os.killpg(lab.pid, signal.SIGTERM)
-        try:
-            lab.wait(timeout=20)
-        except subprocess.TimeoutExpired:
-            os.killpg(lab.pid, signal.SIGKILL)
-            lab.wait()
+        process_tree.stop_group(lab, ((signal.SIGTERM, 20), (signal.SIGKILL, 20)))
 
 
 def terminal_output(port: int, token: str, command: str, until: str, timeout: float = 60) -> str:

@@ -11,6 +11,7 @@ import tempfile
 import time
 from pathlib import Path
 
+from course_lib import waiting
 from course_lib.checks import answers
 from course_lib.checks.probe import RosProbe
 from course_lib.checks.registry import Check
@@ -282,11 +283,5 @@ def clip(text: str, limit: int = 1500) -> str:
 
 
 def _wait_for_file(path: Path, timeout: float, proc) -> bool:
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        if path.exists():
-            return True
-        if not proc.running():
-            return path.exists()
-        time.sleep(0.02)
+    waiting.spin_until(lambda: path.exists() or not proc.running(), timeout, poll=0.02)
     return path.exists()

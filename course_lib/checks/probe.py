@@ -3,7 +3,8 @@
 from __future__ import annotations
 
 import os
-import time
+
+from course_lib import waiting
 
 
 class RosProbe:
@@ -23,13 +24,7 @@ class RosProbe:
 
     def spin_until(self, condition, timeout: float) -> bool:
         """Process callbacks until condition() is true or `timeout` seconds pass; returns condition()."""
-        deadline = time.monotonic() + timeout
-        while not condition():
-            left = deadline - time.monotonic()
-            if left <= 0:
-                return bool(condition())
-            self.executor.spin_once(timeout_sec=min(0.05, left))
-        return True
+        return waiting.spin_until(condition, timeout, executor=self.executor)
 
     def spin_for(self, seconds: float) -> None:
         self.spin_until(lambda: False, seconds)
