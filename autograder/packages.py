@@ -32,7 +32,7 @@ import time
 import xml.etree.ElementTree as ElementTree
 from pathlib import Path
 
-from course_lib import workspace
+from course_lib import colcon, workspace
 
 #: The workspace folder beside the notebook.
 WORKSPACE = "ros2_ws"
@@ -190,7 +190,7 @@ def _package_log(ws: Path, output: str) -> str:
 
 def _colcon(ws: Path, args: list[str], env: dict, run) -> tuple[bool, str]:
     """Run ``colcon build ARGS`` in ws through `run`; (succeeded, the failing package's log)."""
-    command = [str(workspace.colcon_executable()), "build", *args]
+    command = [str(colcon.colcon_executable()), "build", *args]
     returncode, output = run(command, ws, env, BUILD_SECONDS)
     if returncode == 0:
         return True, output
@@ -242,7 +242,7 @@ def build_workspace(ws: Path, cache: InterfaceCache, scratch: Path, run, give=No
     packages = source_packages(ws)
     report.packages = sorted(packages)
     interfaces = {name: folder for name, folder in packages.items() if is_interface_package(folder)}
-    base = workspace.build_environment()
+    base = colcon.build_environment()
     underlays: list[Path] = []
     keys: dict[str, str] = {}
     for name in _in_dependency_order(interfaces):
@@ -410,7 +410,7 @@ def reference_interfaces(assignment: str, cache: InterfaceCache, scratch: Path) 
     from course_lib.checks import packages as checked
 
     found = []
-    env = workspace.build_environment()
+    env = colcon.build_environment()
     for name in checked.PACKAGES.get(assignment, {}):
         folder = REFERENCE_SRC / name
         if not is_interface_package(folder):
