@@ -132,8 +132,8 @@ def content_key(folder: Path, underlay_keys=()) -> str:
 
 class InterfaceCache:
     """Built interface packages, one folder per content key: ``<root>/<key>/install/`` (a colcon
-    install prefix), or ``<root>/<key>/failed.txt`` (the reason, so an identical broken package is
-    not built again either). Written by the grader (root) only; entries appear atomically."""
+    install prefix). Written by the grader (root) only; entries appear atomically. Failed builds
+    are not kept (see _build_interface); store(key, None, reason) records one all the same."""
 
     def __init__(self, root: Path):
         self.root = Path(root)
@@ -296,11 +296,10 @@ def _build_interface(name: str, folder: Path, key: str, cache: InterfaceCache, s
     if ok and (build_ws / "install" / "setup.bash").is_file():
         cache.store(key, build_ws / "install")
         install, _ = cache.lookup(key)
-        return install, None
-    failure = first_error_lines(output)
-    if "did not finish within" not in output:  # a timeout may be the machine's, not the package's
-        cache.store(key, None, failure)
-    return None, failure
+        return install or build_ws / "install", None
+    # A failure is not kept: it may be the machine's (a timeout, a full disk, the grader's own
+    # fault) rather than the package's, and a cached failure would fail every later submission.
+    return None, first_error_lines(output)
 
 
 def _in_dependency_order(interfaces: dict[str, Path]) -> list[str]:
@@ -363,6 +362,10 @@ def build_for_checks(assignment: str, course: Path, work: Path, workdir: Path, u
     def run(command, cwd, env, wall_seconds):
         if uid is not None:
             command = run_as.command(uid, command, max_processes=BUILD_PROCESSES)
+            # The sandbox hides the repository's autograder/: the wrapper runs from the grader's
+            # staged copy (autograder.staging), as the checks' do.
+            staged = work / "grader" / "autograder" / "run_as.py"
+            command = [str(staged) if part == os.path.abspath(run_as.__file__) else part for part in command]
         limits = processes.Limits(wall_seconds=wall_seconds, memory_mb=BUILD_MEMORY_MB, file_size_mb=256,
                                   grace_seconds=3.0)
         # A name of its own: a process started under the name of a running one replaces it (stops
@@ -373,7 +376,10 @@ def build_for_checks(assignment: str, course: Path, work: Path, workdir: Path, u
 
     cache = cache_of(course)
     report = build_workspace(Path(workdir) / WORKSPACE, cache, scratch, run, give)
-    report.reference_underlays = [str(p) for p in reference_interfaces(assignment, cache, scratch)]
+    try:
+        report.reference_underlays = [str(p) for p in reference_interfaces(assignment, cache, scratch)]
+    except RuntimeError as error:  # the course's fault: the checks that need messages say so
+        report.log += f"\n{error}"
     path = report.write(work / "build-report.json")
     return {REPORT_ENV: str(path)}
 

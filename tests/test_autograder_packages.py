@@ -77,9 +77,9 @@ def test_a_changed_message_is_built_again(tmp_path):
     assert packages.content_key(a) == packages.content_key(same) != packages.content_key(b)
 
 
-def test_a_failed_interface_build_gives_its_first_error_lines_and_is_not_built_again(tmp_path):
+def test_a_failed_interface_build_gives_its_first_error_lines_and_is_not_cached(tmp_path):
     """A CMake error: the reason quotes it from its first line, the workspace's other packages are
-    not built, and an identical package later gets the recorded failure without a build."""
+    not built, and an identical package later is built again (a failure may be the machine's)."""
     cache = packages.InterfaceCache(tmp_path / "cache")
     output = ("Starting >>> tutorial_interfaces\n-- Found ament_cmake\n"
               "CMake Error at CMakeLists.txt:2 (rosidl_generate_interfaces):\n  Unknown type 'float96'\n"
@@ -94,7 +94,7 @@ def test_a_failed_interface_build_gives_its_first_error_lines_and_is_not_built_a
         assert not report.ok
         assert report.reason.startswith("colcon build failed in package 'tutorial_interfaces':\nCMake Error at")
         assert "Unknown type 'float96'" in report.reason
-    assert len(colcon.calls) == 1
+    assert len(colcon.calls) == 2 and not cache.root.exists()
 
 
 def test_a_failed_python_package_names_the_package_and_the_error(tmp_path):

@@ -251,3 +251,39 @@ def node(ctx: Context) -> None:
             ctx.item(False, f"{topic}: the message does not decode ({error}); use images.image_to_compressed(crop, 'png')")
             continue
         compare_crop(ctx, topic, crop, expected[name], show=True)
+    _launch_item(ctx, CroppedPicture)
+
+
+#: The launch file that starts the camera and the marker reader.
+LAUNCH = ("readmarker", "catdog_warp.launch.xml")
+
+
+def _launch_item(ctx: Context, message_type) -> None:
+    """One item: ``ros2 launch readmarker catdog_warp.launch.xml`` starts image_publisher and
+    marker_reader, and crops of the camera's board arrive on cropped_img (the webcam's default
+    camera is the course's simulated board)."""
+    import sys
+
+    from rclpy.qos import QoSProfile, ReliabilityPolicy
+
+    ws = packages.require_build(ctx)
+    command = [sys.executable, "-m", "course_lib.launch", *LAUNCH]
+    launch = ctx.students.start(command, name="student-launch", cwd=ctx.workdir, domain_id=ctx.domain_id,
+                                wall_seconds=ctx.remaining() + 5, env=packages.student_env(ctx, ws))
+    crops = []
+    try:
+        with ctx.probe() as probe:
+            probe.node.create_subscription(message_type, "cropped_img", crops.append,
+                                           QoSProfile(depth=10, reliability=ReliabilityPolicy.BEST_EFFORT))
+            probe.spin_until(lambda: bool(crops) or not launch.running(), min(20.0, ctx.remaining() - 3))
+            nodes = {n for n, _ in probe.node.get_node_names_and_namespaces()}
+    finally:
+        launch.stop(timeout=3)
+    shown = f"`ros2 launch {' '.join(LAUNCH)}`"
+    if crops:
+        ctx.item(True, f"{shown} starts image_publisher and marker_reader; crops arrive on /cropped_img")
+        return
+    missing = sorted({"image_publisher", "marker_reader"} - nodes)
+    ctx.item(False, f"{shown}: no crop arrived on /cropped_img within 20 s"
+             + (f"; nodes missing: {missing}" if missing else "")
+             + f". Its output:\n{clip(launch.log_tail(6))}")
