@@ -169,9 +169,14 @@ class InterfaceCache:
 def first_error_lines(output: str, lines: int = 8) -> str:
     """The first error of a build log and the lines after it (or the log's end when no line
     looks like an error), without colcon's progress lines."""
-    text = [line for line in output.splitlines() if line.strip() and not line.startswith(("Starting >>>", "Finished <<<",
-                                                                                          "[Processing:", "Summary:"))]
+    text = [line for line in output.splitlines() if line.strip() and not line.startswith((
+        "Starting >>>", "Finished <<<", "Failed   <<<", "[Processing:", "Summary:"))]
     for index, line in enumerate(text):
+        if line.startswith("Traceback (most recent call last)"):
+            # colcon's own frames first: the exception (a SyntaxError in setup.py, say) is at the
+            # end of the traceback, with the student's file and line just above it.
+            end = next((i for i in range(index + 1, len(text)) if not text[i].startswith((" ", "\t"))), len(text) - 1)
+            return "\n".join(text[max(index + 1, end - 3):end + 1])
         if _ERROR_LINE.search(line):
             return "\n".join(text[index:index + lines])
     return "\n".join(text[-lines:])
@@ -184,7 +189,7 @@ def _package_log(ws: Path, output: str) -> str:
     if failed:
         log = ws / "log" / "latest_build" / failed[0] / "stdout_stderr.log"
         if log.is_file():
-            return log.read_text(errors="replace")
+            return f"Failed   <<< {failed[0]}\n" + log.read_text(errors="replace")
     return output
 
 

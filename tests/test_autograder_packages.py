@@ -122,3 +122,15 @@ def test_interface_packages_are_ordered_by_their_dependencies(tmp_path):
     (a / "package.xml").write_text("<package format=\"3\"><name>a_msgs</name><depend>b_msgs</depend></package>")
     found = packages.source_packages(ws)
     assert packages._in_dependency_order({n: found[n] for n in ("a_msgs", "b_msgs")}) == ["b_msgs", "a_msgs"]
+
+
+def test_a_setup_py_that_does_not_run_is_quoted_from_its_exception_not_from_colcons_frames():
+    """colcon reads setup.py in its own process: the traceback starts in colcon, the student's error ends it."""
+    output = ("Starting >>> pubsub\n--- stderr: pubsub\nTraceback (most recent call last):\n"
+              "  File \"/venv/colcon_core/executor/__init__.py\", line 91, in __call__\n    rc = await self.task()\n"
+              "  File \"/venv/colcon_ros/task/ament_python/build.py\", line 51, in build\n    setup_py_data = get()\n"
+              "  File \"/ws/src/pubsub/setup.py\", line 3\n    package_name = 'pubsub'(\n"
+              "SyntaxError: '(' was never closed\n---\nFailed   <<< pubsub [0.5s, exited with code 1]\n")
+    quoted = packages.first_error_lines(output)
+    assert quoted.endswith("SyntaxError: '(' was never closed") and "setup.py\", line 3" in quoted
+    assert "executor" not in quoted
