@@ -38,7 +38,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from autograder import config, gradebook, intake, kernel, student_uid
+from autograder import config, gradebook, intake, kernel, packages, student_uid
 from autograder.nbgrader_cli import env_for_tools
 from autograder.outputs import keep_autograded, keep_log, scrub_paths
 from autograder.outside_checks import grade_outside
@@ -92,6 +92,12 @@ class Grading:
     @property
     def autograded(self) -> Path:
         return self.root / "autograded" / self.sub.student / self.sub.assignment
+
+    @property
+    def workdir(self) -> Path:
+        """Where the notebook wrote the student's files: as root the kernel ran in a subfolder of
+        its own uid (autograder.kernel)."""
+        return self.autograded / kernel.WORK_SUBDIR if self.result.kernel_uid is not None else self.autograded
 
     @property
     def hide(self) -> list[Path]:
@@ -177,14 +183,22 @@ def read_scores(g: Grading) -> None:
         result.reason = _explain_failure(proc.log, proc)
 
 
+def build_workspace(g: Grading) -> None:
+    """The student's ROS 2 workspace built with colcon in the sandbox, interface packages from the
+    course's cache (autograder.packages); the checks read its report."""
+    if g.failed or not packages.needed(g.sub.assignment, g.workdir):
+        return
+    built = packages.build_for_checks(g.sub.assignment, g.course, g.work, g.workdir, g.result.kernel_uid,
+                                      g.domain_id, g.env, g.hide, run_sandboxed)
+    g.env.update(built)
+    g.result.detail += packages.instructor_note(built)
+
+
 def run_hidden_checks(g: Grading) -> None:
     """The hidden checks, outside the kernel (autograder.outside_checks)."""
     if g.failed:
         return
-    # As root the kernel ran in a subfolder of its own uid (autograder.kernel), where the
-    # notebook wrote the student's module.
-    workdir = g.autograded / kernel.WORK_SUBDIR if g.result.kernel_uid is not None else g.autograded
-    grade_outside(g.sub, g.result, g.work, g.autograded, workdir, g.domain_id, g.env, g.hide)
+    grade_outside(g.sub, g.result, g.work, g.autograded, g.workdir, g.domain_id, g.env, g.hide)
 
 
 def remove_grader_paths(g: Grading) -> None:
@@ -207,7 +221,7 @@ def keep_outputs(g: Grading) -> None:
 
 
 #: Grading one submission, in order (each step sees what the earlier ones left in Grading).
-STEPS = (stage_course_root, choose_environment, run_notebook, read_scores, run_hidden_checks,
+STEPS = (stage_course_root, choose_environment, run_notebook, read_scores, build_workspace, run_hidden_checks,
          remove_grader_paths, note_manual_grading, keep_outputs)
 
 

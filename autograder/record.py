@@ -13,7 +13,7 @@ import os
 import tempfile
 from pathlib import Path
 
-from autograder import reference
+from autograder import packages, reference
 from course_lib.checks import answers, registry, runner
 
 ANSWER_KEYS = Path(__file__).resolve().parent / "answers"
@@ -39,13 +39,18 @@ def record_answers(assignments: list[str] | None = None) -> list[Path]:
             for assignment in assignments or assignments_with_keys():
                 workdir = Path(tmp) / assignment
                 workdir.mkdir()
-                reference.write_reference_module(assignment, workdir)
+                reference.write_reference_workspace(assignment, workdir)
+                report = packages.build_here(assignment, workdir)
+                if not report.ok:
+                    raise RuntimeError(f"the {assignment} reference packages do not build: {report.reason}")
+                os.environ[packages.REPORT_ENV] = str(packages.report_path(workdir))
                 for name in registry.checks_of(assignment):
                     result = runner.execute(assignment, name, runner.SELFCHECK_SEED, workdir=workdir, mode="record")
                     if result.points < result.max_points:
                         raise RuntimeError(f"the reference solution got {result.points:g} of {result.max_points:g} "
                                            f"points in {assignment}/{name}:\n" + "\n".join(result.verdict_lines()))
         finally:
+            os.environ.pop(packages.REPORT_ENV, None)
             if previous is None:
                 os.environ.pop(answers.RECORD_ENV, None)
             else:

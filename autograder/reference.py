@@ -1,7 +1,8 @@
-"""The reference solutions of the assignments, as the source notebooks hold them (instructor side).
+"""The reference solutions of the assignments (instructor side).
 
-A source notebook's solution cells hold the reference between ``### BEGIN SOLUTION`` / ``### END
-SOLUTION`` markers; the cell that starts with ``%%writefile <module>.py`` is the student's module.
+They are the packages in assignments/reference_ws/src, with the solution between ``### BEGIN
+SOLUTION`` / ``### END SOLUTION`` markers; the source notebooks hold them as ``%%writefile
+ros2_ws/src/<package>/<file>`` cells (assignments/build.py).
 """
 
 from __future__ import annotations
@@ -19,31 +20,64 @@ def solution_source(text: str) -> str:
                      if "### BEGIN SOLUTION" not in line and "### END SOLUTION" not in line)
 
 
-def module_cell(nb: nbformat.NotebookNode) -> nbformat.NotebookNode:
-    """The solution cell that writes the student's module (%%writefile)."""
-    for cell in nb.cells:
-        if cell.cell_type == "code" and cell.source.startswith("%%writefile"):
-            return cell
-    raise LookupError("no %%writefile cell in the notebook")
+def writefile_cells(nb: nbformat.NotebookNode) -> list:
+    """The code cells that write the student's package files (%%writefile <path>), in order."""
+    return [cell for cell in nb.cells if cell.cell_type == "code" and cell.source.startswith("%%writefile")]
 
 
 def source_notebook(assignment: str, source: Path = SOURCE) -> nbformat.NotebookNode:
     return nbformat.read(Path(source) / assignment / f"{assignment}.ipynb", as_version=4)
 
 
-def write_module(nb: nbformat.NotebookNode, folder: Path, edits=()) -> Path:
-    """Write the module of a notebook's %%writefile cell into `folder`, as running the cell would,
-    with the solution markers removed and each (old, new) edit applied; return its path."""
-    first, body = solution_source(module_cell(nb).source).split("\n", 1)
+def write_files(nb: nbformat.NotebookNode, folder: Path, edits=()) -> Path:
+    """Write the files of a notebook's %%writefile cells into `folder`, as running the cells would,
+    with the solution markers removed and each (old, new) edit applied to the first file that
+    holds `old`; return folder/ros2_ws."""
+    files = {}
+    for cell in nb.cells:  # the shell cell that makes the folders and the empty files
+        for line in cell.source.splitlines() if cell.cell_type == "code" else ():
+            if line.startswith("!touch "):
+                files.update({path: "" for path in line.split()[1:]})
+    for cell in writefile_cells(nb):
+        first, _, body = solution_source(cell.source).partition("\n")
+        files[first.split()[1]] = body + ("\n" if body and not body.endswith("\n") else "")
+    return _write(files, folder, edits, "the notebook's %%writefile cells")
+
+
+#: The reference packages (assignments/reference_ws/src/<package>): the only copy of each solution.
+REFERENCE_SRC = SOURCE.parent / "reference_ws" / "src"
+
+
+def reference_files(assignment: str) -> dict[str, str]:
+    """{path relative to the notebook's folder (ros2_ws/src/...): text} of an assignment's
+    reference packages, solution markers removed, their tests and caches left out."""
+    from course_lib.checks import packages
+
+    files = {}
+    for package in packages.PACKAGES[assignment]:
+        folder = REFERENCE_SRC / package
+        for path in sorted(p for p in folder.rglob("*") if p.is_file()):
+            relative = path.relative_to(folder)
+            if relative.parts[0] in ("test", "__pycache__") or path.suffix == ".pyc" or "__pycache__" in relative.parts:
+                continue
+            files[f"{packages.WORKSPACE}/src/{package}/{relative.as_posix()}"] = solution_source(path.read_text())
+    return files
+
+
+def write_reference_workspace(assignment: str, folder: Path, edits=()) -> Path:
+    """Write the reference packages of an assignment into folder/ros2_ws/src, with each (old, new)
+    edit applied to the first file that holds `old`; return folder/ros2_ws."""
+    return _write(reference_files(assignment), folder, edits, f"the {assignment} reference packages")
+
+
+def _write(files: dict[str, str], folder: Path, edits, where: str) -> Path:
     for old, new in edits:
-        if old not in body:
-            raise ValueError(f"edit {old!r} is not in the module")
-        body = body.replace(old, new, 1)
-    path = Path(folder) / first.split()[1]
-    path.write_text(body)
-    return path
-
-
-def write_reference_module(assignment: str, folder: Path, edits=()) -> Path:
-    """Write the reference solution's module of an assignment into `folder`; return its path."""
-    return write_module(source_notebook(assignment), folder, edits)
+        target = next((name for name, text in files.items() if old in text), None)
+        if target is None:
+            raise ValueError(f"edit {old!r} is in no file of {where}")
+        files[target] = files[target].replace(old, new, 1)
+    for name, text in files.items():
+        path = Path(folder) / name
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(text)
+    return Path(folder) / "ros2_ws"

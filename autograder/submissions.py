@@ -45,7 +45,7 @@ def _tree_digest(paths: list[Path], digest) -> None:
 
 #: The modules of course_lib.checks that run every assignment's checks (a change regrades).
 CHECK_MODULES = ["registry", "result", "runner", "check_process", "context", "student_calls", "student_processes",
-                 "probe", "student", "answers"]
+                 "probe", "student", "answers", "packages"]
 
 
 def submission_digest(sub: Submission, course: Path) -> str:
@@ -54,6 +54,7 @@ def submission_digest(sub: Submission, course: Path) -> str:
     _tree_digest([sub.path, course / "source" / sub.assignment], digest)
     here, checks = Path(__file__).resolve().parent, Path(registry.__file__).resolve().parent
     code = [here / "kernel.py", here / "config.py", here / "checks_outside.py", here / "student_uid.py", here / "run_as.py",
+            here / "packages.py",
             here / "answers" / f"{sub.assignment}.py",
             *(checks / f"{name}.py" for name in CHECK_MODULES), checks / f"{sub.assignment}.py"]
     _tree_digest([path for path in code if path.exists()], digest)

@@ -1,15 +1,19 @@
-"""How long the autograder takes per submission, and what a second worker buys, in one run.
+"""How long the autograder takes per submission, cold and with the interface build cached, and
+what a second worker buys, in one run.
 
 Not a test: the times depend on the machine and on what else runs, so this prints them instead
 of asserting them. It releases the three assignments into a scratch course, hands in the
-reference solution of each for --students students, then grades the whole class twice with the
-real nbgrader CLI: once with one worker and once (everything graded again) with --workers.
+reference solution of each for --students students, then grades the whole class three times with
+the real nbgrader CLI, everything graded again each time: with one worker and an empty interface
+cache (cold: each assignment's first submission builds its message package), with one worker and
+the cache kept (every message package reused), and with --workers workers.
 
     .venv/bin/python benchmarks/bench_grading.py [--students 2] [--workers 2]
 
-Per assignment it prints the mean seconds per submission (nbgrader's notebook run plus the
-grader's own run of the hidden checks, as the grading report gives them); then the wall time of each
-run and the ratio, which is the speed-up of the extra workers on this machine.
+Per assignment it prints the seconds per submission (nbgrader's notebook run, the colcon build of
+the workspace and the grader's own run of the hidden checks, as the grading report gives them):
+the first submission of the cold run, and the mean of each run; then the wall time of each run
+and the ratio of the two cached runs, which is the speed-up of the extra workers on this machine.
 """
 
 from __future__ import annotations
@@ -17,6 +21,7 @@ from __future__ import annotations
 import argparse
 import os
 import platform
+import shutil
 import statistics
 import sys
 import tempfile
@@ -27,7 +32,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path[:0] = [str(ROOT), str(ROOT / "tests")]  # the grader runs from the repository
 
 import zoo  # noqa: E402 (tests/zoo builds submissions from the reference solutions)
-from autograder import grading, release, sandbox  # noqa: E402
+from autograder import grading, packages, release, sandbox  # noqa: E402
 
 ASSIGNMENTS = ["brightness", "pubsub", "catdog_warp"]
 
@@ -49,21 +54,24 @@ def main(argv=None) -> int:
         for index in range(args.students):
             for assignment in ASSIGNMENTS:
                 zoo.submit(course, f"student{index}", assignment)
-        runs = {workers: timed_grade(course, workers) for workers in (1, args.workers)}
+        shutil.rmtree(packages.cache_of(course).root, ignore_errors=True)
+        runs = {"cold": timed_grade(course, 1), "cached": timed_grade(course, 1),
+                "workers": timed_grade(course, args.workers)}
     print(f"{platform.node()}: {os.cpu_count()} CPUs, isolation {sandbox.isolation()}, "
           f"{args.students} reference submissions per assignment\n")
-    print(f"{'assignment':<14}{'s/submission (1 worker)':>26}{f's/submission ({args.workers} workers)':>28}"
-          f"{'scores':>14}")
+    print(f"{'assignment':<14}{'first, cold':>12}{'mean, cold':>12}{'mean, cached':>14}"
+          f"{f'mean, {args.workers} workers':>18}{'scores':>12}")
     for assignment in ASSIGNMENTS:
-        cells = []
-        for workers in (1, args.workers):
-            seconds = [r.seconds for r in runs[workers][1] if r.assignment == assignment]
+        cells = [f"{[r.seconds for r in runs['cold'][1] if r.assignment == assignment][0]:.1f}"]
+        for run in ("cold", "cached", "workers"):
+            seconds = [r.seconds for r in runs[run][1] if r.assignment == assignment]
             cells.append(f"{statistics.mean(seconds):.1f}")
         scores = {f"{r.score:g}/{r.max_score:g}" for _, results in runs.values() for r in results
                   if r.assignment == assignment}
-        print(f"{assignment:<14}{cells[0]:>26}{cells[1]:>28}{','.join(sorted(scores)):>14}")
-    one, many = runs[1][0], runs[args.workers][0]
-    count = len(runs[1][1])
+        print(f"{assignment:<14}{cells[0]:>12}{cells[1]:>12}{cells[2]:>14}{cells[3]:>18}{','.join(sorted(scores)):>12}")
+    one, many = runs["cached"][0], runs["workers"][0]
+    print(f"\nwall time: {runs['cold'][0]:.0f} s cold, {one:.0f} s cached (1 worker)")
+    count = len(runs["cached"][1])
     print(f"\n{count} submissions: {one:.0f} s with 1 worker, {many:.0f} s with {args.workers} workers: "
           f"speed-up {one / many:.2f}x")
     return 0

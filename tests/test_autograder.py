@@ -12,7 +12,7 @@ import pytest
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import zoo  # noqa: E402
-from autograder import grading, reference, release, sandbox  # noqa: E402
+from autograder import grading, packages, reference, release, sandbox  # noqa: E402
 from course_lib.checks import registry, runner, validate  # noqa: E402
 
 ASSIGNMENTS = ["brightness", "pubsub", "catdog_warp"]
@@ -71,8 +71,13 @@ def test_sandbox_hides_directories_and_keeps_the_command():
         assert command[:3] == ["unshare", "--net", "--mount"] and "/somewhere/course" in command
 
 
-def _module_dir(tmp_path: Path, assignment: str, edits=()) -> Path:
-    reference.write_reference_module(assignment, tmp_path, edits)
+def _module_dir(tmp_path: Path, assignment: str, edits=(), monkeypatch=None) -> Path:
+    """The reference packages (with `edits`) in tmp_path/ros2_ws; with `monkeypatch`, also built as
+    the grader builds them (interface packages from a cache), and the checks told so."""
+    reference.write_reference_workspace(assignment, tmp_path, edits)
+    if monkeypatch is not None:
+        packages.build_here(assignment, tmp_path)
+        monkeypatch.setenv(packages.REPORT_ENV, str(packages.report_path(tmp_path)))
     return tmp_path
 
 
@@ -83,10 +88,10 @@ def _brightness_mistakes():
 
 
 @pytest.mark.parametrize("student", sorted(_brightness_mistakes()))
-def test_brightness_typical_mistake_gets_its_score_and_reason(tmp_path, student):
+def test_brightness_typical_mistake_gets_its_score_and_reason(tmp_path, monkeypatch, student):
     """Typical brightness mistakes, run through the checks directly: expected points and reason."""
     entry = _brightness_mistakes()[student]
-    workdir = _module_dir(tmp_path, "brightness", entry["edits"])
+    workdir = _module_dir(tmp_path, "brightness", entry["edits"], monkeypatch if entry["node"] is not None else None)
     texts, first_failures = [], []
     for check in ("values", "node"):
         if entry[check] is None:
@@ -107,15 +112,18 @@ def test_brightness_typical_mistake_gets_its_score_and_reason(tmp_path, student)
         assert phrase not in text, texts
 
 
+WARP = "crop = cv2.warpPerspective(frame, homography, (width, height), flags=cv2.INTER_LINEAR)"
 CATDOG_MISTAKES = {
-    "bgr_swapped": ([("            crops[name] = cv2.warpPerspective(frame_bgr, H, (width, height))",
-                      "            crops[name] = cv2.cvtColor(cv2.warpPerspective(frame_bgr, H, (width, height)), "
-                      "cv2.COLOR_BGR2RGB)")], "red and blue are swapped"),
-    "mirrored": ([("target = marker_board.crop_corners(size)",
+    "bgr_swapped": ([(WARP, WARP + "\n        crop = cv2.cvtColor(crop, cv2.COLOR_BGR2RGB)")], "red and blue are swapped"),
+    "mirrored": ([("target = marker_board.crop_corners((width, height))",
                    "target = np.float32([[width - 1, 0], [0, 0], [0, height - 1], [width - 1, height - 1]])")],
                  "mirrored left-right"),
-    "corner_order": ([("zip(markers, marker_board.CORNER_OF_MARKER)", "zip(markers, (0, 1, 2, 3))")], "similarity"),
-    "size_swapped": ([("(width, height))\n", "(height, width))\n")], "size is (width, height)"),
+    # Each marker's corner 0 instead of the corner that touches the picture.
+    "corner_order": ([("corners = marker_board.picture_corners(markers, name)",
+                       "corners = (np.float32([markers[m][0] for m in marker_board.PICTURES[name]])\n"
+                       "                   if all(m in markers for m in marker_board.PICTURES[name]) else None)")], "similarity"),
+    "size_swapped": ([("(width, height), flags=cv2.INTER_LINEAR)", "(height, width), flags=cv2.INTER_LINEAR)")],
+                     "size is (width, height)"),
 }
 
 
@@ -132,8 +140,11 @@ def test_catdog_typical_mistake_loses_points_with_its_reason(tmp_path, mistake):
 def test_catdog_picture_reported_from_its_first_marker_loses_points_in_every_grading(tmp_path):
     """Each of a picture's four markers is hidden in turn in every grading, not left to a random
     draw: a crop_pictures that reports a picture whenever its first marker is seen always loses."""
-    edits = [("if all(m in found for m in markers):", "if markers[0] in found:"),
-             ("found[m][c] for m, c in", "found.get(m, found[markers[0]])[c] for m, c in")]
+    edits = [("corners = marker_board.picture_corners(markers, name)",
+              "first = marker_board.PICTURES[name][0]\n"
+              "        corners = marker_board.picture_corners({m: markers.get(m, markers.get(first)) for m in marker_board.PICTURES[name]}\n"
+              "                                         if first in markers else markers, name)"),
+             ("if corners is None or not _is_picture_shape(corners):", "if corners is None:")]
     workdir = _module_dir(tmp_path, "catdog_warp", edits)
     for seed in (3, 4):
         result = runner.execute("catdog_warp", "missing_and_none", seed, workdir=workdir, mode="graded")
@@ -149,23 +160,30 @@ def test_catdog_reference_passes_easy_scenes(tmp_path):
 
 
 PUBSUB_MISTAKES = {
-    # mistake: (edits of the reference module, the check it costs, a phrase of the verdict)
-    "wrong_topic": ([('TOPIC = "ros_tutorial_msg"', 'TOPIC = "ros_tutorial"')], "publisher",
+    # mistake: (edits of the reference packages, the check it costs, a phrase of the verdict)
+    "wrong_topic": ([("TOPIC = 'ros_tutorial_msg'", "TOPIC = 'ros_tutorial'")], "publisher",
                     "nothing arrived on /ros_tutorial_msg"),
-    "queue_depth_10": ([("QUEUE_DEPTH = 100", "QUEUE_DEPTH = 10")], "subscriber", "queue depth of 100"),
-    "best_effort": ([("self.create_publisher(Header, TOPIC, QUEUE_DEPTH)",
-                      "self.create_publisher(Header, TOPIC, rclpy.qos.qos_profile_sensor_data)")], "publisher",
+    "queue_depth_10": ([("QUEUE_DEPTH = 100", "QUEUE_DEPTH = 10")], "publisher", "queue depth of 100"),
+    "best_effort": ([("self.create_publisher(MsgTutorial, TOPIC, QUEUE_DEPTH)",
+                      "self.create_publisher(MsgTutorial, TOPIC, rclpy.qos.qos_profile_sensor_data)")], "publisher",
                     "publisher queue depth 5"),
     "one_hertz": ([("create_timer(0.1,", "create_timer(1.0,")], "publisher", "cannot measure a 10 Hz rate"),
     "counter_stuck": ([("        self.count += 1\n", "")], "publisher", "add one per message"),
+    # Package-level mistakes (the zoo hands some of them in through the whole pipeline).
+    "missing_dependency": ([("  <depend>tutorial_interfaces</depend>\n", "")], "publisher",
+                           "add <depend>tutorial_interfaces</depend>"),
+    "wrong_entry_point": ([("'topic_subscriber = pubsub.topic_subscriber:main'",
+                            "'subscriber = pubsub.topic_subscriber:main'")], "subscriber",
+                          "has no executable 'topic_subscriber'"),
 }
 
 
 @pytest.mark.parametrize("mistake", sorted(PUBSUB_MISTAKES))
-def test_pubsub_typical_mistake_loses_points_with_its_reason(tmp_path, mistake):
+def test_pubsub_typical_mistake_loses_points_with_its_reason(tmp_path, monkeypatch, mistake):
     """Typical publisher/subscriber mistakes score below full, and the verdict names the mistake."""
     edits, check, reason = PUBSUB_MISTAKES[mistake]
-    result = runner.execute("pubsub", check, 5, workdir=_module_dir(tmp_path, "pubsub", edits), mode="graded")
+    result = runner.execute("pubsub", check, 5, workdir=_module_dir(tmp_path, "pubsub", edits, monkeypatch),
+                             mode="graded")
     assert result.points < result.max_points, result.verdict_lines()
     assert reason in "\n".join(result.verdict_lines())
 

@@ -1,9 +1,10 @@
 """Does the autograder grade a zoo of submissions right, in parallel, and survive them all?
 
-One module-scoped grading run (2 workers) is shared by the tests: release the brightness
-assignment into a fresh course directory, hand in the zoo (tests/zoo/brightness.py: the
-reference solution, typical mistakes and hostile submissions), grade, and check each grade,
-its reason, the submitted files, leftover processes, and a second (cached) run.
+One module-scoped grading run (2 workers) is shared by the tests: release the brightness and
+pubsub assignments into a fresh course directory, hand in the zoo (tests/zoo/brightness.py: the
+reference solution, typical mistakes and hostile submissions; tests/zoo/pubsub.py: mistakes in the
+packages), grade, and check each grade, its reason (for the package mistakes on the feedback
+page), the submitted files, leftover processes, and a second (cached) run.
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import zoo  # noqa: E402
 from zoo import brightness as brightness_zoo  # noqa: E402
+from zoo import pubsub as pubsub_zoo  # noqa: E402
 
 # The shared grading run (about 15 submissions, 2 workers) happens in the first test's set-up.
 pytestmark = [pytest.mark.slow, pytest.mark.timeout(1500)]
@@ -36,10 +38,12 @@ def graded(tmp_path_factory):
     from autograder import grading, release
 
     course = tmp_path_factory.mktemp("zoo_course")
-    release.release(course, ["brightness"])
+    release.release(course, ["brightness", "pubsub"])
     entries = {k: v for k, v in brightness_zoo.entries(str(course)).items() if v.get("level") != "check"}
     for student, entry in entries.items():
         zoo.submit(course, student, "brightness", entry["edits"])
+    for student, entry in pubsub_zoo.entries().items():
+        zoo.submit(course, student, "pubsub", entry["edits"])
     before = _hashes(course / "submitted")
     started = time.monotonic()
     results = grading.grade(course, workers=2, progress=False)
@@ -78,6 +82,25 @@ def test_zoo_entry_gets_its_expected_score_and_reason(graded, student):
     for check in ("values", "node"):
         assert _matches(entry[check], scores[check]), (check, scores, _outputs(graded["course"], student)[-3000:])
     assert entry["reason"] in _outputs(graded["course"], student)
+
+
+@pytest.mark.parametrize("student", sorted(pubsub_zoo.entries()))
+def test_package_mistake_is_graded_down_with_its_reasons_on_the_feedback_page(graded, student):
+    """A mistake in a package (a message field, a missing <depend>, a wrong entry point, a build
+    error) costs the points of the checks it breaks, and the student's feedback page names it."""
+    from autograder import feedback
+
+    entry = pubsub_zoo.entries()[student]
+    result = graded["results"][student]
+    assert result.status == "graded", result.reason
+    scores = _check_scores(result)
+    outputs = zoo.graded_outputs(graded["course"], student, "pubsub")
+    for check, expected in entry["scores"].items():
+        assert _matches(expected, scores[check]), (check, scores, outputs[-3000:])
+    feedback.write_feedback(graded["course"], student=student, assignment="pubsub")
+    page = (graded["course"] / "feedback" / student / "pubsub" / "pubsub.html").read_text().replace("&#39;", "'")
+    for reason in entry["reasons"]:
+        assert reason in page, (reason, outputs[-3000:])
 
 
 def test_reference_solution_gets_full_marks(graded):
@@ -122,8 +145,8 @@ def test_grading_report_lists_every_submission(graded):
 
     with open(graded["course"] / "grading_report.csv") as handle:
         rows = list(csv.DictReader(handle))
-    assert {r["student_id"] for r in rows} == set(graded["entries"])
-    assert all(r["assignment"] == "brightness" and r["max_score"] == "11" for r in rows)
+    assert {r["student_id"] for r in rows} == set(graded["entries"]) | set(pubsub_zoo.entries())
+    assert all(r["max_score"] == ("11" if r["assignment"] == "brightness" else "10") for r in rows)
     assert {r["student_id"]: float(r["score"]) for r in rows} == {s: r.score for s, r in graded["results"].items()}
 
 
@@ -143,4 +166,4 @@ def test_gradebook_holds_the_scores(graded):
 
     with Gradebook(f"sqlite:///{graded['course'] / 'gradebook.db'}") as gb:
         for student, result in graded["results"].items():
-            assert gb.find_submission("brightness", student).score == pytest.approx(result.score)
+            assert gb.find_submission(result.assignment, student).score == pytest.approx(result.score)

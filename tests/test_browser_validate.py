@@ -3,8 +3,8 @@ Assignments panel, used as a student uses them.
 
 The brightness assignment is released into a fresh course directory and into a scratch exchange
 (the real nbgrader CLI, as the instructor runs it). Two students work on the released notebook,
-each in a folder of their own under the lab's root (the notebook writes brightness_node.py next
-to itself): ``correct/`` holds the reference solution, ``incorrect/`` the reference with
+each in a folder of their own under the lab's root (the notebook writes and builds its workspace
+ros2_ws next to itself): ``correct/`` holds the reference solution, ``incorrect/`` the reference with
 ``average_brightness`` returning 0. Each presses Validate; nbgrader saves the notebook, runs it
 top to bottom on the server and answers with a dialog, whose text the tests read. Screenshots go
 to artifacts/browser/validate_<student>.png and assignment_list.png.
@@ -100,8 +100,8 @@ def test_validate_says_success_for_the_reference_solution(browser, lab):
     assert verdict == ("Validation Results", "success", False), said(result, lab)
     assert result.text == "Success! Your notebook passes all the tests.", said(result, lab)
     # nbgrader ran the notebook in the student's folder: that is where the module was written.
-    assert (lab.root_dir / "correct" / "brightness_node.py").is_file()
-    assert not (lab.root_dir / "brightness_node.py").exists()
+    assert (lab.root_dir / "correct" / "ros2_ws" / "install" / "brightness").is_dir()
+    assert not (lab.root_dir / "ros2_ws").exists()
 
 
 @pytest.mark.timeout(VALIDATE_TIMEOUT + 300)

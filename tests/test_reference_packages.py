@@ -3,10 +3,12 @@
 - readmarker.crop.crop_pictures (the plain function) against the ground truth of rendered
   scenes: right crops on easy and hard scenes, no crop without all four markers, no crash on
   odd frames;
-- readmarker.marker_reader.MarkerReader in this process over real Fast DDS: mono8/rgb8 input,
-  bad messages skipped;
-- slow: a real `colcon build` of both packages into a temporary workspace, then the installed
-  executables run as processes (like `ros2 run`) in a reserved ROS domain.
+- readmarker.marker_reader.MarkerReader in this process over real Fast DDS (its message package
+  catdog_interfaces built first): mono8/rgb8 input, bad messages skipped;
+- slow: a real `colcon build` of the catdog_warp packages into a temporary workspace (as the
+  grader builds them: autograder.packages, interface packages from a cache), then the installed
+  executables run as processes (like `ros2 run`) in a reserved ROS domain;
+- every assignment's reference packages build, and their solution regions are marked.
 """
 
 import sys
@@ -21,9 +23,9 @@ import rclpy
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
-from sensor_msgs.msg import CompressedImage, Image
+from sensor_msgs.msg import Image
 
-from course_lib import colcon, images, marker_board, pictures, rosenv, scenes, workspace
+from course_lib import images, marker_board, pictures, rosenv, scenes, workspace
 
 SOURCE = Path(__file__).resolve().parents[1] / "assignments" / "reference_ws" / "src"
 PACKAGES = ("webcam", "readmarker")
@@ -31,7 +33,9 @@ BOARD_IDS = tuple(i for ids in marker_board.PICTURES.values() for i in ids)
 
 sys.path.insert(0, str(SOURCE / "readmarker"))  # the package's modules, as colcon would install them
 from readmarker.crop import crop_pictures, find_markers  # noqa: E402
-from readmarker.marker_reader import MarkerReader  # noqa: E402
+
+#: The picture of each CroppedPicture.picture number.
+PICTURE_NAMES = {1: "cat", 2: "dog"}
 
 WAIT = 20.0  # a bound on every wait for messages, not a speed goal
 
@@ -175,8 +179,19 @@ def test_bad_arguments_are_refused_with_the_fix(frame, size, message):
 
 # ---- MarkerReader in this process -----------------------------------------------------------
 
-def test_marker_reader_accepts_bgr_rgb_mono_and_skips_bad_images(domain_id):
+def use_interfaces(ws):
+    """Import catdog_interfaces (which marker_reader imports) in this process: the underlay the
+    build used (readmarker itself is imported from its source, above)."""
+    for install in sorted((ws.parent / ".colcon" / "underlays").glob("*/install")):
+        workspace.use_workspace(install.parent)
+
+
+def test_marker_reader_accepts_bgr_rgb_mono_and_skips_bad_images(built_ws, domain_id):
     """rgb8 gives the bgr8 crops, mono8 grey ones of the same pictures; bad images only count."""
+    use_interfaces(built_ws)
+    from catdog_interfaces.msg import CroppedPicture
+    from readmarker.marker_reader import MarkerReader
+
     scene = scenes.render_scene(4)
     frame = scene.frame
     good = {
@@ -203,8 +218,8 @@ def test_marker_reader_accepts_bgr_rgb_mono_and_skips_bad_images(domain_id):
                                                                     Parameter("height", value=150)])
         tester = Node("tester", context=context)
         publisher = tester.create_publisher(Image, "image", 10)
-        for name in marker_board.PICTURES:
-            tester.create_subscription(CompressedImage, f"cropped_img/{name}", received[name].append, 50)
+        tester.create_subscription(CroppedPicture, "cropped_img",
+                                   lambda msg: received[PICTURE_NAMES[msg.picture]].append(msg.image), 50)
         executor = SingleThreadedExecutor(context=context)
         executor.add_node(reader)
         executor.add_node(tester)
@@ -238,7 +253,10 @@ def test_marker_reader_accepts_bgr_rgb_mono_and_skips_bad_images(domain_id):
             assert score >= marker_board.SAME_CROP_THRESHOLD, f"{name} from {encoding}: {score:.3f}"
 
 
-def test_an_unknown_dictionary_is_refused_with_the_choices(domain_id):
+def test_an_unknown_dictionary_is_refused_with_the_choices(built_ws, domain_id):
+    use_interfaces(built_ws)
+    from readmarker.marker_reader import MarkerReader
+
     context = rclpy.Context()
     rclpy.init(context=context, domain_id=domain_id)
     try:
@@ -266,17 +284,14 @@ def test_packages_have_the_ament_python_layout():
 
 @pytest.fixture(scope="module")
 def built_ws(tmp_path_factory):
-    """Both packages copied to a temporary workspace and built there with colcon, once."""
-    ws = tmp_path_factory.mktemp("reference_ws")
-    for package in PACKAGES:
-        # Copy the sources only: a stray build/ or __pycache__ in the repository must not leak in.
-        for path in (SOURCE / package).rglob("*"):
-            if path.is_file() and "__pycache__" not in path.parts:
-                target = ws / "src" / path.relative_to(SOURCE)
-                target.parent.mkdir(parents=True, exist_ok=True)
-                target.write_bytes(path.read_bytes())
-    result = colcon.build(ws, timeout=240)
-    assert sorted(result.finished) == sorted(PACKAGES), result.output
+    """The catdog_warp packages (sources only) in a temporary workspace, built as the grader builds
+    them (the interface package from a cache), once."""
+    from autograder import packages, reference
+
+    folder = tmp_path_factory.mktemp("reference")
+    ws = reference.write_reference_workspace("catdog_warp", folder)
+    report = packages.build_here("catdog_warp", folder)
+    assert report.ok, report.reason
     return ws
 
 
@@ -296,8 +311,11 @@ class Pipeline:
         rclpy.init(context=self.context, domain_id=domain_id)
         self.node = Node("pipeline_tester", context=self.context)
         self.node.create_subscription(Image, "image", lambda msg: self.input_stamps.add(stamp_of(msg)), 100)
-        for name in marker_board.PICTURES:
-            self.node.create_subscription(CompressedImage, f"cropped_img/{name}", self.crops[name].append, 100)
+        use_interfaces(ws)
+        from catdog_interfaces.msg import CroppedPicture
+
+        self.node.create_subscription(CroppedPicture, "cropped_img",
+                                      lambda msg: self.crops[PICTURE_NAMES[msg.picture]].append(msg.image), 100)
         self.bad_publisher = self.node.create_publisher(Image, "image", 10)
         self.executor = SingleThreadedExecutor(context=self.context)
         self.executor.add_node(self.node)
@@ -374,3 +392,22 @@ def test_built_nodes_stop_cleanly_on_ctrl_c(pipeline):
     assert pipeline.camera.stop() == 0, pipeline.camera.log_tail()
     assert pipeline.reader.stop() == 0, pipeline.reader.log_tail()
     assert "Traceback" not in pipeline.reader.log + pipeline.camera.log
+
+
+# ---- every assignment's reference packages ------------------------------------------------------
+
+@pytest.mark.parametrize("assignment", ["brightness", "pubsub", "catdog_warp"])
+def test_the_source_notebook_writes_exactly_the_reference_packages(tmp_path, assignment):
+    """The source notebook's cells write exactly the files of the assignment's reference packages
+    (markers removed), and its solution cells are the files with solution regions."""
+    from autograder import reference
+    from course_lib.checks import packages
+
+    files = reference.reference_files(assignment)
+    assert set(packages.PACKAGES[assignment]) == {name.split("/")[2] for name in files}
+    nb = reference.source_notebook(assignment)
+    reference.write_files(nb, tmp_path)
+    written = {str(p.relative_to(tmp_path)): p.read_text() for p in tmp_path.rglob("*") if p.is_file()}
+    assert written == files
+    solutions = [c for c in reference.writefile_cells(nb) if c.metadata.get("nbgrader", {}).get("solution")]
+    assert solutions and all("### BEGIN SOLUTION" in c.source for c in solutions)

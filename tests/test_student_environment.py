@@ -72,9 +72,11 @@ def reference_blocks() -> dict[str, list[str]]:
     for path in sorted((REPO / "autograder" / "answers").glob("*.py")):
         for number, block in enumerate(path.read_text().split("\ndef ")[1:]):
             blocks[f"answer key {path.stem}: function {number}"] = significant_lines(block.split("\n", 1)[1])
+    # The reference packages: their solution regions (the rest of their files is given to students).
     packages = REPO / "assignments" / "reference_ws" / "src"
     for path in sorted(p for package in packages.iterdir() for p in (package / package.name).glob("*.py")):
-        blocks[f"reference package {path.relative_to(REPO)}"] = significant_lines(path.read_text())
+        for number, block in enumerate(_between(path.read_text(), "### BEGIN SOLUTION", "### END SOLUTION")):
+            blocks[f"reference package {path.relative_to(REPO)} solution {number}"] = significant_lines(block)
     return {name: lines for name, lines in blocks.items() if lines}
 
 
@@ -162,11 +164,15 @@ def test_the_scan_finds_a_planted_solution(wheel_files):
 
 @pytest.mark.slow
 @pytest.mark.parametrize("assignment", ASSIGNMENTS)
-def test_untouched_release_earns_nothing(release, tmp_path, assignment):
-    """The released stubs, handed in as they are, score 0 in every graded check, and a check that
-    calls a stub says to replace NotImplementedError."""
+def test_untouched_release_earns_nothing(release, tmp_path, monkeypatch, assignment):
+    """The released stubs, handed in as they are (and built as the grader builds them), score 0 in
+    every graded check, and a check that calls a stub says to replace NotImplementedError."""
+    from autograder import packages
+
     nb = nbformat.read(release / assignment / f"{assignment}.ipynb", as_version=4)
-    reference.write_module(nb, tmp_path)
+    reference.write_files(nb, tmp_path)
+    packages.build_here(assignment, tmp_path)
+    monkeypatch.setenv(packages.REPORT_ENV, str(packages.report_path(tmp_path)))
     verdicts = []
     for name in registry.checks_of(assignment):
         result = runner.execute(assignment, name, 7, workdir=tmp_path, mode="graded")

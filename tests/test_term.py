@@ -35,7 +35,7 @@ DUE = "2025-03-14 23:59:00 UTC"
 ON_TIME, LATE = "2025-03-14-20-15-00", "2025-03-16-09-30-00"  # LATE: 1 d 9.5 h late, 2 started days
 PER_DAY = 0.1
 #: bob's subscriber raises in its constructor: the publisher's points only, and a traceback of his module.
-BROKEN_SUBSCRIBER = [("        self.subscription = self.create_subscription(Header, TOPIC, self.on_message, QUEUE_DEPTH)",
+BROKEN_SUBSCRIBER = [("        self.subscription = self.create_subscription(\n            MsgTutorial, TOPIC, self.on_message, QUEUE_DEPTH)",
                       "        raise RuntimeError('subscriber not written yet')")]
 ROSTER = "id,first_name,last_name,email,Section\nalice,Alice,Ang,alice@example.org,A\nbob,Bob,\"Baker, Jr.\",,A\n" \
          "carol,Carol,Chen,,B\ndave,Dave,Dunn,,B\n"
@@ -185,7 +185,7 @@ def test_feedback_shows_the_penalty_and_wraps_and_hides_the_graders_paths(term, 
     bob = (feedback / "bob" / "index.html").read_text()
     assert "due 2025-03-14 23:59 UTC" in bob and "submitted 2025-03-16 09:30 UTC" in bob and "late penalty" in bob
     page = (feedback / "bob" / "pubsub" / "pubsub.html").read_text()
-    assert "subscriber not written yet" in page and 'File "pubsub_nodes.py"' in page.replace("&quot;", '"')
+    assert "subscriber not written yet" in page and 'pubsub/topic_subscriber.py"' in page.replace("&quot;", '"')
     assert "white-space: pre-wrap" in page
     carol = (feedback / "carol" / "index.html").read_text()
     assert "not &#x27;pubsub.ipynb&#x27;" in carol

@@ -10,6 +10,10 @@ The contract (also in the notebook and in assignments/README.md):
   per frame; accepts bgr8 and mono8 frames; keeps up with 1920x1080 frames at 30 Hz; its names
   can be remapped (``--ros-args -r __node:=... -r /image:=...``).
 - ``main(args=None)`` in brightness_node.py runs the node until Ctrl-C.
+
+They live in the ament_python package ``brightness`` (``ros2_ws/src/brightness``), module
+``brightness/brightness_node.py``, executable ``brightness_node``; its package.xml declares
+rclpy, sensor_msgs and std_msgs.
 """
 
 from __future__ import annotations
@@ -18,12 +22,14 @@ import time
 
 import numpy as np
 
-from course_lib.checks import runner
+from course_lib.checks import packages, runner
 from course_lib.checks.context import Context
 from course_lib.checks.registry import check
 from course_lib.checks.student_processes import student_env
 
 ASSIGNMENT = "brightness"
+#: The package and executable of the node: ``ros2 run brightness brightness_node``.
+PACKAGE, EXECUTABLE = "brightness", "brightness_node"
 
 
 def selfcheck(name: str):
@@ -241,9 +247,11 @@ def node(ctx: Context) -> None:
     burst = _burst_images(ctx.rng)
     # All three nodes start at once (their start-up and discovery overlap): the student's node,
     # the same node under remapped names (its topics are apart), and the yardstick.
-    node = ctx.start_node()
-    remapped = ctx.start_node("--ros-args", "-r", f"__node:={REMAPPED_NODE_NAME}", "-r", f"/image:={REMAPPED_IMAGE}",
-                              "-r", f"/brightness:={REMAPPED_BRIGHTNESS}", tag="-remapped")
+    node = packages.run(ctx, PACKAGE, EXECUTABLE)  # ros2 run brightness brightness_node
+    remapped = packages.run(ctx, PACKAGE, EXECUTABLE, "--ros-args", "-r", f"__node:={REMAPPED_NODE_NAME}",
+                            "-r", f"/image:={REMAPPED_IMAGE}", "-r", f"/brightness:={REMAPPED_BRIGHTNESS}",
+                            tag="-remapped")
+    packages.dependency_items(ctx, PACKAGE)
     yardstick = _start_yardstick(ctx)
     crashed = False
     try:

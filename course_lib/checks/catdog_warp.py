@@ -9,9 +9,15 @@ corners that touch it, marker_board.CORNER_OF_MARKER):
   key only when all four of that picture's markers are found; each crop is a BGR uint8 image of
   ``size`` (width, height), the picture's top-left corner at pixel (0, 0), upright, not mirrored.
 - ``MarkerReader()``: node ``marker_reader``; subscribes ``image`` (sensor_msgs/Image, any QoS);
-  for each frame publishes the crops it finds on ``cropped_img/cat`` and ``cropped_img/dog``
-  (sensor_msgs/CompressedImage, e.g. images.image_to_compressed(crop, "png")).
+  for each frame publishes each crop it finds on ``cropped_img`` as a
+  ``catdog_interfaces/msg/CroppedPicture``: ``int32 picture`` (CAT = 1, DOG = 2) and
+  ``sensor_msgs/CompressedImage image`` (e.g. images.image_to_compressed(crop, "png")).
 - ``main(args=None)`` runs the node until Ctrl-C.
+
+The packages (``ros2_ws/src``): ``catdog_interfaces`` (the message), ``webcam`` (executable
+``image_publisher``) and ``readmarker`` (``readmarker/crop.py`` with crop_pictures,
+``readmarker/marker_reader.py`` with the node, executable ``marker_reader``, and
+``launch/catdog_warp.launch.xml`` starting both nodes).
 
 Crops are compared with the ground truth of the generated scene (Scene.expected_crops) by
 marker_board.crop_similarity, passing at marker_board.SAME_CROP_THRESHOLD; colours are checked separately
@@ -24,11 +30,14 @@ import time
 
 import numpy as np
 
-from course_lib.checks import runner
+from course_lib.checks import packages, runner
 from course_lib.checks.context import Context, clip
 from course_lib.checks.registry import check
 
 ASSIGNMENT = "catdog_warp"
+#: The message of a crop: which picture (CAT = 1, DOG = 2) and the crop.
+MESSAGE_FIELDS = [("int32", "picture"), ("sensor_msgs/CompressedImage", "image")]
+PICTURE_NUMBERS = {"cat": 1, "dog": 2}
 SIZE = (320, 240)
 #: Largest difference of the per-channel means of a crop and its expected crop (grey levels).
 COLOUR_TOLERANCE = 20.0
@@ -187,20 +196,27 @@ def noisy(ctx: Context) -> None:
 
 @check(points=3, timeout=90)
 def node(ctx: Context) -> None:
-    """MarkerReader: node marker_reader turns frames on image into crops on cropped_img/cat and cropped_img/dog."""
+    """marker_reader: node marker_reader turns frames on image into CroppedPicture messages on cropped_img."""
     from course_lib import images, scenes
     from rclpy.qos import QoSProfile, ReliabilityPolicy
-    from sensor_msgs.msg import CompressedImage, Image
+    from sensor_msgs.msg import Image
 
-    proc = ctx.start_node()
+    proc = packages.run(ctx, "readmarker", "marker_reader")  # ros2 run readmarker marker_reader
+    packages.use_interfaces(ctx)
+    from catdog_interfaces.msg import CroppedPicture
+
+    packages.message_item(ctx, "catdog_interfaces", "CroppedPicture", MESSAGE_FIELDS)
+    packages.dependency_items(ctx, "readmarker")
     try:
         with ctx.probe() as probe:
             got: dict[str, list] = {"cat": [], "dog": []}
             # Reliable publisher and best-effort subscriptions match every QoS the student may pick.
             pub = probe.node.create_publisher(Image, "image", QoSProfile(depth=5, reliability=ReliabilityPolicy.RELIABLE))
-            for name in got:
-                probe.node.create_subscription(CompressedImage, f"cropped_img/{name}", got[name].append,
-                                               QoSProfile(depth=10, reliability=ReliabilityPolicy.BEST_EFFORT))
+            numbers = {number: name for name, number in PICTURE_NUMBERS.items()}
+            probe.node.create_subscription(
+                CroppedPicture, "cropped_img",
+                lambda msg: got[numbers[msg.picture]].append(msg.image) if msg.picture in numbers else None,
+                QoSProfile(depth=10, reliability=ReliabilityPolicy.BEST_EFFORT))
             names = lambda: {n for n, _ in probe.node.get_node_names_and_namespaces()}  # noqa: E731
             probe.spin_until(lambda: "marker_reader" in names() or not proc.running(), 25.0)
             if not proc.running():
@@ -219,13 +235,14 @@ def node(ctx: Context) -> None:
             types = dict(probe.node.get_topic_names_and_types())
     finally:
         proc.stop(timeout=2)
+    wanted = ["catdog_interfaces/msg/CroppedPicture"]
     for name in ("cat", "dog"):
-        topic = f"/cropped_img/{name}"
+        topic = f"/cropped_img ({name}, picture {PICTURE_NUMBERS[name]})"
         if not got[name]:
-            seen = types.get(topic)
-            ctx.item(False, f"nothing arrived on {topic} within 8 s" +
-                     (f" (it carries {seen}; the contract says sensor_msgs/msg/CompressedImage)" if seen and
-                      seen != ["sensor_msgs/msg/CompressedImage"] else "") +
+            seen = types.get("/cropped_img")
+            ctx.item(False, f"no {name} (picture = {PICTURE_NUMBERS[name]}) arrived on /cropped_img within 8 s" +
+                     (f" (it carries {seen}; the contract says {wanted[0]})" if seen and seen != wanted else
+                      "" if seen else f" (topics: {sorted(t for t in types if not t.startswith(('/rosout', '/parameter')))})") +
                      "; the node's output:\n" + clip(proc.log_tail(4)))
             continue
         try:
@@ -234,3 +251,39 @@ def node(ctx: Context) -> None:
             ctx.item(False, f"{topic}: the message does not decode ({error}); use images.image_to_compressed(crop, 'png')")
             continue
         compare_crop(ctx, topic, crop, expected[name], show=True)
+    _launch_item(ctx, CroppedPicture)
+
+
+#: The launch file that starts the camera and the marker reader.
+LAUNCH = ("readmarker", "catdog_warp.launch.xml")
+
+
+def _launch_item(ctx: Context, message_type) -> None:
+    """One item: ``ros2 launch readmarker catdog_warp.launch.xml`` starts image_publisher and
+    marker_reader, and crops of the camera's board arrive on cropped_img (the webcam's default
+    camera is the course's simulated board)."""
+    import sys
+
+    from rclpy.qos import QoSProfile, ReliabilityPolicy
+
+    ws = packages.require_build(ctx)
+    command = [sys.executable, "-m", "course_lib.launch", *LAUNCH]
+    launch = ctx.students.start(command, name="student-launch", cwd=ctx.workdir, domain_id=ctx.domain_id,
+                                wall_seconds=ctx.remaining() + 5, env=packages.student_env(ctx, ws))
+    crops = []
+    try:
+        with ctx.probe() as probe:
+            probe.node.create_subscription(message_type, "cropped_img", crops.append,
+                                           QoSProfile(depth=10, reliability=ReliabilityPolicy.BEST_EFFORT))
+            probe.spin_until(lambda: bool(crops) or not launch.running(), min(20.0, ctx.remaining() - 3))
+            nodes = {n for n, _ in probe.node.get_node_names_and_namespaces()}
+    finally:
+        launch.stop(timeout=3)
+    shown = f"`ros2 launch {' '.join(LAUNCH)}`"
+    if crops:
+        ctx.item(True, f"{shown} starts image_publisher and marker_reader; crops arrive on /cropped_img")
+        return
+    missing = sorted({"image_publisher", "marker_reader"} - nodes)
+    ctx.item(False, f"{shown}: no crop arrived on /cropped_img within 20 s"
+             + (f"; nodes missing: {missing}" if missing else "")
+             + f". Its output:\n{clip(launch.log_tail(6))}")

@@ -108,15 +108,25 @@ class Context:
 
     @property
     def module(self) -> str:
-        """The student's module name: ``<assignment>_node`` (written by the notebook's %%writefile cell)."""
-        return MODULES[self.spec.assignment]
+        """The dotted name of the student's module of plain functions (course_lib.checks.packages)."""
+        from course_lib.checks import packages
+
+        return packages.FUNCTION_MODULES[self.spec.assignment][1]
+
+    @property
+    def module_root(self) -> Path:
+        """The folder the student's module is imported from: its package's source, ros2_ws/src/<package>."""
+        from course_lib.checks import packages
+
+        return packages.package_dir(self, packages.FUNCTION_MODULES[self.spec.assignment][0])
 
     def require_module(self) -> None:
         """Raise StudentError with the fix when the student's module file does not exist."""
-        path = self.workdir / f"{self.module}.py"
+        path = self.module_root / (self.module.replace(".", "/") + ".py")
         if not path.is_file():
-            raise StudentError(f"{path.name} does not exist next to the notebook: run the cell that starts "
-                               f"with %%writefile {path.name} (it writes your module)")
+            shown = path.relative_to(self.workdir)
+            raise StudentError(f"{shown} does not exist: run the cell that starts with %%writefile {shown} "
+                               "(it writes your module)")
         if (self.workdir / IMPORT_HANG_MARK).exists():
             raise StudentError(f"importing {self.module} did not finish within {IMPORT_TIMEOUT:g} s in an "
                                "earlier check: remove code that runs forever at import (loops, spin()) "
@@ -144,14 +154,15 @@ class Context:
         finally:
             shutil.rmtree(job, ignore_errors=True)
 
-    def endpoints(self, class_name: str, timeout: float = 20.0) -> dict:
+    def endpoints(self, class_name: str, timeout: float = 20.0, module: str | None = None,
+                  env: dict | None = None) -> dict:
         """Construct the student's node class (not spun) in a student process and return the QoS of
         its publishers and subscriptions: {"publishers"|"subscriptions": [{"topic", "type",
         "depth", "history", "reliability", "durability"}]}. Raises StudentError when it fails."""
         job = Path(tempfile.mkdtemp(prefix="autograder-endpoints-"))
         try:
             timeout = min(timeout, self.remaining())
-            proc, _seconds = self._run_student("endpoints", class_name, job, timeout)
+            proc, _seconds = self._run_student("endpoints", class_name, job, timeout, module=module, env=env)
             try:
                 return json.loads((job / "endpoints.json").read_text())
             except (OSError, ValueError):
@@ -160,7 +171,8 @@ class Context:
         finally:
             shutil.rmtree(job, ignore_errors=True)
 
-    def _run_student(self, command: str, target: str, job: Path, timeout: float):
+    def _run_student(self, command: str, target: str, job: Path, timeout: float, module: str | None = None,
+                     env: dict | None = None):
         """Run ``python -m course_lib.checks.student COMMAND MODULE TARGET JOB`` to its end, or until
         `timeout` seconds (import included, never past the check's own time) have passed.
 
@@ -170,23 +182,26 @@ class Context:
         Raises:
             StudentError: the module did not import.
         """
-        self.require_module()
+        if module is None:  # a module of a built package (env: its workspace) needs no source check
+            self.require_module()
+        module = module or self.module
         self.students.give(job)
         timeout = min(timeout, self.remaining())
         deadline = time.monotonic() + timeout
-        proc = self.students.start([sys.executable, "-m", "course_lib.checks.student", command, self.module, target,
-                                    str(job)], name=f"student-{target}", cwd=self.workdir, domain_id=self.domain_id,
-                                   wall_seconds=timeout + 2)
+        proc = self.students.start([sys.executable, "-m", "course_lib.checks.student", command, module, target,
+                                    str(job)], name=f"student-{target}",
+                                   cwd=self.module_root if env is None else self.workdir, domain_id=self.domain_id,
+                                   wall_seconds=timeout + 2, env=env)
         import_wait = min(IMPORT_TIMEOUT, timeout)
         call_seconds = 0.0
         try:
             imported = _wait_for_file(job / "imported", import_wait, proc)
             if not imported and proc.running():
                 if import_wait < IMPORT_TIMEOUT:
-                    raise StudentError(f"importing {self.module} did not finish within the {import_wait:.0f} s "
+                    raise StudentError(f"importing {module} did not finish within the {import_wait:.0f} s "
                                        "this check had left (the machine may be busy; the import itself took long)")
                 _mark(self.workdir / IMPORT_HANG_MARK)
-                raise StudentError(f"importing {self.module} did not finish within {IMPORT_TIMEOUT:g} s: "
+                raise StudentError(f"importing {module} did not finish within {IMPORT_TIMEOUT:g} s: "
                                    "remove code that runs forever at import (loops, spin()) from the "
                                    "top level of the module; put it in main()")
             if imported:
@@ -198,7 +213,7 @@ class Context:
         finally:
             proc.stop(timeout=1)
         if not (job / "imported").exists():
-            raise StudentError(f"{self.module} could not be imported ({proc.describe_exit()}):\n"
+            raise StudentError(f"{module} could not be imported ({proc.describe_exit()}):\n"
                                f"{last_lines(proc.log, 6)}")
         return proc, call_seconds
 
@@ -249,10 +264,6 @@ class _Fixed:
 
     def release(self) -> None:
         pass
-
-
-#: The student's module of each assignment (the notebook writes it with %%writefile).
-MODULES = {"brightness": "brightness_node", "pubsub": "pubsub_nodes", "catdog_warp": "marker_reader"}
 
 
 def _mark(path: Path) -> None:

@@ -1,16 +1,20 @@
-"""Checks of the pubsub assignment: a counter publisher and a subscriber that records what it hears.
+"""Checks of the pubsub assignment: the MsgTutorial publisher and subscriber, as ROS 2 packages.
 
-The contract (also in the notebook and in assignments/README.md). Until the course's own
-MsgTutorial message exists, the message is the stock ``std_msgs/msg/Header``: ``stamp`` is the
-time of publishing and ``frame_id`` holds the counter as decimal text.
+The contract (also in the notebook and in assignments/README.md). The workspace ``ros2_ws/src``
+holds two packages:
 
-- ``CounterPublisher()``: node ``counter_publisher``; publishes on ``ros_tutorial_msg`` with a
-  queue depth of 100, at 10 Hz (a 0.1 s timer); counter 0, 1, 2, ... (one more per message);
-  each stamp later than the one before.
-- ``CounterSubscriber()``: node ``counter_subscriber``; subscribes ``ros_tutorial_msg`` with a
-  queue depth of 100; appends ``(stamp, counter)`` to ``self.received`` and logs
-  ``I heard: <counter>`` for each message.
-- ``main_publisher(args=None)`` and ``main_subscriber(args=None)`` run one node each until Ctrl-C.
+- ``tutorial_interfaces`` (ament_cmake): ``msg/MsgTutorial.msg`` with ``builtin_interfaces/Time
+  stamp`` and ``int32 data``;
+- ``pubsub`` (ament_python), depending on rclpy and tutorial_interfaces, with two executables:
+  ``topic_publisher`` (module ``pubsub/topic_publisher.py``, class ``TopicPublisher``, node
+  ``topic_publisher``): publishes MsgTutorial on ``ros_tutorial_msg`` with a queue depth of 100 at
+  10 Hz, ``stamp`` = the time of publishing, ``data`` = a counter 0, 1, 2, ...;
+  ``topic_subscriber`` (``pubsub/topic_subscriber.py``, ``TopicSubscriber``, node
+  ``topic_subscriber``): subscribes ``ros_tutorial_msg`` (depth 100) and logs each field of every
+  message, e.g. ``I heard: stamp 1718000000.250000000 data 7``.
+
+The checks start the executables as ``ros2 run pubsub topic_publisher`` would (the grader builds
+the workspace first); the checker's own node uses the reference MsgTutorial.
 """
 
 from __future__ import annotations
@@ -18,17 +22,21 @@ from __future__ import annotations
 import re
 import time
 
-from course_lib.checks import runner
+from course_lib.checks import packages, runner
 from course_lib.checks.context import Context, StudentError, clip
 from course_lib.checks.registry import check
 
 ASSIGNMENT = "pubsub"
+PACKAGE = "pubsub"
+INTERFACES = "tutorial_interfaces"
+MESSAGE_FIELDS = [("builtin_interfaces/Time", "stamp"), ("int32", "data")]
 TOPIC = "/ros_tutorial_msg"
 RATE_HZ = 10.0
 #: Relative tolerance of the measured rate (from the message stamps).
 RATE_TOLERANCE = 0.15
 QUEUE_DEPTH = 100
-HEARD = re.compile(r"I heard: (-?\d+)")
+#: A subscriber's log line: the stamp (seconds, and nanoseconds when shown) and the data.
+HEARD = re.compile(r"I heard:.*?stamp\D{0,4}(\d+)(?:\.(\d+))?.*?data\D{0,4}(-?\d+)")
 
 
 def selfcheck(name: str):
@@ -45,12 +53,12 @@ def _stamp_seconds(stamp) -> float:
     return stamp.sec + stamp.nanosec * 1e-9
 
 
-def _queue_depth(ctx, class_name: str, kind: str) -> None:
+def _queue_depth(ctx, module: str, class_name: str, kind: str) -> None:
     """One item: the node's endpoint on the topic keeps the last QUEUE_DEPTH messages. A running
     node's depth is not visible to other processes (DDS discovery does not carry it), so the
     class is constructed in a student process of its own and asked."""
     try:
-        found = [e for e in ctx.endpoints(class_name)[kind] if e["topic"] == TOPIC]
+        found = [e for e in packages.endpoints(ctx, module, class_name)[kind] if e["topic"] == TOPIC]
     except StudentError as error:
         ctx.item(False, f"queue depth: {error}")
         return
@@ -77,41 +85,43 @@ def _wait_node(ctx, probe, proc, name: str) -> bool:
     return ctx.precondition(True, f"node {name} runs")
 
 
-@check(points=5, timeout=60)
-def publisher(ctx: Context) -> None:
-    """CounterPublisher: std_msgs/Header on ros_tutorial_msg at 10 Hz, counter +1 per message, increasing stamps."""
-    from std_msgs.msg import Header
+def _start(ctx, executable: str, tag: str = ""):
+    """``ros2 run pubsub <executable>`` (raises StudentError when the workspace did not build)."""
+    return packages.run(ctx, PACKAGE, executable, tag=tag)
 
-    _queue_depth(ctx, "CounterPublisher", "publishers")
-    proc = ctx.start_node(entry="main_publisher")
+
+@check(points=5, timeout=90)
+def publisher(ctx: Context) -> None:
+    """topic_publisher: MsgTutorial on ros_tutorial_msg at 10 Hz, data +1 per message, increasing stamps."""
+    proc = _start(ctx, "topic_publisher")
+    packages.use_interfaces(ctx)
+    from tutorial_interfaces.msg import MsgTutorial
+
+    packages.message_item(ctx, INTERFACES, "MsgTutorial", MESSAGE_FIELDS)
+    packages.dependency_items(ctx, PACKAGE)
+    _queue_depth(ctx, "pubsub.topic_publisher", "TopicPublisher", "publishers")
     try:
         with ctx.probe() as probe:
             messages = []
-            probe.node.create_subscription(Header, TOPIC, messages.append, 100)
-            if not _wait_node(ctx, probe, proc, "counter_publisher"):
+            probe.node.create_subscription(MsgTutorial, TOPIC, messages.append, 100)
+            if not _wait_node(ctx, probe, proc, "topic_publisher"):
                 return
             types = dict(probe.node.get_topic_names_and_types())
             if not probe.spin_until(lambda: len(messages) > 0, 5.0):
                 types = dict(probe.node.get_topic_names_and_types())
                 ctx.item(False, f"nothing arrived on {TOPIC} within 5 s (topics: "
                                 f"{ {t: v for t, v in types.items() if not t.startswith('/rosout') and not t.startswith('/parameter')} }); "
-                                "publish std_msgs/msg/Header on 'ros_tutorial_msg' from a 0.1 s timer")
+                                "publish tutorial_interfaces/msg/MsgTutorial on 'ros_tutorial_msg' from a 0.1 s timer")
                 return
             probe.spin_for(3.0)
     finally:
         proc.stop(timeout=2)
     types = types.get(TOPIC, [])
-    ctx.item(types == ["std_msgs/msg/Header"], f"{TOPIC} carries {types}" +
-             ("" if types == ["std_msgs/msg/Header"] else "; the contract says std_msgs/msg/Header"))
-    counters = []
-    for msg in messages:
-        try:
-            counters.append(int(msg.frame_id))
-        except ValueError:
-            ctx.item(False, f"frame_id is {msg.frame_id!r}; it must hold the counter as text, str(self.count)")
-            return
+    wanted = ["tutorial_interfaces/msg/MsgTutorial"]
+    ctx.item(types == wanted, f"{TOPIC} carries {types}" + ("" if types == wanted else f"; the contract says {wanted[0]}"))
+    counters = [msg.data for msg in messages]
     steps = {b - a for a, b in zip(counters, counters[1:])}
-    ctx.item(steps == {1}, f"counters {counters[:4]}...{counters[-2:]}: " +
+    ctx.item(steps == {1}, f"data {counters[:4]}...{counters[-2:]}: " +
              ("one more per message" if steps == {1} else f"steps {sorted(steps)[:5]}; add one per message"))
     stamps = [_stamp_seconds(m.stamp) for m in messages]
     increasing = all(b > a for a, b in zip(stamps, stamps[1:]))
@@ -126,49 +136,56 @@ def publisher(ctx: Context) -> None:
         ctx.item(False, f"only {len(stamps)} messages with usable stamps in 3 s: cannot measure a 10 Hz rate")
 
 
-@check(points=3, timeout=60)
+@check(points=3, timeout=90)
 def subscriber(ctx: Context) -> None:
-    """CounterSubscriber: node counter_subscriber hears every message on ros_tutorial_msg and logs 'I heard: N'."""
-    from std_msgs.msg import Header
+    """topic_subscriber: node topic_subscriber hears every MsgTutorial on ros_tutorial_msg and logs its stamp and data."""
+    proc = _start(ctx, "topic_subscriber")
+    packages.use_interfaces(ctx)
+    from tutorial_interfaces.msg import MsgTutorial
 
-    _queue_depth(ctx, "CounterSubscriber", "subscriptions")
+    _queue_depth(ctx, "pubsub.topic_subscriber", "TopicSubscriber", "subscriptions")
     first = int(ctx.rng.integers(100, 10000))
-    sent = list(range(first, first + 20))
-    proc = ctx.start_node(entry="main_subscriber")
+    sent = [(int(ctx.rng.integers(10**6, 10**9)), first + i) for i in range(20)]  # (stamp sec, data)
     try:
         with ctx.probe() as probe:
-            pub = probe.node.create_publisher(Header, TOPIC, 100)
-            if not _wait_node(ctx, probe, proc, "counter_subscriber"):
+            pub = probe.node.create_publisher(MsgTutorial, TOPIC, 100)
+            if not _wait_node(ctx, probe, proc, "topic_subscriber"):
                 return
             if not probe.spin_until(lambda: pub.get_subscription_count() > 0, 5.0):
-                ctx.item(False, f"counter_subscriber does not subscribe {TOPIC}: "
-                                "create_subscription(Header, 'ros_tutorial_msg', self.callback, 100)")
+                ctx.item(False, f"topic_subscriber does not subscribe {TOPIC}: "
+                                "create_subscription(MsgTutorial, 'ros_tutorial_msg', self.callback, 100)")
                 return
             probe.spin_for(0.3)
-            for counter in sent:
-                msg = Header(frame_id=str(counter))
-                msg.stamp = probe.node.get_clock().now().to_msg()
+            for sec, data in sent:
+                msg = MsgTutorial(data=data)
+                msg.stamp.sec, msg.stamp.nanosec = sec, 250_000_000
                 pub.publish(msg)
                 probe.spin_for(0.05)
-            probe.spin_until(lambda: sent[-1] in _heard(proc.log), 3.0)
+            probe.spin_until(lambda: sent[-1][1] in [d for _, d in _heard(proc.log)], 3.0)
     finally:
         proc.stop(timeout=2)
     heard = _heard(proc.log)
-    ok = heard == sent
-    ctx.item(ok, f"logged 'I heard: N' for all {len(sent)} messages in order" if ok else
-             f"sent counters {sent[0]}..{sent[-1]}, the log shows {heard[:6]}{'...' if len(heard) > 6 else ''}: "
-             "log self.get_logger().info(f'I heard: {counter}') for every message", weight=2)
+    data = [d for _, d in heard]
+    ok = data == [d for _, d in sent]
+    ctx.item(ok, f"logged the data of all {len(sent)} messages in order" if ok else
+             f"sent data {sent[0][1]}..{sent[-1][1]}, the log shows {data[:6]}{'...' if len(data) > 6 else ''}: "
+             "log self.get_logger().info(f'I heard: stamp {msg.stamp.sec}.{msg.stamp.nanosec:09d} data {msg.data}') "
+             "for every message", weight=2)
+    stamps_ok = bool(heard) and [s for s, _ in heard] == [s for s, _ in sent][:len(heard)]
+    ctx.item(stamps_ok, "logged the stamp of each message" if stamps_ok else
+             "the log lines do not show each message's stamp (its sec): log every field, stamp and data")
 
 
-def _heard(log: str) -> list[int]:
-    return [int(n) for n in HEARD.findall(log)]
+def _heard(log: str) -> list[tuple[int, int]]:
+    """(stamp sec, data) of each 'I heard: ...' line of a subscriber's log."""
+    return [(int(sec), int(data)) for sec, _nanosec, data in HEARD.findall(log)]
 
 
 @check(points=2, timeout=60)
 def together(ctx: Context) -> None:
-    """The subscriber receives what the publisher publishes: consecutive counters, none lost."""
-    pub = ctx.start_node(entry="main_publisher")
-    sub = ctx.start_node(entry="main_subscriber")
+    """The subscriber receives what the publisher publishes: consecutive data, none lost."""
+    pub = _start(ctx, "topic_publisher")
+    sub = _start(ctx, "topic_subscriber")
     try:
         deadline = time.monotonic() + 20.0
         while time.monotonic() < deadline and len(_heard(sub.log)) < 15 and sub.running() and pub.running():
@@ -176,8 +193,8 @@ def together(ctx: Context) -> None:
     finally:
         sub.stop(timeout=2)
         pub.stop(timeout=2)
-    heard = _heard(sub.log)
+    heard = [d for _, d in _heard(sub.log)]
     steps = {b - a for a, b in zip(heard, heard[1:])}
     ok = len(heard) >= 15 and steps == {1}
-    ctx.item(ok, f"the subscriber heard {len(heard)} messages, counters {heard[:3]}...{heard[-2:]}" +
-             ("" if ok else ": expected at least 15 consecutive counters within 20 s"))
+    ctx.item(ok, f"the subscriber heard {len(heard)} messages, data {heard[:3]}...{heard[-2:]}" +
+             ("" if ok else ": expected at least 15 consecutive values within 20 s"))

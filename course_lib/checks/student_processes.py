@@ -32,11 +32,12 @@ def student_env() -> dict:
 class StudentProcesses:
     """Starts a check's student processes as the check's own user (see the module docstring)."""
 
-    def start(self, command: list[str], *, name: str, cwd, domain_id: int, wall_seconds: float):
-        """Start `command` (the student's code) and return its running course_lib.processes.NodeProcess."""
+    def start(self, command: list[str], *, name: str, cwd, domain_id: int, wall_seconds: float, env: dict | None = None):
+        """Start `command` (the student's code) and return its running course_lib.processes.NodeProcess;
+        `env`: variables on top of student_env() (a sourced workspace, course_lib.checks.packages)."""
         from course_lib import processes
 
-        command, env, private_dirs = self.confine(list(command), student_env())
+        command, env, private_dirs = self.confine(list(command), {**student_env(), **(env or {})})
         return processes.NodeProcess(command, name=name, cwd=cwd, domain_id=domain_id, env=env,
                                      limits=self.limits(wall_seconds), private_dirs=private_dirs).start()
 

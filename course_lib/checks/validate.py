@@ -19,13 +19,23 @@ TEST_CELL_TIMEOUT = 150
 
 
 def cell_timeout(cell) -> int:
-    """nbclient's timeout_func: graded cells get TEST_CELL_TIMEOUT, all others CELL_TIMEOUT."""
+    """nbclient's timeout_func: graded cells and a workspace's build cell (a message package takes
+    tens of seconds to build) get TEST_CELL_TIMEOUT, all others CELL_TIMEOUT."""
     meta = cell.get("metadata", {}).get("nbgrader", {})
+    if "course_lib build" in cell.get("source", ""):
+        return TEST_CELL_TIMEOUT
     return TEST_CELL_TIMEOUT if meta.get("grade") and not meta.get("solution") else CELL_TIMEOUT
 
 
+#: What nbgrader leaves out when it submits, collects or autogrades a folder: its defaults, and
+#: colcon's output folders (a workspace's build/, install/ and log/ are made again by its build).
+IGNORE = [".ipynb_checkpoints", "*.pyc", "__pycache__", "feedback", "build", "install", "log"]
+
+
 def apply_student(c) -> None:
-    """Give an nbgrader config object (``c = get_config()``) the course's cell timeouts."""
+    """Give an nbgrader config object (``c = get_config()``) the course's cell timeouts and the
+    files it leaves out (IGNORE)."""
+    c.CourseDirectory.ignore = IGNORE
     c.Execute.timeout = TEST_CELL_TIMEOUT
     c.Execute.timeout_func = cell_timeout
     c.Execute.interrupt_on_timeout = True

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import nbformat
 
-from autograder.reference import module_cell, solution_source
+from autograder.reference import solution_source, writefile_cells
 
 
 def filled_notebook(course: Path, assignment: str) -> nbformat.NotebookNode:
@@ -30,26 +30,31 @@ def filled_notebook(course: Path, assignment: str) -> nbformat.NotebookNode:
 
 
 def edited_notebook(course: Path, assignment: str, edits=(), student: str = "") -> nbformat.NotebookNode:
-    """The filled notebook with `edits`: each (old, new) applied to the module cell, or a function nb -> None."""
+    """The filled notebook with `edits`: each (old, new) applied to the first %%writefile cell (a
+    file of the student's packages) that holds `old`, or a function nb -> None."""
     nb = filled_notebook(course, assignment)
     for edit in edits:
         if callable(edit):
             edit(nb)
             continue
         old, new = edit
-        cell = module_cell(nb)
-        if old not in cell.source:
-            raise ValueError(f"zoo edit for {student}: {old!r} is not in the reference module")
+        cell = next((c for c in writefile_cells(nb) if old in c.source), None)
+        if cell is None:
+            raise ValueError(f"zoo edit for {student}: {old!r} is in no file of the reference packages")
         cell.source = cell.source.replace(old, new, 1)
     return nb
 
 
 def submit(course: Path, student: str, assignment: str, edits=()) -> Path:
-    """Write a zoo submission (see edited_notebook) where nbgrader's collect step puts it."""
+    """Write a zoo submission (see edited_notebook) where nbgrader's collect step puts it: the
+    notebook, and the workspace its %%writefile cells wrote, as a student who ran them hands it in."""
+    from autograder.reference import write_files
+
     nb = edited_notebook(course, assignment, edits, student)
     target = Path(course) / "submitted" / student / assignment / f"{assignment}.ipynb"
     target.parent.mkdir(parents=True, exist_ok=True)
     nbformat.write(nb, target)
+    write_files(nb, target.parent)
     return target
 
 

@@ -46,6 +46,7 @@ def find_markers(frame, detector=None):
     Returns:
         dict marker id -> float32 array (4, 2) of its corners in OpenCV order.
     """
+    ### BEGIN SOLUTION
     detector = detector or default_detector()
     corners, ids, _ = detector.detectMarkers(frame)
     found = {}
@@ -58,6 +59,7 @@ def find_markers(frame, detector=None):
         if marker_id not in found or area > found[marker_id][0]:
             found[marker_id] = (area, marker)
     return {marker_id: marker for marker_id, (_, marker) in found.items()}
+    ### END SOLUTION
 
 
 _BOARD_IDS = tuple(i for ids in marker_board.PICTURES.values() for i in ids)
@@ -89,6 +91,7 @@ def find_board_markers(frame, detector=None, erode_passes=ERODE_PASSES, paint_pi
     Returns:
         dict marker id -> float32 (4, 2) corners, as find_markers.
     """
+    ### BEGIN SOLUTION
     found = find_markers(frame, detector)
     if all(i in found for i in _BOARD_IDS):
         return found
@@ -109,9 +112,11 @@ def find_board_markers(frame, detector=None, erode_passes=ERODE_PASSES, paint_pi
     if paint_pictures and len(known) >= 2:
         found.update(_markers_beside_painted_pictures(grey, found, known, detector))
     return found
+    ### END SOLUTION
 
 
 def _markers_beside_painted_pictures(grey, found, known, detector):
+    ### BEGIN SOLUTION
     board = boards.default_board()  # only its geometry (board units) is used, the same for any pictures
     square = np.concatenate([board.marker_square(i) for i in known])
     seen = np.concatenate([found[i] for i in known])
@@ -128,6 +133,7 @@ def _markers_beside_painted_pictures(grey, found, known, detector):
     points = np.concatenate(list(new.values())).reshape(-1, 1, 2).astype(np.float32)
     cv2.cornerSubPix(grey, points, (3, 3), (-1, -1), (cv2.TERM_CRITERIA_EPS + cv2.TERM_CRITERIA_COUNT, 30, 0.01))
     return {marker_id: points[4 * k:4 * k + 4].reshape(4, 2) for k, marker_id in enumerate(new)}
+    ### END SOLUTION
 
 
 def _is_picture_shape(corners):
@@ -138,12 +144,14 @@ def _is_picture_shape(corners):
     duplicate chosen) usually break that; such a picture is left out rather than warped into
     nonsense.
     """
+    ### BEGIN SOLUTION
     crossings = []
     for i in range(4):
         a, b, c = corners[i], corners[(i + 1) % 4], corners[(i + 2) % 4]
         ab, bc = b - a, c - b
         crossings.append(float(ab[0] * bc[1] - ab[1] * bc[0]))
     return all(value > 0 for value in crossings)
+    ### END SOLUTION
 
 
 def _check_size(size):
@@ -190,6 +198,7 @@ def crop_pictures(frame_bgr, size=marker_board.DEFAULT_SIZE, detector=None, seco
     Raises:
         ValueError: a frame that is not a uint8 BGR or grey image, or a bad size.
     """
+    ### BEGIN SOLUTION
     frame = _check_frame(frame_bgr)
     width, height = _check_size(size)
     markers = find_board_markers(frame, detector) if second_look else find_markers(frame, detector)
@@ -205,3 +214,4 @@ def crop_pictures(frame_bgr, size=marker_board.DEFAULT_SIZE, detector=None, seco
             crop = cv2.cvtColor(crop, cv2.COLOR_GRAY2BGR)
         crops[name] = crop
     return crops
+    ### END SOLUTION

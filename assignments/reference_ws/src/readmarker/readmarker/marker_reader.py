@@ -1,23 +1,29 @@
 """The marker reader node: camera images in, cropped cat and dog pictures out.
 
 ``ros2 run readmarker marker_reader`` subscribes ``image`` (sensor_msgs/Image, sensor-data
-QoS) and publishes each fully framed picture as a PNG sensor_msgs/CompressedImage on
-``cropped_img/cat`` and ``cropped_img/dog``, with the header (stamp, frame) of the image it
-was cut from. The work is readmarker.crop.crop_pictures; this node only converts messages.
+QoS) and publishes each fully framed picture on ``cropped_img`` as a
+catdog_interfaces/CroppedPicture: which picture (``picture``: CAT = 1, DOG = 2) and the crop as a
+PNG sensor_msgs/CompressedImage (``image``), with the header (stamp, frame) of the image it was
+cut from. The work is readmarker.crop.crop_pictures; this node only converts messages.
+``ros2 launch readmarker catdog_warp.launch.xml`` starts it with the webcam's image_publisher.
 """
 
+from catdog_interfaces.msg import CroppedPicture
 import cv2
 import rclpy
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.qos import qos_profile_sensor_data
-from sensor_msgs.msg import CompressedImage, Image
+from sensor_msgs.msg import Image
 
 from course_lib import images, marker_board
 from readmarker.crop import crop_pictures
 
 #: Seconds between two warnings about bad input images.
 WARNING_PERIOD = 5.0
+
+#: The picture number of each picture name (CroppedPicture.picture).
+PICTURE_NUMBERS = {'cat': CroppedPicture.CAT, 'dog': CroppedPicture.DOG}
 
 
 def make_detector(dictionary_name):
@@ -46,7 +52,7 @@ class MarkerReader(Node):
         width, height (int, 320, 240): size of the crops.
         dictionary (string, 'DICT_4X4_50'): the ArUco dictionary of the markers.
         image_topic (string, 'image'): where the camera images come from.
-        output_prefix (string, 'cropped_img'): crops go to '<output_prefix>/<picture>'.
+        output_topic (string, 'cropped_img'): where the crops go.
 
     Raises:
         ValueError: a crop size below 2x2 or an unknown dictionary.
@@ -58,7 +64,7 @@ class MarkerReader(Node):
         height = int(self.declare_parameter('height', marker_board.DEFAULT_SIZE[1]).value)
         dictionary = str(self.declare_parameter('dictionary', 'DICT_4X4_50').value)
         image_topic = str(self.declare_parameter('image_topic', 'image').value)
-        prefix = str(self.declare_parameter('output_prefix', 'cropped_img').value)
+        output_topic = str(self.declare_parameter('output_topic', 'cropped_img').value)
         if width < 2 or height < 2:
             raise ValueError(f'width and height must be at least 2, not {width}x{height}; '
                              'for example width:=320 height:=240')
@@ -66,16 +72,14 @@ class MarkerReader(Node):
         self.detector = make_detector(dictionary)
         self.frames_received = 0
         self.bad_frames = 0
-        self.crop_publishers = {
-            name: self.create_publisher(CompressedImage, f'{prefix}/{name}', 10)
-            for name in marker_board.PICTURES
-        }
+        ### BEGIN SOLUTION
+        self.crop_publisher = self.create_publisher(CroppedPicture, output_topic, 10)
         self.subscription = self.create_subscription(
             Image, image_topic, self.on_image, qos_profile_sensor_data)
-        topics = ', '.join(publisher.topic_name for publisher in self.crop_publishers.values())
+        ### END SOLUTION
         self.get_logger().info(
             f'Reading {dictionary} markers on {self.subscription.topic_name}; '
-            f'{width}x{height} crops go to {topics}')
+            f'{width}x{height} crops go to {self.crop_publisher.topic_name}')
 
     def on_image(self, msg):
         """Crop the fully framed pictures of one image and publish each as PNG."""
@@ -90,9 +94,12 @@ class MarkerReader(Node):
                 f'Skipping an image that cannot be read ({self.bad_frames} so far): {error}',
                 throttle_duration_sec=WARNING_PERIOD)
             return
+        ### BEGIN SOLUTION
         for name, crop in crops.items():
-            self.crop_publishers[name].publish(
-                images.image_to_compressed(crop, 'png', header=msg.header))
+            self.crop_publisher.publish(CroppedPicture(
+                picture=PICTURE_NUMBERS[name],
+                image=images.image_to_compressed(crop, 'png', header=msg.header)))
+        ### END SOLUTION
 
 
 def main(args=None):

@@ -1,0 +1,477 @@
+"""Builds a submission's ROS 2 workspace with colcon, for the checks that run its executables.
+
+A submission holds a colcon workspace beside its notebook (``ros2_ws/src/<package>/...``, written
+by the notebook's ``%%writefile`` cells). After the notebook ran, the grader builds it
+(:func:`build_workspace`), the way a student's ``colcon build`` would, but:
+
+- inside the submission's sandbox and as the student's uid (a ``setup.py`` or ``CMakeLists.txt``
+  is the student's code), with a wall time and memory bound (the caller's ``run``);
+- interface packages (``rosidl_generate_interfaces``: ``.msg`` files) are built once per content
+  and kept in a cache folder of the course (:class:`InterfaceCache`, keyed by the hash of the
+  package's files and of this environment), so a class that hands in identical ``.msg`` files
+  costs one CMake build; the workspace's other packages are built on top of the cached install
+  (an underlay, as ``source other_ws/install/setup.bash`` before ``colcon build
+  --packages-ignore <interface packages>``).
+
+The outcome is a :class:`BuildReport` (written as JSON for the checks, see
+course_lib.checks.packages): when the build failed, its ``reason`` quotes the first error lines of
+colcon, CMake or setup.py, and the checks that need the build give 0 with that reason while the
+checks of plain functions still grade.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+import os
+import re
+import shutil
+import sys
+import time
+import xml.etree.ElementTree as ElementTree
+from pathlib import Path
+
+from course_lib import colcon, workspace
+
+#: The workspace folder beside the notebook.
+WORKSPACE = "ros2_ws"
+
+#: Seconds one colcon build may take (an interface package takes 10-40 s on a busy machine).
+BUILD_SECONDS = 240.0
+
+#: Bumped when the way interface packages are built changes: older cache entries are then unused.
+CACHE_VERSION = "1"
+
+#: Lines that start an error in colcon's, CMake's, the compiler's or setup.py's output.
+_ERROR_LINE = re.compile(r"(CMake Error|error:|Error:|Traceback \(most recent call last\)|SyntaxError|"
+                         r"ModuleNotFoundError|No module named|Failed\s+<<<|ERROR|not found:)")
+
+
+@dataclasses.dataclass
+class BuildReport:
+    """What building a submission's workspace gave.
+
+    Attributes:
+        ok: every package built.
+        reason: for the student, when not ok: what failed, with the first error lines.
+        workspace: the built workspace (its install/setup.bash chains the underlays).
+        packages: the packages of the workspace's src/.
+        cached: interface packages taken from the cache (not built again).
+        built_interfaces: interface packages built now (and put in the cache).
+        seconds: wall time of the whole build.
+        reference_underlays: install prefixes of the assignment's reference interface packages,
+            built by the grader (the checks' own nodes use these, never code the student built).
+        log: for the instructor: the end of the failed build's output.
+    """
+
+    ok: bool
+    reason: str = ""
+    workspace: str = ""
+    packages: list[str] = dataclasses.field(default_factory=list)
+    cached: list[str] = dataclasses.field(default_factory=list)
+    built_interfaces: list[str] = dataclasses.field(default_factory=list)
+    seconds: float = 0.0
+    reference_underlays: list[str] = dataclasses.field(default_factory=list)
+    log: str = ""
+
+    def write(self, path: Path) -> Path:
+        path.write_text(json.dumps(dataclasses.asdict(self), indent=1))
+        return path
+
+    @classmethod
+    def read(cls, path: Path) -> "BuildReport":
+        return cls(**json.loads(Path(path).read_text()))
+
+
+# ---- the packages of a workspace -------------------------------------------------------------
+
+def source_packages(ws: Path) -> dict[str, Path]:
+    """{package name: folder} of every package.xml under ws/src (as colcon finds them)."""
+    found = {}
+    for xml in sorted((Path(ws) / "src").rglob("package.xml")):
+        if any(part in ("build", "install", "log") or part.startswith(".") for part in xml.relative_to(ws).parts[:-1]):
+            continue
+        try:
+            name = ElementTree.parse(xml).getroot().findtext("name", "").strip()
+        except ElementTree.ParseError:
+            name = xml.parent.name  # colcon reports the broken file when it builds
+        found.setdefault(name or xml.parent.name, xml.parent)
+    return found
+
+
+def is_interface_package(folder: Path) -> bool:
+    """An ament_cmake package that generates interfaces (rosidl_generate_interfaces)."""
+    cmake = folder / "CMakeLists.txt"
+    try:
+        return "rosidl_generate_interfaces" in cmake.read_text(errors="replace")
+    except OSError:
+        return False
+
+
+def _depends(folder: Path) -> set[str]:
+    try:
+        root = ElementTree.parse(folder / "package.xml").getroot()
+    except (ElementTree.ParseError, OSError):
+        return set()
+    return {(e.text or "").strip() for e in root if e.tag in ("depend", "build_depend", "exec_depend")}
+
+
+def content_key(folder: Path, underlay_keys=()) -> str:
+    """The cache key of an interface package: its files (names and bytes), the keys of the
+    workspace's interface packages it builds on, this interpreter and CACHE_VERSION."""
+    digest = hashlib.sha256(f"{CACHE_VERSION}\0{sys.version}\0{sys.prefix}\0".encode())
+    for key in underlay_keys:
+        digest.update(key.encode() + b"\0")
+    for path in sorted(p for p in folder.rglob("*") if p.is_file()):
+        digest.update(str(path.relative_to(folder)).encode() + b"\0" + path.read_bytes() + b"\0")
+    return digest.hexdigest()[:32]
+
+
+# ---- the cache ---------------------------------------------------------------------------------
+
+class InterfaceCache:
+    """Built interface packages, one folder per content key: ``<root>/<key>/install/`` (a colcon
+    install prefix). Written by the grader (root) only; entries appear atomically. Failed builds
+    are not kept (see _build_interface); store(key, None, reason) records one all the same."""
+
+    def __init__(self, root: Path):
+        self.root = Path(root)
+
+    def entry(self, key: str) -> Path:
+        return self.root / key
+
+    def lookup(self, key: str) -> tuple[Path | None, str | None]:
+        """(install prefix, None) when built, (None, reason) when it failed, (None, None) when new."""
+        entry = self.entry(key)
+        if (entry / "install" / "setup.bash").is_file():
+            return entry / "install", None
+        if (entry / "failed.txt").is_file():
+            return None, (entry / "failed.txt").read_text()
+        return None, None
+
+    def store(self, key: str, install: Path | None, reason: str = "") -> None:
+        self.root.mkdir(parents=True, exist_ok=True)
+        staging = self.root / f".{key}.{os.getpid()}.{time.monotonic_ns()}"
+        staging.mkdir()
+        if install is not None:
+            shutil.copytree(install, staging / "install", symlinks=True)
+        else:
+            (staging / "failed.txt").write_text(reason)
+        try:
+            os.rename(staging, self.entry(key))
+        except OSError:  # another worker stored the same key meanwhile: theirs is as good
+            shutil.rmtree(staging, ignore_errors=True)
+
+
+# ---- building ----------------------------------------------------------------------------------
+
+def first_error_lines(output: str, lines: int = 8) -> str:
+    """The first error of a build log and the lines after it (or the log's end when no line
+    looks like an error), without colcon's progress lines."""
+    text = [line for line in output.splitlines() if line.strip() and not line.startswith((
+        "Starting >>>", "Finished <<<", "Failed   <<<", "[Processing:", "Summary:"))]
+    for index, line in enumerate(text):
+        if line.startswith("Traceback (most recent call last)"):
+            # colcon's own frames first: the exception (a SyntaxError in setup.py, say) is at the
+            # end of the traceback, with the student's file and line just above it.
+            end = next((i for i in range(index + 1, len(text)) if not text[i].startswith((" ", "\t"))), len(text) - 1)
+            return "\n".join(text[max(index + 1, end - 3):end + 1])
+        if _ERROR_LINE.search(line):
+            return "\n".join(text[index:index + lines])
+    return "\n".join(text[-lines:])
+
+
+def _package_log(ws: Path, output: str) -> str:
+    """The log of the package colcon reported as failed (CMake's and the compiler's messages are
+    there, not in colcon's summary), else colcon's output."""
+    failed = re.findall(r"^Failed\s+<<< (\S+)", output, re.MULTILINE)
+    if failed:
+        log = ws / "log" / "latest_build" / failed[0] / "stdout_stderr.log"
+        if log.is_file():
+            return f"Failed   <<< {failed[0]}\n" + log.read_text(errors="replace")
+    return output
+
+
+def _colcon(ws: Path, args: list[str], env: dict, run) -> tuple[bool, str]:
+    """Run ``colcon build ARGS`` in ws through `run`; (succeeded, the failing package's log)."""
+    command = [str(colcon.colcon_executable()), "build", *args]
+    returncode, output = run(command, ws, env, BUILD_SECONDS)
+    if returncode == 0:
+        return True, output
+    if returncode is None:
+        return False, f"colcon build did not finish within {BUILD_SECONDS:g} s.\n{output[-2000:]}"
+    log = _package_log(ws, output)
+    return False, log if log.strip() else f"colcon build ended with exit code {returncode} and printed nothing"
+
+
+def _underlay_env(base: dict, underlays: list[Path]) -> dict:
+    """The environment after sourcing each underlay's setup.bash, in order."""
+    env = base
+    for install in underlays:
+        env = workspace.workspace_environment(install.parent, base=env)
+    return env
+
+
+def _readable(path: Path) -> None:
+    """Let every uid read (and enter) a tree the grader wrote: the student's build reads it."""
+    for directory, _dirs, files in os.walk(path):
+        os.chmod(directory, 0o755)
+        for name in files:
+            file = os.path.join(directory, name)
+            if not os.path.islink(file):
+                os.chmod(file, os.stat(file).st_mode | 0o444)
+
+
+def build_workspace(ws: Path, cache: InterfaceCache, scratch: Path, run, give=None) -> BuildReport:
+    """Build the workspace `ws` (interface packages from `cache`); see the module docstring.
+
+    Args:
+        ws: the submission's workspace (``<notebook folder>/ros2_ws``), writable by the student's uid.
+        cache: where built interface packages are kept.
+        scratch: a folder of the grader's for this submission (interface builds, underlays).
+        run: ``run(command, cwd, env, wall_seconds) -> (returncode or None, output)``: runs a
+            command sandboxed as the student's uid (autograder.grading); a plain subprocess in tests.
+        give: ``give(path)``, hands a folder the grader created to the student's uid (None: nothing).
+
+    Returns:
+        The BuildReport (never raises for the student's faults).
+    """
+    started = time.monotonic()
+    ws = Path(ws)
+    report = BuildReport(ok=False, workspace=str(ws))
+    if not (ws / "src").is_dir():
+        report.reason = (f"there is no {WORKSPACE}/src folder beside the notebook: run the cells that write your "
+                         f"package files (%%writefile {WORKSPACE}/src/...)")
+        return report
+    packages = source_packages(ws)
+    report.packages = sorted(packages)
+    interfaces = {name: folder for name, folder in packages.items() if is_interface_package(folder)}
+    base = colcon.build_environment()
+    underlays: list[Path] = []
+    keys: dict[str, str] = {}
+    for name in _in_dependency_order(interfaces):
+        folder = interfaces[name]
+        key = content_key(folder, [keys[d] for d in sorted(_depends(folder)) if d in keys])
+        keys[name] = key
+        install, failure = cache.lookup(key)
+        if install is None and failure is None:
+            install, failure = _build_interface(name, folder, key, cache, scratch, _underlay_env(base, underlays),
+                                                run, give)
+            if install is not None:
+                report.built_interfaces.append(name)
+        else:
+            report.cached.append(name)
+        if failure is not None:
+            report.reason = f"colcon build failed in package {name!r}:\n{failure}"
+            report.seconds = round(time.monotonic() - started, 1)
+            return report
+        # The course's folder is hidden in the sandbox: the checks use a copy of their own.
+        underlay = scratch / "underlays" / key / "install"
+        if not underlay.exists():
+            shutil.copytree(install, underlay, symlinks=True)
+            _readable(underlay.parent)
+        underlays.append(underlay)
+    skip = ["--packages-ignore", *interfaces] if interfaces else []
+    ok, output = _colcon(ws, skip, _underlay_env(base, underlays), run)
+    if ok:
+        report.ok = True
+    else:
+        report.reason = _reason(output)
+        report.log = output[-4000:]
+    report.seconds = round(time.monotonic() - started, 1)
+    return report
+
+
+def _reason(log: str) -> str:
+    failed = re.findall(r"^Failed\s+<<< (\S+)", log, re.MULTILINE)
+    where = f" in package {failed[0]!r}" if failed else ""
+    return f"colcon build failed{where}:\n{first_error_lines(log)}"
+
+
+def _build_interface(name: str, folder: Path, key: str, cache: InterfaceCache, scratch: Path, env: dict, run, give):
+    """Build one interface package alone in a scratch workspace and store the outcome in the cache."""
+    build_ws = scratch / "interfaces" / key
+    if build_ws.exists():
+        shutil.rmtree(build_ws)
+    shutil.copytree(folder, build_ws / "src" / name, symlinks=False)
+    if give is not None:
+        give(build_ws)
+    ok, output = _colcon(build_ws, [], env, run)
+    if ok and (build_ws / "install" / "setup.bash").is_file():
+        cache.store(key, build_ws / "install")
+        install, _ = cache.lookup(key)
+        return install or build_ws / "install", None
+    # A failure is not kept: it may be the machine's (a timeout, a full disk, the grader's own
+    # fault) rather than the package's, and a cached failure would fail every later submission.
+    return None, first_error_lines(output)
+
+
+def _in_dependency_order(interfaces: dict[str, Path]) -> list[str]:
+    ordered, pending = [], dict(interfaces)
+    while pending:
+        ready = [n for n in sorted(pending) if not (_depends(pending[n]) & set(pending) - {n})]
+        for name in ready or sorted(pending):  # a cycle: colcon will say so
+            ordered.append(name)
+            pending.pop(name)
+    return ordered
+
+
+# ---- in the grader -----------------------------------------------------------------------------
+
+#: The checks find the build report here (course_lib.checks.packages reads it).
+REPORT_ENV = "AUTOGRADER_BUILD_REPORT"
+
+#: Memory (address space, MB) of the build: CMake, the compiler and rosidl's generators.
+BUILD_MEMORY_MB = 4096
+
+#: Processes and threads of the student's uid during the build (make -j and colcon's workers).
+BUILD_PROCESSES = 384
+
+#: The sandbox variables of the grader's environment that a build needs too (autograder.grading).
+_SANDBOX_VARIABLES = ("AUTOGRADER_EXPOSE", "AUTOGRADER_BLOCKED", "AUTOGRADER_STAGE")
+
+
+def cache_of(course: Path) -> InterfaceCache:
+    """The course's cache of built interface packages: COURSE_DIR/autograder/.interface-cache."""
+    return InterfaceCache(Path(course) / "autograder" / ".interface-cache")
+
+
+def build_for_checks(assignment: str, course: Path, work: Path, workdir: Path, uid: int | None, domain_id: int,
+                     grader_env: dict, hide: list[Path], run_sandboxed) -> dict:
+    """Build the submission's workspace (``workdir/ros2_ws``) in the sandbox as the student's uid
+    (autograder.run_as),
+    write the report into the grader's `work` folder, and return the variables that tell the
+    checks where it is ({REPORT_ENV: path}).
+
+    Args:
+        run_sandboxed: autograder.grading's ``_run_sandboxed(command, hide, name, domain_id, env, cwd, limits)``.
+    """
+    from autograder import run_as
+    from course_lib import processes
+
+    scratch = work / "colcon"
+    scratch.mkdir(mode=0o711, exist_ok=True)
+    home = scratch / "home"
+    home.mkdir(exist_ok=True)
+    give = None
+    if uid is not None:
+        def give(path: Path) -> None:
+            for directory, dirs, files in os.walk(path):
+                os.chown(directory, uid, uid)
+                for name in files:
+                    os.lchown(os.path.join(directory, name), uid, uid)
+        give(home)
+    sandbox = {name: grader_env[name] for name in _SANDBOX_VARIABLES if grader_env.get(name)}
+
+    def run(command, cwd, env, wall_seconds):
+        if uid is not None:
+            command = run_as.command(uid, command, max_processes=BUILD_PROCESSES)
+            # The sandbox hides the repository's autograder/: the wrapper runs from the grader's
+            # staged copy (autograder.staging), as the checks' do.
+            staged = work / "grader" / "autograder" / "run_as.py"
+            command = [str(staged) if part == os.path.abspath(run_as.__file__) else part for part in command]
+        limits = processes.Limits(wall_seconds=wall_seconds, memory_mb=BUILD_MEMORY_MB, file_size_mb=256,
+                                  grace_seconds=3.0)
+        # A name of its own: a process started under the name of a running one replaces it (stops
+        # it), and another worker builds its own ros2_ws at the same time.
+        proc = run_sandboxed(command, hide, f"colcon build {cwd}", domain_id,
+                             {**env, **sandbox, "HOME": str(home), "PYTHONDONTWRITEBYTECODE": "1"}, cwd, limits)
+        return (None if proc.exit_reason == "wall_seconds" else proc.returncode), proc.log
+
+    cache = cache_of(course)
+    report = build_workspace(Path(workdir) / WORKSPACE, cache, scratch, run, give)
+    try:
+        report.reference_underlays = [str(p) for p in reference_interfaces(assignment, cache, scratch)]
+    except RuntimeError as error:  # the course's fault: the checks that need messages say so
+        report.log += f"\n{error}"
+    path = report.write(work / "build-report.json")
+    return {REPORT_ENV: str(path)}
+
+
+def needed(assignment: str, workdir: Path) -> bool:
+    """Whether a submission's workspace is built: the assignment's checks run packages, or the
+    notebook wrote a workspace."""
+    from course_lib.checks import packages as checked
+
+    return assignment in checked.PACKAGES or (Path(workdir) / WORKSPACE).exists()
+
+
+def run_here(command, cwd, env, wall_seconds):
+    """A build runner without a sandbox (the grader's own reference packages, and tests)."""
+    import subprocess
+
+    try:
+        done = subprocess.run(command, cwd=cwd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                              stdin=subprocess.DEVNULL, text=True, errors="replace", timeout=wall_seconds)
+    except subprocess.TimeoutExpired as error:
+        return None, (error.stdout or "") if isinstance(error.stdout, str) else ""
+    return done.returncode, done.stdout
+
+
+def reference_interfaces(assignment: str, cache: InterfaceCache, scratch: Path) -> list[Path]:
+    """The assignment's reference interface packages (assignments/reference_ws/src), from the cache
+    or built by the grader itself, copied into `scratch`: the checks' probes load these, so no
+    package a student wrote runs in a check process.
+
+    Raises:
+        RuntimeError: a reference package does not build (the course's fault, not the student's).
+    """
+    from autograder.reference import REFERENCE_SRC
+    from course_lib.checks import packages as checked
+
+    found = []
+    env = colcon.build_environment()
+    for name in checked.PACKAGES.get(assignment, {}):
+        folder = REFERENCE_SRC / name
+        if not is_interface_package(folder):
+            continue
+        # The same key as a student's identical package: an entry depends on the package's files
+        # and this environment only (the build runs alone, in a fresh sandbox), so a class that
+        # hands in the reference .msg files and the checks share one build.
+        key = content_key(folder)
+        install, failure = cache.lookup(key)
+        if install is None:
+            install, failure = _build_interface(name, folder, key, cache, scratch, env, run_here, None)
+        if install is None:
+            raise RuntimeError(f"the reference package {name} does not build:\n{failure}")
+        copy = scratch / "reference" / key / "install"
+        if not copy.exists():
+            shutil.copytree(install, copy, symlinks=True)
+        found.append(copy)
+    return found
+
+
+def local_cache() -> InterfaceCache:
+    """A cache of interface builds for runs outside a course (tests, benchmarks, record-answers)."""
+    import tempfile
+
+    return InterfaceCache(Path(tempfile.gettempdir()) / f"ros2cv-interface-cache-{os.getuid()}")
+
+
+def build_here(assignment: str, workdir: Path, cache: InterfaceCache | None = None) -> BuildReport:
+    """Build workdir/ros2_ws as the grader does, without a sandbox (reference solutions, tests,
+    benchmarks). The report goes to workdir/.colcon/build-report.json; checks run with
+    REPORT_ENV set to it use this build (see course_lib.checks.packages)."""
+    scratch = Path(workdir) / ".colcon"
+    scratch.mkdir(exist_ok=True)
+    cache = cache or local_cache()
+    report = build_workspace(Path(workdir) / WORKSPACE, cache, scratch, run_here)
+    report.reference_underlays = [str(p) for p in reference_interfaces(assignment, cache, scratch)]
+    report.write(scratch / "build-report.json")
+    return report
+
+
+def report_path(workdir: Path) -> Path:
+    """Where build_here wrote its report."""
+    return Path(workdir) / ".colcon" / "build-report.json"
+
+
+def instructor_note(variables: dict) -> str:
+    """For the grading report: what failed in the build whose report `variables` (build_for_checks)
+    names, with the end of its output ("" when it built)."""
+    try:
+        report = BuildReport.read(Path(variables[REPORT_ENV]))
+    except (KeyError, OSError, ValueError, TypeError):
+        return ""
+    return "" if report.ok else f"\nThe workspace did not build: {report.reason}\n{report.log[-1500:]}"

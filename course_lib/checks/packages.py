@@ -1,0 +1,230 @@
+"""The student's ROS 2 packages as the checks use them: built, run like ``ros2 run``, declared.
+
+An assignment's work is a colcon workspace beside the notebook (``ros2_ws/src/<package>/``,
+written by the notebook's ``%%writefile`` cells). The checks
+
+- call plain functions (``average_brightness``, ``crop_pictures``) from the package's source,
+  without a build (course_lib.checks.context.Context.call, with the module named in :data:`FUNCTION_MODULES`);
+- start executables as ``ros2 run <package> <executable>`` would: the console script colcon
+  installed in ``ros2_ws/install/<package>/lib/<package>/``, in the environment of
+  ``source ros2_ws/install/setup.bash`` (:func:`run`);
+- read package.xml against the imports of the package's Python files (:func:`dependency_items`).
+
+Who builds: in a self-check, the student, with the notebook's build cell (the check says so when
+``install/`` is missing); at grading, the grader (autograder.packages, in its sandbox), which hands
+the checks its report through AUTOGRADER_BUILD_REPORT. When that build failed, every check that
+needs it fails with the build's own error lines.
+"""
+
+from __future__ import annotations
+
+import ast
+import json
+import os
+import xml.etree.ElementTree as ElementTree
+from pathlib import Path
+
+from course_lib.checks.context import StudentError
+from course_lib.checks.student_processes import student_env as _student_env
+
+#: The workspace folder beside the notebook.
+WORKSPACE = "ros2_ws"
+
+#: Set by the grader: the JSON report of its build (autograder.packages.BuildReport).
+REPORT_ENV = "AUTOGRADER_BUILD_REPORT"
+
+#: The packages of each assignment and their executables (what ``ros2 run`` offers).
+PACKAGES = {
+    "brightness": {"brightness": ("brightness_node",)},
+    "pubsub": {"tutorial_interfaces": (), "pubsub": ("topic_publisher", "topic_subscriber")},
+    "catdog_warp": {"catdog_interfaces": (), "webcam": ("image_publisher",), "readmarker": ("marker_reader",)},
+}
+
+#: The module holding each assignment's plain functions: (package, dotted module name).
+FUNCTION_MODULES = {"brightness": ("brightness", "brightness.brightness_node"),
+                    "catdog_warp": ("readmarker", "readmarker.crop")}
+
+#: Python modules that belong to no ROS package (a <depend> on them is not needed here). Every
+#: other top-level module whose name is a ROS package (installed, or in the workspace) must be
+#: declared.
+_NOT_ROS = {"course_lib", "numpy", "cv2"}
+
+
+def workspace_dir(ctx) -> Path:
+    return Path(ctx.workdir) / WORKSPACE
+
+
+def package_dir(ctx, package: str) -> Path:
+    """The package's source folder, ros2_ws/src/<package>."""
+    return workspace_dir(ctx) / "src" / package
+
+
+def require_build(ctx) -> Path:
+    """The built workspace; raises StudentError with the reason when it is not built."""
+    ws = workspace_dir(ctx)
+    report = os.environ.get(REPORT_ENV)
+    if report:
+        data = json.loads(Path(report).read_text())
+        if not data["ok"]:
+            raise StudentError(f"your workspace did not build, so this cannot run. {data['reason']}")
+        return Path(data["workspace"])
+    if not (ws / "install" / "setup.bash").is_file():
+        raise StudentError(f"{WORKSPACE} is not built yet: run the notebook's build cell "
+                                   f"(in a terminal: cd {WORKSPACE} && colcon build --symlink-install)")
+    return ws
+
+
+def student_env(ctx, ws: Path) -> dict:
+    """The environment of the student's processes: ``source ros2_ws/install/setup.bash`` on top of
+    the course's, PYTHONPATH ending with course_lib's (student_processes.student_env)."""
+    from course_lib import workspace
+
+    if getattr(ctx, "_workspace_env", None) is None:
+        try:
+            ctx._workspace_env = workspace.workspace_environment(ws, domain_id=ctx.domain_id)
+        except (FileNotFoundError, RuntimeError) as error:
+            raise StudentError(str(error)) from None
+    env = dict(ctx._workspace_env)
+    paths = [p for p in env.get("PYTHONPATH", "").split(os.pathsep) if p]
+    env.update(_student_env())
+    env["PYTHONPATH"] = os.pathsep.join(paths + [env["PYTHONPATH"]])
+    env[REPORT_ENV] = None
+    return env
+
+
+def run(ctx, package: str, executable: str, *ros_args: str, tag: str = ""):
+    """Start ``ros2 run <package> <executable> [ros_args]`` in the check's ROS domain, as the
+    student's uid with the student's limits; stopped at the end of the check.
+
+    Returns:
+        The started course_lib.processes.NodeProcess.
+
+    Raises:
+        StudentError: the workspace is not built, or has no such package or executable
+            (the message lists the executables there are: an entry point missing from setup.py).
+    """
+    from course_lib import workspace
+
+    ws = require_build(ctx)
+    try:
+        command = workspace.executable_command(ws, package, executable, ros_args=ros_args)
+    except FileNotFoundError as error:
+        raise StudentError(f"`ros2 run {package} {executable}` cannot start: {error}") from None
+    return ctx.students.start(command, name=f"student-{package}-{executable}{tag}", cwd=ctx.workdir,
+                              domain_id=ctx.domain_id, wall_seconds=ctx.remaining() + 5, env=student_env(ctx, ws))
+
+
+def endpoints(ctx, module: str, class_name: str) -> dict:
+    """Context.endpoints for a class of a built package (its messages need the build)."""
+    ws = require_build(ctx)
+    return ctx.endpoints(class_name, module=module, env=student_env(ctx, ws))
+
+
+# ---- package.xml -------------------------------------------------------------------------------
+
+def declared(package_xml: Path) -> set[str]:
+    """The packages package.xml lets the code use at run time: <depend> and <exec_depend>."""
+    root = ElementTree.parse(package_xml).getroot()
+    return {(e.text or "").strip() for e in root if e.tag in ("depend", "exec_depend")}
+
+
+def imported(folder: Path) -> dict[str, str]:
+    """{top-level module: the first file (relative to folder) that imports it} of the package's
+    Python files (its tests and setup.py left out)."""
+    found: dict[str, str] = {}
+    for path in sorted(folder.rglob("*.py")):
+        relative = path.relative_to(folder)
+        if relative.parts[0] in ("test", "build", "install") or relative.name == "setup.py":
+            continue
+        try:
+            tree = ast.parse(path.read_text(errors="replace"))
+        except SyntaxError:
+            continue  # the build or the import reports it, with the line
+        for node in ast.walk(tree):
+            names = [a.name for a in node.names] if isinstance(node, ast.Import) else \
+                [node.module] if isinstance(node, ast.ImportFrom) and node.module and not node.level else []
+            for name in names:
+                found.setdefault(name.split(".")[0], str(relative))
+    return found
+
+
+def ros_packages(ctx) -> set[str]:
+    """The ROS packages the code could import: installed ones (the ament index) and the workspace's."""
+    from course_lib import ament
+
+    names = set(ament.packages())
+    src = workspace_dir(ctx) / "src"
+    names.update(p.parent.name for p in src.glob("*/package.xml"))
+    return names
+
+
+def dependency_items(ctx, package: str, weight: float = 1.0) -> None:
+    """One item: every ROS package the package's Python code imports is a <depend> or
+    <exec_depend> of its package.xml (``rosdep`` and a full ROS install rely on it). Like every
+    package item it costs `weight` when wrong and earns nothing when right (the release's
+    package.xml is right already: an untouched release must score 0)."""
+    folder = package_dir(ctx, package)
+    try:
+        have = declared(folder / "package.xml")
+    except (OSError, ElementTree.ParseError) as error:
+        ctx.item(False, f"{package}/package.xml cannot be read ({error}): write it with the notebook's cell",
+                 weight=weight)
+        return
+    known = ros_packages(ctx)
+    missing = {name: where for name, where in imported(folder).items()
+               if name in known and name not in have and name not in _NOT_ROS and name != package}
+    if missing:
+        lines = "; ".join(f"{where} imports {name}" for name, where in sorted(missing.items()))
+        tags = " ".join(f"<depend>{name}</depend>" for name in sorted(missing))
+        ctx.item(False, f"{package}/package.xml does not declare what the code uses ({lines}): add {tags}",
+                 weight=weight)
+    else:
+        ctx.item(True, f"{package}/package.xml declares every ROS package its code imports", weight=0.0)
+
+
+# ---- messages ----------------------------------------------------------------------------------
+
+def use_interfaces(ctx) -> None:
+    """Make the assignment's message packages importable in this check process: at grading the
+    reference interface packages the grader built (never code the student built: the check runs
+    as the grader), in a self-check the student's own workspace."""
+    from course_lib import workspace
+
+    report = os.environ.get(REPORT_ENV)
+    try:
+        if report:
+            for install in json.loads(Path(report).read_text()).get("reference_underlays", []):
+                workspace.use_workspace(Path(install).parent)
+        else:
+            workspace.use_workspace(require_build(ctx))
+    except (FileNotFoundError, RuntimeError) as error:
+        raise StudentError(f"the messages of your workspace cannot be loaded: {error}") from None
+
+
+def message_fields(path: Path) -> list[tuple[str, str]]:
+    """The (type, name) fields of a .msg file, comments, blank lines and constants left out."""
+    fields = []
+    for line in Path(path).read_text(errors="replace").splitlines():
+        line = line.split("#", 1)[0].strip()
+        parts = line.split()
+        if len(parts) >= 2 and "=" not in line:
+            fields.append((parts[0], parts[1]))
+    return fields
+
+
+def message_item(ctx, package: str, message: str, expected: list[tuple[str, str]], weight: float = 1.0) -> bool:
+    """One item: the student's msg/<message>.msg of `package` has exactly the contract's fields
+    (costs `weight` when wrong, earns nothing when right, as dependency_items)."""
+    path = package_dir(ctx, package) / "msg" / f"{message}.msg"
+    if not path.is_file():
+        return ctx.item(False, f"{package}/msg/{message}.msg does not exist: write it with the notebook's cell",
+                        weight=weight)
+    fields = message_fields(path)
+    # builtin_interfaces/Time and builtin_interfaces/msg/Time name the same type.
+    found = [(kind.replace("/msg/", "/"), name) for kind, name in fields]
+    wanted = ", ".join(f"{kind} {name}" for kind, name in expected)
+    if found == expected:
+        return ctx.item(True, f"{package}/msg/{message}.msg has the fields {wanted}", weight=0.0)
+    have = ", ".join(f"{kind} {name}" for kind, name in fields) or "no fields"
+    return ctx.item(False, f"{package}/msg/{message}.msg has {have}; the contract says {wanted} "
+                           "(a node that uses other fields cannot talk to the grader's)", weight=weight)
