@@ -173,7 +173,7 @@ the work, and a ROS 2 node that only converts messages and calls it, in an `amen
    *all* bytes of the image (every channel of every pixel), rounded **down** as the tutorial's integer
    division `sum // count`, returned as a Python `int`. It works for colour `(H, W, 3)` and grey
    `(H, W)` images.
-3. `BrightnessNode()`: a node named **`my_node`** that subscribes **`/image`**
+3. `BrightnessNode()`: a node named **`brightness_node`** (the name lesson 02 gives it) that subscribes **`/image`**
    (`sensor_msgs/msg/Image`) and publishes **`/brightness`** (`std_msgs/msg/UInt8`), both with the
    **sensor-data QoS** (`qos_profile_sensor_data`), one value per frame. It accepts `bgr8` and
    `mono8` frames, keeps up with 1920×1080 frames at 30 Hz, and its names can be remapped

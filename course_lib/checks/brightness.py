@@ -5,7 +5,7 @@ The contract (also in the notebook and in assignments/README.md):
 - ``average_brightness(image: np.ndarray) -> int``: the mean of all bytes of the image (every
   channel of every pixel), rounded down as the tutorial's integer division does
   (``sum // count``), returned as an int. Works for colour (H, W, 3) and grey (H, W) images.
-- ``BrightnessNode()``: node name ``my_node``; subscribes ``/image`` (sensor_msgs/Image,
+- ``BrightnessNode()``: node name ``brightness_node``; subscribes ``/image`` (sensor_msgs/Image,
   sensor-data QoS) and publishes ``/brightness`` (std_msgs/UInt8, sensor-data QoS), one value
   per frame; accepts bgr8 and mono8 frames; keeps up with 1920x1080 frames at 30 Hz; its names
   can be remapped (``--ros-args -r __node:=... -r /image:=...``).
@@ -99,7 +99,7 @@ def values(ctx: Context) -> None:
 
 # -- the node ---------------------------------------------------------------------------------
 
-NODE_NAME = "my_node"
+NODE_NAME = "brightness_node"
 #: Frames of the throughput test: 1920x1080 BGR at 30 Hz for this many seconds.
 THROUGHPUT_SECONDS = 2.0
 THROUGHPUT_RATE = 30.0
@@ -238,7 +238,7 @@ def _consequences(ctx, cause: str, done: int) -> None:
 
 @check(points=7, timeout=90)
 def node(ctx: Context) -> None:
-    """BrightnessNode: name my_node, /image -> /brightness with sensor-data QoS, bgr8 and mono8, 30 Hz at 1080p, remappable."""
+    """BrightnessNode: name brightness_node, /image -> /brightness with sensor-data QoS, bgr8 and mono8, 30 Hz at 1080p, remappable."""
     # Every input is drawn first: what is drawn must not depend on how the run goes (the
     # self-check's answers were recorded for exactly these inputs).
     colour = [ctx.rng.integers(0, 256, size=(480, 640, 3), dtype=np.uint8) // int(d) for d in (1, 2, 3)]

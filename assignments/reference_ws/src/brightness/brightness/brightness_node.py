@@ -28,7 +28,7 @@ class BrightnessNode(Node):
     """Subscribes /image and publishes the average brightness of every frame on /brightness."""
 
     def __init__(self):
-        super().__init__("my_node")
+        super().__init__("brightness_node")
         ### BEGIN SOLUTION
         self.publisher = self.create_publisher(UInt8, "/brightness", qos_profile_sensor_data)
         self.subscription = self.create_subscription(Image, "/image", self.on_image, qos_profile_sensor_data)
