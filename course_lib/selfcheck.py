@@ -565,27 +565,6 @@ CHECK_CAMERA_TOPIC = "/selfcheck/camera"
 _BUILD_COMMAND = "cd {ws} && colcon build --symlink-install --packages-select brightness"
 
 
-def _imported_modules(tree) -> dict[str, int]:
-    """{top-level module: line} of a module's absolute imports."""
-    import ast
-
-    found: dict[str, int] = {}
-    for node in ast.walk(tree):
-        names = ([alias.name for alias in node.names] if isinstance(node, ast.Import) else
-                 [node.module] if isinstance(node, ast.ImportFrom) and node.level == 0 and node.module else [])
-        for name in names:
-            found.setdefault(name.split(".")[0], node.lineno)
-    return found
-
-
-def _run_dependencies(package_xml) -> set[str]:
-    """The packages package.xml needs at run time (<depend> and <exec_depend>)."""
-    import xml.etree.ElementTree as ElementTree
-
-    root = ElementTree.parse(package_xml).getroot()
-    return {(element.text or "").strip() for tag in ("depend", "exec_depend") for element in root.iter(tag)}
-
-
 def _calls(tree, attribute: str) -> bool:
     import ast
 
@@ -593,25 +572,11 @@ def _calls(tree, attribute: str) -> bool:
                for node in ast.walk(tree))
 
 
-def _console_scripts(setup_py) -> dict[str, str]:
-    """{executable: "module:function"} of the strings in setup.py that read like console-script entries."""
-    import ast
-    import re
-
-    scripts = {}
-    for node in ast.walk(ast.parse(setup_py.read_text(), str(setup_py))):
-        if isinstance(node, ast.Constant) and isinstance(node.value, str):
-            match = re.fullmatch(r"\s*([\w.-]+)\s*=\s*(\S+?)\s*", node.value)
-            if match:
-                scripts[match.group(1)] = match.group(2)
-    return scripts
-
-
 def _package_files(ws) -> Verdict | None:
     """The static part of the brightness package check: files, imports against package.xml, the entry point."""
     import ast
 
-    from course_lib import ament
+    from course_lib import ament, package_files
 
     package_dir = ws / "src" / BRIGHTNESS_PACKAGE
     node_file = package_dir / BRIGHTNESS_PACKAGE / f"{BRIGHTNESS_EXECUTABLE}.py"
@@ -631,12 +596,12 @@ def _package_files(ws) -> Verdict | None:
         return _verdict(False, f"Not done yet: {node_file.name} creates no {' and no '.join(missing)} (the TODOs in "
                                "BrightnessNode.__init__).")
     try:
-        declared = _run_dependencies(package_dir / "package.xml")
+        declared = package_files.run_dependencies(package_dir / "package.xml")
     except Exception as error:  # ElementTree.ParseError, and what a mangled file may raise
         return _verdict(False, f"package.xml cannot be read ({error}): run `ros2 pkg create` again in a fresh folder, "
                                "or mend the line it names.")
     ros_packages = ament.packages()
-    for module, line in _imported_modules(tree).items():
+    for module, line in package_files.imported_modules(tree).items():
         needed = module if module in ros_packages else PYTHON_DEPENDENCIES.get(module)
         if needed and module != BRIGHTNESS_PACKAGE and needed not in declared:
             return _verdict(False, f"{node_file.name} imports {module} (line {line}), but package.xml does not "
@@ -646,7 +611,7 @@ def _package_files(ws) -> Verdict | None:
     if not any(isinstance(node, ast.FunctionDef) and node.name == "main" for node in tree.body):
         return _verdict(False, f"{node_file.name} has no function main(args=None): the executable calls it.")
     try:
-        scripts = _console_scripts(package_dir / "setup.py")
+        scripts = package_files.console_scripts(package_dir / "setup.py")
     except (OSError, SyntaxError) as error:
         return _verdict(False, f"setup.py cannot be read: {error}.")
     wanted = f"{BRIGHTNESS_PACKAGE}.{BRIGHTNESS_EXECUTABLE}:main"

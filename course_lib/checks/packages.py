@@ -18,12 +18,12 @@ needs it fails with the build's own error lines.
 
 from __future__ import annotations
 
-import ast
 import json
 import os
 import xml.etree.ElementTree as ElementTree
 from pathlib import Path
 
+from course_lib import package_files
 from course_lib.checks.context import StudentError
 from course_lib.checks.student_processes import student_env as _student_env
 
@@ -122,32 +122,6 @@ def endpoints(ctx, module: str, class_name: str) -> dict:
 
 # ---- package.xml -------------------------------------------------------------------------------
 
-def declared(package_xml: Path) -> set[str]:
-    """The packages package.xml lets the code use at run time: <depend> and <exec_depend>."""
-    root = ElementTree.parse(package_xml).getroot()
-    return {(e.text or "").strip() for e in root if e.tag in ("depend", "exec_depend")}
-
-
-def imported(folder: Path) -> dict[str, str]:
-    """{top-level module: the first file (relative to folder) that imports it} of the package's
-    Python files (its tests and setup.py left out)."""
-    found: dict[str, str] = {}
-    for path in sorted(folder.rglob("*.py")):
-        relative = path.relative_to(folder)
-        if relative.parts[0] in ("test", "build", "install") or relative.name == "setup.py":
-            continue
-        try:
-            tree = ast.parse(path.read_text(errors="replace"))
-        except SyntaxError:
-            continue  # the build or the import reports it, with the line
-        for node in ast.walk(tree):
-            names = [a.name for a in node.names] if isinstance(node, ast.Import) else \
-                [node.module] if isinstance(node, ast.ImportFrom) and node.module and not node.level else []
-            for name in names:
-                found.setdefault(name.split(".")[0], str(relative))
-    return found
-
-
 def ros_packages(ctx) -> set[str]:
     """The ROS packages the code could import: installed ones (the ament index) and the workspace's."""
     from course_lib import ament
@@ -165,13 +139,13 @@ def dependency_items(ctx, package: str, weight: float = 1.0) -> None:
     package.xml is right already: an untouched release must score 0)."""
     folder = package_dir(ctx, package)
     try:
-        have = declared(folder / "package.xml")
+        have = package_files.run_dependencies(folder / "package.xml")
     except (OSError, ElementTree.ParseError) as error:
         ctx.item(False, f"{package}/package.xml cannot be read ({error}): write it with the notebook's cell",
                  weight=weight)
         return
     known = ros_packages(ctx)
-    missing = {name: where for name, where in imported(folder).items()
+    missing = {name: where for name, where in package_files.package_imports(folder).items()
                if name in known and name not in have and name not in _NOT_ROS and name != package}
     if missing:
         lines = "; ".join(f"{where} imports {name}" for name, where in sorted(missing.items()))
