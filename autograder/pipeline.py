@@ -17,7 +17,7 @@ are listed in :data:`STEPS`):
    run in the student's kernel could be faked by the student's code (patch checks.grade and
    every test cell "passes").
 4. The hidden checks run after the notebook, in a fresh sandbox of the same kind, as processes
-   of the grader (``python -m autograder.checks_outside``, root), against the module the
+   of the grader (``python -m autograder.hidden_checks_process``, root), against the module the
    notebook wrote; the student's code they start runs as the worker's uid, with the same limits.
    Their points replace nbgrader's scores of those cells, and their verdicts (seed, what passed
    and failed, pictures) replace the cells' outputs in the autograded notebook.
@@ -41,7 +41,7 @@ from pathlib import Path
 from autograder import config, gradebook, intake, kernel, packages, student_uid
 from autograder.nbgrader_cli import env_for_tools
 from autograder.outputs import keep_autograded, keep_log, scrub_paths
-from autograder.outside_checks import grade_outside
+from autograder.hidden_checks import grade_outside
 from autograder.result import GradeResult
 from autograder.sandbox import HIDDEN_FROM_STUDENTS, interpreter_exposure, isolation, run_sandboxed
 from autograder.staging import private_copy, stage_grader
@@ -195,7 +195,7 @@ def build_workspace(g: Grading) -> None:
 
 
 def run_hidden_checks(g: Grading) -> None:
-    """The hidden checks, outside the kernel (autograder.outside_checks)."""
+    """The hidden checks, outside the kernel (autograder.hidden_checks)."""
     if g.failed:
         return
     grade_outside(g.sub, g.result, g.work, g.autograded, g.workdir, g.domain_id, g.env, g.hide)

@@ -1,6 +1,6 @@
 """The grader's student uid: the checks' student processes run as the worker's uid, not as root.
 
-The grader runs a submission's hidden checks as root (autograder.checks_outside) and sets
+The grader runs a submission's hidden checks as root (autograder.hidden_checks_process) and sets
 STUDENT_UID_ENV (and STUDENT_NPROC_ENV) for them. :class:`StudentUid` is then what the checks
 (course_lib.checks.context.Context) start the student's code with: the same limits as a
 self-check, plus the uid (autograder.run_as) and a fresh HOME it owns. The student's code can

@@ -53,7 +53,7 @@ def submission_digest(sub: Submission, course: Path) -> str:
     digest = hashlib.sha256()
     _tree_digest([sub.path, course / "source" / sub.assignment], digest)
     here, checks = Path(__file__).resolve().parent, Path(registry.__file__).resolve().parent
-    code = [here / "kernel.py", here / "config.py", here / "checks_outside.py", here / "student_uid.py", here / "run_as.py",
+    code = [here / "kernel.py", here / "config.py", here / "hidden_checks_process.py", here / "student_uid.py", here / "run_as.py",
             here / "packages.py",
             here / "answers" / f"{sub.assignment}.py",
             *(checks / f"{name}.py" for name in CHECK_MODULES), checks / f"{sub.assignment}.py"]

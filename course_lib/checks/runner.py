@@ -12,7 +12,7 @@ Where things run:
   costs the points of that check and nothing else.
 
 At grading the course's grader (autograder.grading) runs the hidden checks itself, outside the
-student's kernel (``python -m autograder.checks_outside``): :func:`grade` in the notebook only
+student's kernel (``python -m autograder.hidden_checks_process``): :func:`grade` in the notebook only
 says so. As root the check stays root and the student's processes run as the grader's worker
 uid (AUTOGRADER_STUDENT_UID), so the student's code can neither fake a check's result nor read
 its seed (passed in the environment, not on the command line).

@@ -35,7 +35,7 @@ def grade_outside(sub: Submission, result: GradeResult, work: Path, autograded: 
         return
     out = work / "checks"
     out.mkdir(mode=0o700)
-    command = [sys.executable, "-m", "autograder.checks_outside", sub.assignment, *names,
+    command = [sys.executable, "-m", "autograder.hidden_checks_process", sub.assignment, *names,
                "--workdir", str(workdir), "--out", str(out)]
     wall = sum(checks[name].timeout + 30 for name in names)
     env = {**env, runner.SEED_ENV: None, "AUTOGRADER_SEED": os.environ.get("AUTOGRADER_SEED")}

@@ -1,5 +1,5 @@
 """The grader's run of a graded notebook's hidden checks, outside the student's kernel:
-``python -m autograder.checks_outside ASSIGNMENT CHECK... --workdir DIR --out DIR`` (autograder.grading)."""
+``python -m autograder.hidden_checks_process ASSIGNMENT CHECK... --workdir DIR --out DIR`` (started by autograder.hidden_checks)."""
 
 from __future__ import annotations
 
@@ -42,7 +42,7 @@ def run_outside(assignment: str, names: list[str], workdir, out: Path) -> None:
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m autograder.checks_outside",
+    parser = argparse.ArgumentParser(prog="python -m autograder.hidden_checks_process",
                                      description="Run the hidden checks of a graded notebook's module (the grader).")
     parser.add_argument("assignment")
     parser.add_argument("checks", nargs="+")
