@@ -149,13 +149,10 @@ def _exchange(ctx, probe, node, publisher, replies: list, frames, encoding: str,
         expected = ctx.expected("average_brightness", image)
         msg = images.image_to_msg(image, encoding)
         replies.clear()
-        deadline = time.monotonic() + 4.0
         # Resent every 0.3 s (best effort may drop a frame); WRONG_ANSWERS wrong answers end the
         # wait early. `earlier` collects the right answers of all frames sent before.
         wrong = lambda: _wrong(replies, earlier - {expected}) >= WRONG_ANSWERS  # noqa: E731
-        while time.monotonic() < deadline and expected not in replies and node.running() and not wrong():
-            publisher.publish(msg)
-            probe.spin_until(lambda: expected in replies or not node.running() or wrong(), 0.3)
+        probe.resend_until(publisher, msg, lambda: expected in replies or not node.running() or wrong(), 4.0)
         earlier.add(expected)
         if not node.running():
             return None
@@ -430,10 +427,7 @@ def _remapped(ctx, probe, remapped, image) -> None:
         return
     expected = ctx.expected("average_brightness", image)
     msg = images.image_to_msg(image, "bgr8")
-    deadline = time.monotonic() + 4.0
-    while time.monotonic() < deadline and expected not in replies and len(replies) < WRONG_ANSWERS:
-        publisher.publish(msg)
-        probe.spin_until(lambda: expected in replies or len(replies) >= WRONG_ANSWERS, 0.3)
+    probe.resend_until(publisher, msg, lambda: expected in replies or len(replies) >= WRONG_ANSWERS, 4.0)
     if expected in replies:
         ctx.item(True, f"{label}: {REMAPPED_IMAGE} -> {REMAPPED_BRIGHTNESS} works")
         return

@@ -26,7 +26,6 @@ marker_board.crop_similarity, passing at marker_board.SAME_CROP_THRESHOLD; colou
 
 from __future__ import annotations
 
-import time
 
 import numpy as np
 
@@ -228,10 +227,7 @@ def node(ctx: Context) -> None:
             scene = scenes.render_scene(_seed(ctx), difficulty="easy")
             expected = scene.expected_crops(SIZE)
             msg = images.image_to_msg(scene.frame, "bgr8")
-            deadline = time.monotonic() + 8.0
-            while time.monotonic() < deadline and not (got["cat"] and got["dog"]):
-                pub.publish(msg)
-                probe.spin_until(lambda: bool(got["cat"] and got["dog"]), 0.5)
+            probe.resend_until(pub, msg, lambda: bool(got["cat"] and got["dog"]), 8.0, every=0.5)
             types = dict(probe.node.get_topic_names_and_types())
     finally:
         proc.stop(timeout=2)

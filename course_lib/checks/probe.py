@@ -26,6 +26,20 @@ class RosProbe:
         """Process callbacks until condition() is true or `timeout` seconds pass; returns condition()."""
         return waiting.spin_until(condition, timeout, executor=self.executor)
 
+    def resend_until(self, publisher, msg, condition, timeout: float, every: float = 0.3) -> bool:
+        """Publish `msg` every `every` seconds (best effort may drop one) and process callbacks,
+        until condition() is true or `timeout` seconds pass; returns condition()."""
+        import time
+
+        end = time.monotonic() + timeout
+        while not condition():
+            left = end - time.monotonic()
+            if left <= 0:
+                return bool(condition())
+            publisher.publish(msg)
+            self.spin_until(condition, min(every, left))
+        return True
+
     def spin_for(self, seconds: float) -> None:
         self.spin_until(lambda: False, seconds)
 

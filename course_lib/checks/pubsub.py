@@ -20,8 +20,8 @@ the workspace first); the checker's own node uses the reference MsgTutorial.
 from __future__ import annotations
 
 import re
-import time
 
+from course_lib import waiting
 from course_lib.checks import packages, runner
 from course_lib.checks.context import Context, StudentError, clip
 from course_lib.checks.registry import check
@@ -187,9 +187,7 @@ def together(ctx: Context) -> None:
     pub = _start(ctx, "topic_publisher")
     sub = _start(ctx, "topic_subscriber")
     try:
-        deadline = time.monotonic() + 20.0
-        while time.monotonic() < deadline and len(_heard(sub.log)) < 15 and sub.running() and pub.running():
-            time.sleep(0.1)
+        waiting.spin_until(lambda: len(_heard(sub.log)) >= 15 or not (sub.running() and pub.running()), 20.0, poll=0.1)
     finally:
         sub.stop(timeout=2)
         pub.stop(timeout=2)
