@@ -73,7 +73,10 @@ class RosInstall:
 
 
 def _has_ament_index(prefix: Path) -> bool:
-    return (prefix / "share" / "ament_index" / "resource_index").is_dir()
+    try:
+        return (prefix / "share" / "ament_index" / "resource_index").is_dir()
+    except PermissionError:  # a prefix on AMENT_PREFIX_PATH this user may not read: not an install of theirs
+        return False
 
 
 def _env_prefixes() -> list[Path]:

@@ -11,6 +11,7 @@
 - every assignment's reference packages build, and their solution regions are marked.
 """
 
+import os
 import sys
 import time
 import xml.etree.ElementTree as ElementTree
@@ -178,6 +179,16 @@ def test_bad_arguments_are_refused_with_the_fix(frame, size, message):
 
 
 # ---- MarkerReader in this process -----------------------------------------------------------
+
+@pytest.fixture(scope="module", autouse=True)
+def environment_restored():
+    """use_interfaces sources a workspace into this process's environment; test modules that run
+    later on this worker (and the processes they start) must not inherit its paths."""
+    saved = dict(os.environ)
+    yield
+    os.environ.clear()
+    os.environ.update(saved)
+
 
 def use_interfaces(ws):
     """Import catdog_interfaces (which marker_reader imports) in this process: the underlay the

@@ -20,6 +20,26 @@ def test_pip_wheels_are_detected_in_the_project_environment():
     assert any((p / "share/ament_index/resource_index/packages/rclpy").exists() for p in install.prefixes)
 
 
+def test_an_unreadable_prefix_on_the_ament_path_is_skipped(tmp_path, monkeypatch):
+    """A grading run once passed a prefix of the grader's (mode 0700) to a student's process, where
+    importing course_lib raised PermissionError. (Root reads everything, so the refusal is made here.)"""
+    import pathlib
+
+    private = tmp_path / "private"
+    (private / "share" / "ament_index" / "resource_index").mkdir(parents=True)
+    is_dir = pathlib.Path.is_dir
+
+    def refusing(path, *args, **kwargs):
+        if str(path).startswith(str(private)):
+            raise PermissionError(13, "Permission denied", str(path))
+        return is_dir(path, *args, **kwargs)
+
+    monkeypatch.setattr(pathlib.Path, "is_dir", refusing)
+    monkeypatch.setenv("AMENT_PREFIX_PATH", os.pathsep.join([str(private), os.environ.get("AMENT_PREFIX_PATH", "")]))
+    install = rosenv.detect_install()
+    assert install.prefixes and private not in install.prefixes
+
+
 def test_child_environment_is_isolated_and_finds_the_ament_index():
     env = rosenv.ros_environment(domain_id=42, base={"PATH": "/usr/bin", "ROS_LOCALHOST_ONLY": "1"})
     assert env["ROS_DOMAIN_ID"] == "42"
