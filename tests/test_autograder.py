@@ -1,5 +1,5 @@
-"""The autograder: checks declared right, stubs that fail with a hint, typical mistakes named,
-and release -> reference solution -> grade -> full marks (catdog_warp here; see FULL_RUN_REFERENCES), then feedback."""
+"""The autograder's checks: declared right, stubs that fail with a hint, typical mistakes named
+(the whole pipeline, nbgrader to the feedback page: tests/test_autograder_pipeline.py)."""
 
 from __future__ import annotations
 
@@ -11,8 +11,7 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-import zoo  # noqa: E402
-from autograder import grading, packages, reference, release, sandbox  # noqa: E402
+from autograder import packages, reference, sandbox  # noqa: E402
 from course_lib.checks import registry, runner, validate  # noqa: E402
 
 ASSIGNMENTS = ["brightness", "pubsub", "catdog_warp"]
@@ -186,82 +185,3 @@ def test_pubsub_typical_mistake_loses_points_with_its_reason(tmp_path, monkeypat
                              mode="graded")
     assert result.points < result.max_points, result.verdict_lines()
     assert reason in "\n".join(result.verdict_lines())
-
-
-# ---------------------------------------------------------------------------------------------
-# End to end, with the real nbgrader CLI and gradebook
-
-
-#: Typical mistakes that also go through the whole pipeline (nbgrader, grader, feedback page).
-FULL_RUN_MISTAKES = {"catdog_warp": CATDOG_MISTAKES["mirrored"], "pubsub": PUBSUB_MISTAKES["wrong_topic"][::2]}
-
-
-#: References graded through the whole pipeline here. Each assignment's reference goes through it
-#: once in the suite: brightness's in the zoo (tests/test_autograder_zoo.py, "full"), pubsub's in
-#: the term (tests/test_term.py, alice), catdog_warp's here.
-FULL_RUN_REFERENCES = ["catdog_warp"]
-
-
-@pytest.fixture(scope="module")
-def course(tmp_path_factory):
-    course = tmp_path_factory.mktemp("course")
-    release.release(course, ASSIGNMENTS)
-    for assignment in FULL_RUN_REFERENCES:
-        zoo.submit(course, "reference", assignment)
-    for assignment, (edits, _reason) in FULL_RUN_MISTAKES.items():
-        zoo.submit(course, "mistaken", assignment, edits)
-    results = grading.grade(course, workers=2, progress=False)
-    return course, {(r.student, r.assignment): r for r in results}
-
-
-@pytest.fixture(scope="module")
-def feedback_pages(course):
-    from autograder import feedback
-
-    root, _ = course
-    return root, feedback.write_feedback(root)
-
-
-@pytest.mark.slow
-@pytest.mark.timeout(900)
-def test_release_has_stubs_and_no_solutions_or_hidden_tests(course):
-    """release/ holds the notebooks with stubs: no solution code, no hidden tests."""
-    root, _ = course
-    for assignment in ASSIGNMENTS:
-        text = (root / "release" / assignment / f"{assignment}.ipynb").read_text()
-        assert "BEGIN SOLUTION" not in text and "HIDDEN TESTS" not in text and "checks.grade(" not in text
-        assert "NotImplementedError" in text
-
-
-@pytest.mark.slow
-@pytest.mark.parametrize("assignment", FULL_RUN_REFERENCES)
-def test_reference_solutions_get_full_marks(course, assignment):
-    """release -> reference solution in the student notebook -> grade: every point."""
-    root, results = course
-    result = results["reference", assignment]
-    assert result.status == "graded", result.reason
-    assert result.score == result.max_score > 0, zoo.graded_outputs(root, "reference", assignment)
-
-
-@pytest.mark.slow
-@pytest.mark.parametrize("assignment", sorted(FULL_RUN_MISTAKES))
-def test_typical_mistake_is_graded_down_with_its_reason_in_the_feedback(feedback_pages, course, assignment):
-    """A typical mistake, handed in as a notebook, loses points, and its feedback page says why."""
-    _, results = course
-    root, _pages = feedback_pages
-    result = results["mistaken", assignment]
-    assert result.status == "graded" and 0 < result.score < result.max_score, zoo.graded_outputs(root, "mistaken", assignment)
-    page = (root / "feedback" / "mistaken" / assignment / f"{assignment}.html").read_text()
-    reason = FULL_RUN_MISTAKES[assignment][1]
-    assert reason in page.replace("&#39;", "'").replace("&quot;", '"')
-
-
-@pytest.mark.slow
-def test_feedback_shows_crops_beside_expected(feedback_pages):
-    """Feedback: an index per student, and the warp notebook's page shows both crops."""
-    root, pages = feedback_pages
-    assert root / "feedback" / "reference" / "index.html" in pages
-    page = (root / "feedback" / "reference" / "catdog_warp" / "catdog_warp.html").read_text()
-    assert "yours" in page and "expected" in page and "data:image/png;base64" in page
-    assert "reproduce with AUTOGRADER_SEED=" in page
-    assert not (root / "feedback" / "reference" / "catdog_warp" / "autograder.log").exists()
