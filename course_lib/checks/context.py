@@ -217,20 +217,6 @@ class Context:
                                f"{last_lines(proc.log, 6)}")
         return proc, call_seconds
 
-    def start_node(self, *ros_args: str, entry: str = "main", tag: str = ""):
-        """Start the student's node (``<module>:main``) in this check's ROS domain; stopped at the end.
-        Nodes started at the same time need different `tag`s (a process of the same name is replaced).
-
-        Returns:
-            The running course_lib.processes.NodeProcess (see its log, running(), describe_exit()).
-        """
-        from course_lib import processes
-
-        self.require_module()
-        return self.students.start(processes.python_command(f"{self.module}:{entry}", *ros_args),
-                                   name=f"student-{self.module}-{entry}{tag}", cwd=self.workdir,
-                                   domain_id=self.domain_id, wall_seconds=self.remaining() + 5)
-
     @property
     def domain_id(self) -> int:
         if self._reservation is None:

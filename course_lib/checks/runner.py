@@ -7,7 +7,7 @@ Where things run:
   so nothing a check does can hang or crash the kernel, and nothing the kernel's state holds
   (a node the student left spinning, a patched module) changes the check;
 - the student's code runs in a third process, started by the check (:meth:`Context.call` for
-  plain functions, :meth:`Context.start_node` for nodes), with its own resource limits and, for
+  plain functions, course_lib.checks.packages.run for nodes, as `ros2 run`), with its own limits and, for
   ROS, a ROS_DOMAIN_ID reserved for the check. A student process that loops, crashes or exits
   costs the points of that check and nothing else.
 
