@@ -27,7 +27,9 @@ hello = session.add_node(Hello())
 session.spin_for(0.5)""",
     "session.spin_for(0.5)\nprint('the next cell')",
     "print(node_logs.text('hello').splitlines()[0])",
-    "hello = session.add_node(Hello())  # the first cell, re-run",
+    # The first cell, re-run; then a moment for its lines to arrive before the kernel shuts down (in
+    # a live notebook they appear in the widget whenever they come).
+    "hello = session.add_node(Hello())\nsession.spin_for(0.5)",
 ]
 
 
