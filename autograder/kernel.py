@@ -31,13 +31,6 @@ from autograder import run_as
 WORK_SUBDIR = ".autograder-cwd"
 
 
-def _give(path: str, uid: int) -> None:
-    os.chown(path, uid, uid)
-    for directory, dirs, files in os.walk(path):
-        for name in dirs + files:
-            os.lchown(os.path.join(directory, name), uid, uid)
-
-
 def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     connection = argv[0]
@@ -49,7 +42,7 @@ def main(argv=None) -> int:
         shutil.copyfile(connection, copy)
         for name in ("home", "tmp"):
             os.mkdir(os.path.join(private, name))
-        _give(private, uid)
+        run_as.give_tree(private, uid)
         os.chmod(private, 0o700)
         work = os.path.join(os.getcwd(), WORK_SUBDIR)
         if os.path.islink(work) or os.path.isfile(work):  # handed in under that name: not ours
@@ -57,7 +50,7 @@ def main(argv=None) -> int:
         elif os.path.isdir(work):
             shutil.rmtree(work)
         shutil.copytree(os.getcwd(), work, symlinks=True, ignore=shutil.ignore_patterns(WORK_SUBDIR))
-        _give(work, uid)
+        run_as.give_tree(work, uid)
         os.chmod(work, 0o700)
         os.chmod(os.getcwd(), 0o711)
         os.chdir(work)

@@ -357,10 +357,7 @@ def build_for_checks(assignment: str, course: Path, work: Path, workdir: Path, u
     give = None
     if uid is not None:
         def give(path: Path) -> None:
-            for directory, dirs, files in os.walk(path):
-                os.chown(directory, uid, uid)
-                for name in files:
-                    os.lchown(os.path.join(directory, name), uid, uid)
+            run_as.give_tree(path, uid)
         give(home)
     sandbox = {name: grader_env[name] for name in _SANDBOX_VARIABLES if grader_env.get(name)}
 

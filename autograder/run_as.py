@@ -82,6 +82,15 @@ def home_for(user: str | int) -> str:
     return home
 
 
+def give_tree(path, uid: int) -> None:
+    """Make `uid` (and its group of the same number) own a folder the grader created and all in it,
+    links themselves included, so the student's processes can write there."""
+    os.chown(path, uid, uid)
+    for directory, dirs, files in os.walk(path):
+        for name in dirs + files:
+            os.lchown(os.path.join(directory, name), uid, uid)
+
+
 def become(uid: int, gid: int, max_processes: int | None = None) -> None:
     """Switch this process to uid and gid with no supplementary groups, then bound the processes
     and threads of that uid (RLIMIT_NPROC): the wrapper's step, and the grading kernel's

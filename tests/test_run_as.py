@@ -115,3 +115,14 @@ def test_the_child_still_dies_with_its_supervisor(token):
     os.kill(process._supervisor.pid, signal.SIGKILL)
     assert wait_until(lambda: not processes_with(token), timeout=10)
     process.stop()
+
+
+@needs_root
+def test_give_tree_hands_every_file_folder_and_link_to_the_uid(tmp_path):
+    (tmp_path / "a" / "b").mkdir(parents=True)
+    (tmp_path / "a" / "b" / "file").write_text("x")
+    (tmp_path / "a" / "link").symlink_to("/etc/hostname")
+    run_as.give_tree(tmp_path / "a", 61990)
+    for path in (tmp_path / "a", tmp_path / "a" / "b", tmp_path / "a" / "b" / "file", tmp_path / "a" / "link"):
+        assert os.lstat(path).st_uid == 61990 and os.lstat(path).st_gid == 61990, path
+    assert os.stat("/etc/hostname").st_uid == 0  # the link's target is not the student's
