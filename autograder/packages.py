@@ -32,7 +32,7 @@ import time
 import xml.etree.ElementTree as ElementTree
 from pathlib import Path
 
-from course_lib import colcon, workspace
+from course_lib import colcon, package_files, workspace
 
 #: The workspace folder beside the notebook.
 WORKSPACE = "ros2_ws"
@@ -111,10 +111,9 @@ def is_interface_package(folder: Path) -> bool:
 
 def _depends(folder: Path) -> set[str]:
     try:
-        root = ElementTree.parse(folder / "package.xml").getroot()
+        return package_files.dependencies(folder / "package.xml")
     except (ElementTree.ParseError, OSError):
         return set()
-    return {(e.text or "").strip() for e in root if e.tag in ("depend", "build_depend", "exec_depend")}
 
 
 def content_key(folder: Path, underlay_keys=()) -> str:
@@ -185,9 +184,9 @@ def first_error_lines(output: str, lines: int = 8) -> str:
 def _package_log(ws: Path, output: str) -> str:
     """The log of the package colcon reported as failed (CMake's and the compiler's messages are
     there, not in colcon's summary), else colcon's output."""
-    failed = re.findall(r"^Failed\s+<<< (\S+)", output, re.MULTILINE)
+    failed = colcon.failed_packages(output)
     if failed:
-        log = ws / "log" / "latest_build" / failed[0] / "stdout_stderr.log"
+        log = colcon.package_log_path(ws, failed[0])
         if log.is_file():
             return f"Failed   <<< {failed[0]}\n" + log.read_text(errors="replace")
     return output
@@ -284,7 +283,7 @@ def build_workspace(ws: Path, cache: InterfaceCache, scratch: Path, run, give=No
 
 
 def _reason(log: str) -> str:
-    failed = re.findall(r"^Failed\s+<<< (\S+)", log, re.MULTILINE)
+    failed = colcon.failed_packages(log)
     where = f" in package {failed[0]!r}" if failed else ""
     return f"colcon build failed{where}:\n{first_error_lines(log)}"
 

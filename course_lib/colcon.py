@@ -57,7 +57,17 @@ class BuildResult:
 
     def log_path(self, package: str) -> Path:
         """colcon's full log of one package in this build."""
-        return self.ws_dir / "log" / "latest_build" / package / "stdout_stderr.log"
+        return package_log_path(self.ws_dir, package)
+
+
+def package_log_path(ws_dir, package: str) -> Path:
+    """colcon's full log of one package in the workspace's latest build."""
+    return Path(ws_dir) / "log" / "latest_build" / package / "stdout_stderr.log"
+
+
+def failed_packages(output: str) -> list[str]:
+    """The packages colcon's output reports as failed ("Failed   <<< name"), in its order."""
+    return re.findall(r"^Failed\s+<<< (\S+)", output, re.MULTILINE)
 
 
 # --- building ----------------------------------------------------------------------------------
@@ -138,7 +148,7 @@ def build(ws_dir, packages=None, *, extra_args=(), timeout: float = 600,
     result = BuildResult(ws_dir, command, None if timed_out else process.returncode, output,
                          time.monotonic() - started,
                          re.findall(r"^Finished <<< (\S+)", output, re.MULTILINE),
-                         re.findall(r"^Failed\s+<<< (\S+)", output, re.MULTILINE))
+                         failed_packages(output))
     if timed_out:
         raise BuildError(f"colcon build in {ws_dir} did not finish within {timeout:g} s and was stopped; "
                          f"pass a larger timeout or build fewer packages.\n{_tail(output)}", result)

@@ -18,15 +18,20 @@ import xml.etree.ElementTree as ElementTree
 from pathlib import Path
 
 
-def run_dependencies(package_xml) -> set[str]:
-    """The names of ``<depend>`` and ``<exec_depend>`` in a package.xml (format 2 or 3).
+def dependencies(package_xml, tags=("depend", "build_depend", "exec_depend")) -> set[str]:
+    """The package names a package.xml (format 2 or 3) lists in elements of these `tags`.
 
     Raises:
         OSError: the file cannot be read.
         xml.etree.ElementTree.ParseError: it is not well-formed XML.
     """
     root = ElementTree.parse(package_xml).getroot()
-    return {(element.text or "").strip() for element in root if element.tag in ("depend", "exec_depend")}
+    return {(element.text or "").strip() for element in root if element.tag in tags}
+
+
+def run_dependencies(package_xml) -> set[str]:
+    """The packages a package.xml lets the code use at run time: ``<depend>`` and ``<exec_depend>``."""
+    return dependencies(package_xml, ("depend", "exec_depend"))
 
 
 def imported_modules(tree: ast.AST) -> dict[str, int]:

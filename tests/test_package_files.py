@@ -56,3 +56,9 @@ def test_console_scripts_reads_entries_wherever_setup_builds_its_list(tmp_path):
         "setup(name='demo', entry_points={'console_scripts': SCRIPTS + ['listener=demo.listener:main']})\n")
     assert package_files.console_scripts(tmp_path / "setup.py") == {"talker": "demo.talker:main",
                                                                     "listener": "demo.listener:main"}
+
+
+def test_dependencies_of_chosen_tags(tmp_path):
+    (tmp_path / "package.xml").write_text(PACKAGE_XML)
+    assert package_files.dependencies(tmp_path / "package.xml") == {"rclpy", "sensor_msgs", "std_msgs"}
+    assert package_files.dependencies(tmp_path / "package.xml", ("test_depend",)) == {"ament_flake8"}
