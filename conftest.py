@@ -78,7 +78,8 @@ def pytest_collection_modifyitems(items):
     if _lessons_run_in_chromium(items):
         run_in_lab = {item.name.split("[", 1)[1].rstrip("]") for item in items
                       if item.name.startswith("test_course_notebook_runs_clean_in_jupyterlab[")}
-        skip = pytest.mark.skip(reason=f"runs top to bottom in JupyterLab (tests/test_browser.py); "
+        skip = pytest.mark.skip(reason=f"runs top to bottom in JupyterLab (tests/test_browser.py or "
+                                       f"test_browser_lessons.py); "
                                        f"{NBMAKE_LESSONS_ENV}=1 runs it under nbmake too")
         for item in items:
             if item.path.suffix == ".ipynb" and item.path.name in run_in_lab:
