@@ -43,7 +43,8 @@ def domain_id():
 #: xdist hands out files in collection order, and a long file started last ends the suite last.
 #: (Longest-first by measured time, browser and the three grading runs at once, measured 12:36
 #: against 11:50 for this order: four CPU-heavy files together on 2 cores slow each other down.)
-LONGEST_FIRST = ("test_term.py", "test_hub.py", "test_autograder_zoo.py", "test_autograder.py", "test_browser.py")
+LONGEST_FIRST = ("test_term.py", "test_hub.py", "test_autograder_zoo.py", "test_autograder.py", "test_browser.py",
+                 "test_browser_lessons.py")
 
 
 #: Set to 1 to run the lessons under nbmake even when tests/test_browser.py runs them in Chromium.
@@ -77,7 +78,8 @@ def pytest_collection_modifyitems(items):
     if _lessons_run_in_chromium(items):
         run_in_lab = {item.name.split("[", 1)[1].rstrip("]") for item in items
                       if item.name.startswith("test_course_notebook_runs_clean_in_jupyterlab[")}
-        skip = pytest.mark.skip(reason=f"runs top to bottom in JupyterLab (tests/test_browser.py); "
+        skip = pytest.mark.skip(reason=f"runs top to bottom in JupyterLab (tests/test_browser.py or "
+                                       f"test_browser_lessons.py); "
                                        f"{NBMAKE_LESSONS_ENV}=1 runs it under nbmake too")
         for item in items:
             if item.path.suffix == ".ipynb" and item.path.name in run_in_lab:

@@ -503,6 +503,56 @@ def save_full_notebook_screenshot(page, target: Path) -> None:
         page.set_viewport_size(VIEWPORT)
 
 
+# --- the course's lessons ------------------------------------------------------------------
+
+LESSONS_DIR = Path(__file__).resolve().parents[1] / "notebooks"
+SCREENSHOTS = Path(__file__).resolve().parents[1] / "artifacts" / "browser"
+#: Seconds a lesson may take from Run All Cells until nothing runs (ROS nodes and colcon builds
+#: take a minute on a busy 2-core machine; allow plenty).
+LESSON_RUN_TIMEOUT = 300
+
+#: The lessons tests/test_browser_lessons.py runs, in a JupyterLab of its own; tests/test_browser.py
+#: runs the others. Under `--dist loadfile` each file goes to one xdist worker, so the two halves
+#: run side by side: all six lessons in one file took 6 of its 8 minutes, the longest file of
+#: the suite. These three build packages with colcon (about half of the lessons' time).
+SECOND_LAB_LESSONS = ("01b_custom_messages.ipynb", "02_images_and_brightness.ipynb",
+                      "02b_packages_launch_parameters.ipynb")
+
+
+def course_lessons(second_lab: bool) -> list[str]:
+    """The lessons (paths under notebooks/) one of the two lesson files runs (see SECOND_LAB_LESSONS)."""
+    lessons = sorted(str(p.relative_to(LESSONS_DIR)) for p in LESSONS_DIR.rglob("*.ipynb")
+                     if ".ipynb_checkpoints" not in p.parts)
+    return [lesson for lesson in lessons if (lesson in SECOND_LAB_LESSONS) == second_lab]
+
+
+def copy_lessons(root: Path) -> None:
+    """Copy notebooks/ to root/notebooks as in a fresh checkout: no checkpoints, no colcon output."""
+    if LESSONS_DIR.is_dir():
+        shutil.copytree(LESSONS_DIR, root / "notebooks",
+                        ignore=shutil.ignore_patterns(".ipynb_checkpoints", "build", "install", "log"))
+
+
+def run_in_lab(context, lab: JupyterLab, path: str, screenshot: Path | None = None) -> NotebookRun:
+    """Open path in JupyterLab, run all cells, shut its kernel down; return the NotebookRun."""
+    page = open_notebook(context, lab, path)
+    try:
+        run = run_notebook(page, path, code_cell_count(lab.root_dir / path), LESSON_RUN_TIMEOUT, screenshot)
+    finally:
+        lab.shut_down_kernels_of(path)
+        page.close()
+    print(f"\n{path}: Run All Cells took {run.seconds:.1f} s")
+    return run
+
+
+def assert_lesson_runs_clean(context, lab: JupyterLab, notebook: str) -> None:
+    """Run a lesson (its path under notebooks/) top to bottom in lab: every code cell ran, none
+    shows an error, every image renders (a screenshot goes to artifacts/browser/)."""
+    screenshot = SCREENSHOTS / (notebook.removesuffix(".ipynb").replace("/", "__") + ".png")
+    run = run_in_lab(context, lab, f"notebooks/{notebook}", screenshot)
+    assert not run.problems(), f"{notebook} in JupyterLab (screenshot {screenshot}):\n" + "\n".join(run.problems())
+
+
 # --- nbgrader -------------------------------------------------------------------------------
 
 # nbgrader's lab extension answers every press of Validate with a dialog of one of these classes,

@@ -3,26 +3,24 @@
 One JupyterLab server and one headless Chromium serve the whole module. The server's root is a
 scratch directory holding a copy of notebooks/ (outputs never reach the repository) and the
 checker's own small notebooks, which prove that the checker passes a good notebook and fails
-one that raises. Screenshots go to artifacts/browser/<notebook>.png.
+one that raises. Screenshots go to artifacts/browser/<notebook>.png. The lessons that build
+packages run in tests/test_browser_lessons.py, beside this file (browser_support.SECOND_LAB_LESSONS).
 """
 
 import json
-import shutil
 from pathlib import Path
 
 import pytest
 
-from browser_support import (NOTEBOOK, click_toolbar_button, code_cell_count, open_notebook, run_notebook,
-                             running_jupyterlab, toolbar_labels, write_notebook)
+from browser_support import (LESSON_RUN_TIMEOUT, NOTEBOOK, SCREENSHOTS, assert_lesson_runs_clean,
+                             click_toolbar_button, copy_lessons, course_lessons, open_notebook, run_in_lab,
+                             run_notebook, running_jupyterlab, toolbar_labels, write_notebook)
 
 ROOT = Path(__file__).resolve().parents[1]
 NOTEBOOKS = ROOT / "notebooks"
-SCREENSHOTS = ROOT / "artifacts" / "browser"
-# Notebooks may start ROS nodes and take a minute on a busy 2-core machine; allow plenty.
-RUN_TIMEOUT = 300
+RUN_TIMEOUT = LESSON_RUN_TIMEOUT
 
-COURSE_NOTEBOOKS = sorted(str(p.relative_to(NOTEBOOKS)) for p in NOTEBOOKS.rglob("*.ipynb")
-                          if ".ipynb_checkpoints" not in p.parts)
+COURSE_NOTEBOOKS = course_lessons(second_lab=False)
 
 pytestmark = pytest.mark.browser
 
@@ -68,10 +66,7 @@ def lesson_line(notebook: str, start: str) -> str:
 def lab(tmp_path_factory):
     """JupyterLab on a scratch root holding a copy of notebooks/ and the checker's notebooks."""
     root = tmp_path_factory.mktemp("lab-root")
-    if NOTEBOOKS.is_dir():
-        # As in a fresh checkout: no checkpoints, no colcon output (git ignores both).
-        shutil.copytree(NOTEBOOKS, root / "notebooks",
-                        ignore=shutil.ignore_patterns(".ipynb_checkpoints", "build", "install", "log"))
+    copy_lessons(root)
     (root / "checker").mkdir()
     for name, sources in CHECKER_NOTEBOOKS.items():
         write_notebook(root / "checker" / name, sources)
@@ -88,26 +83,12 @@ def lab(tmp_path_factory):
         yield server
 
 
-def run_in_lab(browser, lab, path, screenshot=None):
-    """Open path in JupyterLab, run all cells, shut its kernel down; return the NotebookRun."""
-    page = open_notebook(browser, lab, path)
-    try:
-        run = run_notebook(page, path, code_cell_count(lab.root_dir / path), RUN_TIMEOUT, screenshot)
-    finally:
-        lab.shut_down_kernels_of(path)
-        page.close()
-    print(f"\n{path}: Run All Cells took {run.seconds:.1f} s")
-    return run
-
-
 @pytest.mark.timeout(RUN_TIMEOUT + 180)
 @pytest.mark.parametrize("notebook", COURSE_NOTEBOOKS or [
     pytest.param(None, marks=pytest.mark.skip(reason=f"no notebooks in {NOTEBOOKS} yet"))])
 def test_course_notebook_runs_clean_in_jupyterlab(notebook, browser, lab):
     """After Run All Cells every code cell has run, none shows an error, every image renders."""
-    screenshot = SCREENSHOTS / (notebook.removesuffix(".ipynb").replace("/", "__") + ".png")
-    run = run_in_lab(browser, lab, f"notebooks/{notebook}", screenshot)
-    assert not run.problems(), f"{notebook} in JupyterLab (screenshot {screenshot}):\n" + "\n".join(run.problems())
+    assert_lesson_runs_clean(browser, lab, notebook)
 
 
 def test_the_students_lab_has_no_instructor_side(lab):
