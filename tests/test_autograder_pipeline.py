@@ -12,8 +12,9 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
+import course_support  # noqa: E402
 import zoo  # noqa: E402
-from autograder import grading, release  # noqa: E402
+from autograder import grading  # noqa: E402
 from test_autograder import ASSIGNMENTS, CATDOG_MISTAKES, PUBSUB_MISTAKES  # noqa: E402
 
 #: Typical mistakes that also go through the whole pipeline (nbgrader, grader, feedback page).
@@ -28,8 +29,8 @@ FULL_RUN_REFERENCES = ["catdog_warp"]
 
 @pytest.fixture(scope="module")
 def course(tmp_path_factory):
-    course = tmp_path_factory.mktemp("course")
-    release.release(course, ASSIGNMENTS)
+    course = course_support.released_course(tmp_path_factory, tmp_path_factory.mktemp("course"), ASSIGNMENTS)
+    course_support.seed_interface_cache(tmp_path_factory, course, ASSIGNMENTS)
     for assignment in FULL_RUN_REFERENCES:
         zoo.submit(course, "reference", assignment)
     for assignment, (edits, _reason) in FULL_RUN_MISTAKES.items():
