@@ -12,12 +12,18 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
+import course_support  # noqa: E402
 import zoo  # noqa: E402
-from autograder import grading, release  # noqa: E402
-from test_autograder import ASSIGNMENTS, CATDOG_MISTAKES, PUBSUB_MISTAKES  # noqa: E402
+from autograder import grading  # noqa: E402
+from test_autograder import ASSIGNMENTS, CATDOG_CHECK, CATDOG_MISTAKES, FULL_RUN, PUBSUB_MISTAKES  # noqa: E402
 
-#: Typical mistakes that also go through the whole pipeline (nbgrader, grader, feedback page).
-FULL_RUN_MISTAKES = {"catdog_warp": CATDOG_MISTAKES["mirrored"], "pubsub": PUBSUB_MISTAKES["wrong_topic"][::2]}
+#: Typical mistakes that go through the whole pipeline (nbgrader, grader, feedback page), as
+#: (edits, the check it costs, a phrase of the verdict); the other typical mistakes are run through
+#: the checks only (tests/test_autograder.py), which is cheaper.
+FULL_RUN_MISTAKES = {
+    "catdog_warp": (CATDOG_MISTAKES[FULL_RUN["catdog_warp"]][0], CATDOG_CHECK, CATDOG_MISTAKES[FULL_RUN["catdog_warp"]][1]),
+    "pubsub": PUBSUB_MISTAKES[FULL_RUN["pubsub"]],
+}
 
 
 #: References graded through the whole pipeline here. Each assignment's reference goes through it
@@ -28,11 +34,11 @@ FULL_RUN_REFERENCES = ["catdog_warp"]
 
 @pytest.fixture(scope="module")
 def course(tmp_path_factory):
-    course = tmp_path_factory.mktemp("course")
-    release.release(course, ASSIGNMENTS)
+    course = course_support.released_course(tmp_path_factory, tmp_path_factory.mktemp("course"), ASSIGNMENTS)
+    course_support.seed_interface_cache(tmp_path_factory, course, ASSIGNMENTS)
     for assignment in FULL_RUN_REFERENCES:
         zoo.submit(course, "reference", assignment)
-    for assignment, (edits, _reason) in FULL_RUN_MISTAKES.items():
+    for assignment, (edits, _check, _reason) in FULL_RUN_MISTAKES.items():
         zoo.submit(course, "mistaken", assignment, edits)
     results = grading.grade(course, workers=2, progress=False)
     return course, {(r.student, r.assignment): r for r in results}
@@ -70,13 +76,16 @@ def test_reference_solutions_get_full_marks(course, assignment):
 @pytest.mark.slow
 @pytest.mark.parametrize("assignment", sorted(FULL_RUN_MISTAKES))
 def test_typical_mistake_is_graded_down_with_its_reason_in_the_feedback(feedback_pages, course, assignment):
-    """A typical mistake, handed in as a notebook, loses points, and its feedback page says why."""
+    """A typical mistake, handed in as a notebook, loses points in the check it breaks, and its
+    feedback page says why."""
     _, results = course
     root, _pages = feedback_pages
     result = results["mistaken", assignment]
     assert result.status == "graded" and 0 < result.score < result.max_score, zoo.graded_outputs(root, "mistaken", assignment)
+    _edits, check, reason = FULL_RUN_MISTAKES[assignment]
+    cell = next(c for c in result.cells if c["cell"] == f"check_{check}")
+    assert cell["auto_score"] < cell["max_score"], (cell, zoo.graded_outputs(root, "mistaken", assignment))
     page = (root / "feedback" / "mistaken" / assignment / f"{assignment}.html").read_text()
-    reason = FULL_RUN_MISTAKES[assignment][1]
     assert reason in page.replace("&#39;", "'").replace("&quot;", '"')
 
 

@@ -20,6 +20,7 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
+import course_support  # noqa: E402
 import zoo  # noqa: E402
 from zoo import brightness as brightness_zoo  # noqa: E402
 from zoo import pubsub as pubsub_zoo  # noqa: E402
@@ -35,10 +36,11 @@ def _hashes(folder: Path) -> dict[str, str]:
 
 @pytest.fixture(scope="module")
 def graded(tmp_path_factory):
-    from autograder import grading, release
+    from autograder import grading
 
-    course = tmp_path_factory.mktemp("zoo_course")
-    release.release(course, ["brightness", "pubsub"])
+    course = course_support.released_course(tmp_path_factory, tmp_path_factory.mktemp("zoo_course"),
+                                            ["brightness", "pubsub"])
+    course_support.seed_interface_cache(tmp_path_factory, course, ["pubsub"])
     entries = {k: v for k, v in brightness_zoo.entries(str(course)).items() if v.get("level") != "check"}
     for student, entry in entries.items():
         zoo.submit(course, student, "brightness", entry["edits"])

@@ -9,7 +9,8 @@ import zipfile
 import pytest
 from traitlets.config import Config
 
-from autograder import collect, release, roster
+import course_support
+from autograder import collect, roster
 
 
 @pytest.mark.parametrize("zone, hour", [("UTC", 9), ("Europe/Berlin", 8)])
@@ -32,8 +33,7 @@ def test_other_files_and_names_are_skipped():
 
 @pytest.fixture(scope="module")
 def course(tmp_path_factory):
-    root = tmp_path_factory.mktemp("course")
-    release.release(root, ["pubsub"])
+    root = course_support.released_course(tmp_path_factory, tmp_path_factory.mktemp("course"), ["pubsub"])
     (root / "roster.csv").write_text("id\nalice\ncarol\n")
     roster.import_roster(root, root / "roster.csv")
     return root

@@ -9,7 +9,8 @@ import sys
 
 import pytest
 
-from autograder import config, guard, release
+import course_support
+from autograder import config, guard
 from course_lib.checks import runner
 
 
@@ -19,8 +20,7 @@ def course(tmp_path_factory):
     notebook and her scores in the gradebook)."""
     from autograder import gradebook
 
-    root = tmp_path_factory.mktemp("course")
-    release.release(root, ["pubsub"])
+    root = course_support.released_course(tmp_path_factory, tmp_path_factory.mktemp("course"), ["pubsub"])
     for folder in ("submitted", "autograded"):
         (root / folder / "alice" / "pubsub").mkdir(parents=True)
         shutil.copy(root / "release" / "pubsub" / "pubsub.ipynb", root / folder / "alice" / "pubsub")

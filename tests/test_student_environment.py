@@ -19,7 +19,7 @@ from pathlib import Path
 import nbformat
 import pytest
 
-import autograder.release
+import course_support
 from autograder import reference
 from course_lib.checks import registry, runner
 
@@ -104,8 +104,7 @@ def _text(data: bytes) -> str | None:
 
 @pytest.fixture(scope="module")
 def release(tmp_path_factory) -> Path:
-    course = tmp_path_factory.mktemp("course")
-    autograder.release.release(course, ASSIGNMENTS)
+    course = course_support.released_course(tmp_path_factory, tmp_path_factory.mktemp("course"), ASSIGNMENTS)
     return course / "release"
 
 

@@ -24,6 +24,7 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
+import course_support  # noqa: E402
 import zoo  # noqa: E402
 
 pytestmark = [pytest.mark.slow, pytest.mark.timeout(900)]
@@ -75,6 +76,7 @@ def term(tmp_path_factory):
     (downloads / "roster.csv").write_text(ROSTER)
     _run("roster", str(course), str(downloads / "roster.csv"))
     _run("release", str(course), "--assignment", "pubsub", "--assignment", "brightness", "--duedate", DUE)
+    course_support.seed_interface_cache(tmp_path_factory, course, ["pubsub"])  # built once per test run
     settings = config.write_config(course)
     settings.write_text(settings.read_text() + f"c.LatePenalty.per_day = {{'pubsub': {PER_DAY}}}\n")
     pubsub = _lms_zip(course, downloads, "pubsub", {
