@@ -275,7 +275,7 @@ def _explain_failure(log: str, proc, seconds: float) -> str:
                 "os._exit() or sys.exit() at the top level, or being killed for using too much memory): "
                 "no cell after it could run, so every check scores 0.")
     if proc.exit_reason == "wall_seconds":
-        cell = _timed_out_cell(log)
+        cell = _cells_timed_out(log)
         return (f"The notebook did not finish within the {seconds:g} s its run was given (of "
                 f"{GRADING_SECONDS:g} s for grading one submission): something in it runs forever or waits "
                 f"for input{cell}.")
@@ -283,12 +283,15 @@ def _explain_failure(log: str, proc, seconds: float) -> str:
             "the details.")
 
 
-def _timed_out_cell(log: str) -> str:
-    """Where nbgrader's log says a cell timed out: " (a cell stopped after N s: <its first line>)", or ""."""
+def _cells_timed_out(log: str) -> str:
+    """What nbgrader's log says of cells stopped at their time limit (validate.cell_timeout):
+    ", and N cell(s) ran past their limit of S s", or ""."""
     import re
 
-    match = re.search(r"Cell execution timed out[^\n]*", log) or re.search(r"CellTimeoutError[^\n]*", log)
-    return f" ({match.group(0).strip()[:200]})" if match else ""
+    limits = re.findall(r"Timeout waiting for execute reply \((\d+)s\)", log)
+    if not limits:
+        return ""
+    return f"; {len(limits)} cell(s) ran past their limit of {', '.join(sorted(set(limits)))} s and were interrupted"
 
 
 def _remove_tree(path: Path) -> None:
