@@ -49,9 +49,13 @@ from autograder.submissions import Submission, submission_digest
 from course_lib.checks import runner
 
 
-#: Seconds one submission's grading may take, every step included (issue #14: a hostile
-#: submission must not stall the class). Each step gets at most what is left of it.
+#: Seconds one submission's grading may take on an idle machine, every step included (issue #14:
+#: a hostile submission must not stall the class). Each step gets at most what is left of it.
 GRADING_SECONDS = 60.0
+#: On a machine busier than its cores, the budget grows with the load (grading_budget), at most
+#: this many times: the bound is on the share of the machine a submission gets, and a reference
+#: submission that takes 6 s on an idle machine took 40 s with a load of 20 on 2 cores.
+MAX_LOAD_FACTOR = 6.0
 #: Seconds one notebook may take under grading, everything included (also bounded by what is left
 #: of GRADING_SECONDS less KEPT_FOR_CHECKS).
 NOTEBOOK_TIMEOUT = 420.0
@@ -89,7 +93,8 @@ class Grading:
     work: Path                 # the private work folder, removed at the end
     env: dict = dataclasses.field(default_factory=dict)  # for every sandboxed process
     notebook_run: object = None  # the nbgrader autograde process (course_lib.processes.NodeProcess)
-    deadline: float = 0.0      # time.monotonic() by which the grading must end (GRADING_SECONDS)
+    deadline: float = 0.0      # time.monotonic() by which the grading must end (grading_budget)
+    budget: float = GRADING_SECONDS  # the seconds the grading was given
     notebook_seconds: float = 0.0  # the wall time the notebook run was given
 
     def seconds_left(self, keep: float = 0.0) -> float:
@@ -193,7 +198,7 @@ def read_scores(g: Grading) -> None:
     if result.status == "failed":
         # The student reads the first line; nbgrader's log is for the instructor.
         result.detail = result.reason.strip() + "\n" + "\n".join(proc.log.strip().splitlines()[-15:])
-        result.reason = _explain_failure(proc.log, proc, g.notebook_seconds)
+        result.reason = _explain_failure(proc.log, proc, g.notebook_seconds, g.budget)
 
 
 def build_workspace(g: Grading) -> None:
@@ -254,8 +259,9 @@ def grade_submission(sub: Submission, course: Path, domain_id: int) -> GradeResu
         keep_log(course, sub, problem.fix + "\n")
         result.seconds = round(time.monotonic() - started, 1)
         return result
+    budget = grading_budget()
     grading = Grading(sub, course, domain_id, result, Path(tempfile.mkdtemp(prefix="autograder-work-")),
-                      deadline=started + GRADING_SECONDS)
+                      deadline=started + budget, budget=budget)
     try:
         for step in STEPS:
             step_started = time.monotonic()
@@ -268,7 +274,15 @@ def grade_submission(sub: Submission, course: Path, domain_id: int) -> GradeResu
     return result
 
 
-def _explain_failure(log: str, proc, seconds: float) -> str:
+def grading_budget() -> float:
+    """GRADING_SECONDS, times the machine's load per core over the last minute when that is above 1
+    (at most MAX_LOAD_FACTOR): the steps' limits are wall time, and a loaded machine gives each
+    process a fraction of a core."""
+    load = os.getloadavg()[0] / (os.cpu_count() or 1)
+    return round(GRADING_SECONDS * min(MAX_LOAD_FACTOR, max(1.0, load)), 1)
+
+
+def _explain_failure(log: str, proc, seconds: float, budget: float) -> str:
     """A failed submission's reason, in the student's terms."""
     if "Kernel died" in log or "DeadKernelError" in log:
         return ("The notebook's Python kernel died while running your code (a crash such as a segfault, "
@@ -277,7 +291,7 @@ def _explain_failure(log: str, proc, seconds: float) -> str:
     if proc.exit_reason == "wall_seconds":
         cell = _cells_timed_out(log)
         return (f"The notebook did not finish within the {seconds:g} s its run was given (of "
-                f"{GRADING_SECONDS:g} s for grading one submission): something in it runs forever or waits "
+                f"{budget:g} s for grading one submission): something in it runs forever or waits "
                 f"for input{cell}.")
     return (f"The grader could not run your notebook to its end ({proc.describe_exit()}); your instructor has "
             "the details.")

@@ -72,7 +72,7 @@ def main(argv=None) -> int:
         scores = {f"{r.score:g}/{r.max_score:g}" for _, results in runs.values() for r in results
                   if r.assignment == assignment}
         print(f"{assignment:<14}{cells[0]:>12}{cells[1]:>12}{cells[2]:>14}{cells[3]:>18}{','.join(sorted(scores)):>12}")
-    print(f"\nseconds per step, mean of the cached run with 1 worker (budget {pipeline.GRADING_SECONDS:g} s "
+    print(f"\nseconds per step, mean of the cached run with 1 worker (budget {pipeline.GRADING_SECONDS:g} s idle, "
           f"per submission):")
     print(f"{'assignment':<14}" + "".join(f"{name:>19}" for name in [*SHOWN_STEPS, "other"]))
     for assignment in ASSIGNMENTS:
