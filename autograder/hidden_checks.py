@@ -14,8 +14,15 @@ from course_lib.checks import registry, runner
 from course_lib.checks.result import Result, images_html, verdict_text
 
 
+#: The hidden checks' share of the submission's grading budget, float seconds, in the
+#: environment of ``python -m autograder.hidden_checks_process`` (the checks end within it).
+CHECKS_SECONDS_ENV = "AUTOGRADER_CHECKS_SECONDS"
+#: Seconds between the checks' own budget and the wall limit of their process.
+CHECKS_MARGIN = 3.0
+
+
 def grade_outside(sub: Submission, result: GradeResult, work: Path, autograded: Path, workdir: Path,
-                   domain_id: int, env: dict, hide: list[Path]) -> None:
+                   domain_id: int, env: dict, hide: list[Path], seconds: float | None = None) -> None:
     """Run the hidden checks of the graded cells in processes of the grader, not in the student's
     kernel, against the module the notebook wrote in `workdir`; their points replace the cells'
     scores and their verdicts replace the outputs of the cells of the notebooks in `autograded`
@@ -23,6 +30,8 @@ def grade_outside(sub: Submission, result: GradeResult, work: Path, autograded: 
 
     The check runs as root in a fresh sandbox (network and mount namespaces); the student's
     processes it starts run as the worker's uid, so they cannot touch the check or its results.
+    With `seconds`, the checks together get that much wall time: the process is told
+    (CHECKS_SECONDS_ENV, a little less, so that it can still write its verdicts) and stopped after it.
     """
     from course_lib import processes
 
@@ -39,6 +48,9 @@ def grade_outside(sub: Submission, result: GradeResult, work: Path, autograded: 
                "--workdir", str(workdir), "--out", str(out)]
     wall = sum(checks[name].timeout + 30 for name in names)
     env = {**env, runner.SEED_ENV: None, "AUTOGRADER_SEED": os.environ.get("AUTOGRADER_SEED")}
+    if seconds is not None:
+        wall = min(wall, seconds)
+        env[CHECKS_SECONDS_ENV] = f"{max(1.0, wall - CHECKS_MARGIN):.1f}"
     proc = run_sandboxed(command, hide, f"checks {sub.key}", domain_id, env, out,
                           processes.Limits(wall_seconds=wall, grace_seconds=5.0))
     verdicts = {}
@@ -46,9 +58,10 @@ def grade_outside(sub: Submission, result: GradeResult, work: Path, autograded: 
         try:
             verdicts[name] = Result(**json.loads((out / f"{name}.json").read_text()))
         except (OSError, ValueError, TypeError):
+            stopped = (f"the hidden checks were given {wall:g} s and did not finish: a call or callback of "
+                       f"yours may never return" if proc.exit_reason == "wall_seconds" else proc.describe_exit())
             verdicts[name] = Result(sub.assignment, name, 0.0, checks[name].points, 0,
-                                            error=f"The grader could not run this check ({proc.describe_exit()}):\n"
-                                                  f"{proc.log_tail(8)}")
+                                    error=f"The grader could not run this check ({stopped}):\n{proc.log_tail(8)}")
     for cell in result.cells:
         if check_of(cell["cell"]) in verdicts:
             cell["auto_score"] = min(verdicts[check_of(cell["cell"])].points, cell["max_score"])

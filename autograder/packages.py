@@ -199,7 +199,9 @@ def _colcon(ws: Path, args: list[str], env: dict, run) -> tuple[bool, str]:
     if returncode == 0:
         return True, output
     if returncode is None:
-        return False, f"colcon build did not finish within {BUILD_SECONDS:g} s.\n{output[-2000:]}"
+        given = getattr(run, "seconds_given", BUILD_SECONDS)
+        return False, (f"colcon build did not finish within the {given:g} s it was given (a setup.py that "
+                       f"loops or waits?).\n{output[-2000:]}")
     log = _package_log(ws, output)
     return False, log if log.strip() else f"colcon build ended with exit code {returncode} and printed nothing"
 
@@ -337,14 +339,19 @@ def cache_of(course: Path) -> InterfaceCache:
 
 
 def build_for_checks(assignment: str, course: Path, work: Path, workdir: Path, uid: int | None, domain_id: int,
-                     grader_env: dict, hide: list[Path], run_sandboxed) -> dict:
+                     grader_env: dict, hide: list[Path], run_sandboxed,
+                     seconds: float = BUILD_SECONDS) -> tuple[dict, float]:
     """Build the submission's workspace (``workdir/ros2_ws``) in the sandbox as the student's uid
     (autograder.run_as),
     write the report into the grader's `work` folder, and return the variables that tell the
-    checks where it is ({REPORT_ENV: path}).
+    checks where it is ({REPORT_ENV: path}) and the seconds spent building interface packages the
+    cache did not have.
 
     Args:
         run_sandboxed: autograder.grading's ``_run_sandboxed(command, hide, name, domain_id, env, cwd, limits)``.
+        seconds: wall time for the student's own packages (at most BUILD_SECONDS each colcon run);
+            an interface package missing from the course's cache is the course's cost and gets
+            BUILD_SECONDS of its own, outside this budget.
     """
     from autograder import run_as
     from course_lib import processes
@@ -360,7 +367,16 @@ def build_for_checks(assignment: str, course: Path, work: Path, workdir: Path, u
         give(home)
     sandbox = {name: grader_env[name] for name in _SANDBOX_VARIABLES if grader_env.get(name)}
 
+    deadline = time.monotonic() + seconds
+    interface_seconds = 0.0
+
     def run(command, cwd, env, wall_seconds):
+        nonlocal interface_seconds
+        started = time.monotonic()
+        interface = Path(cwd).is_relative_to(scratch / "interfaces")
+        if not interface:
+            wall_seconds = max(1.0, min(wall_seconds, deadline + interface_seconds - started))
+        run.seconds_given = round(wall_seconds, 1)
         if uid is not None:
             command = run_as.command(uid, command, max_processes=BUILD_PROCESSES)
             # The sandbox hides the repository's autograder/: the wrapper runs from the grader's
@@ -373,6 +389,8 @@ def build_for_checks(assignment: str, course: Path, work: Path, workdir: Path, u
         # it), and another worker builds its own ros2_ws at the same time.
         proc = run_sandboxed(command, hide, f"colcon build {cwd}", domain_id,
                              {**env, **sandbox, "HOME": str(home), "PYTHONDONTWRITEBYTECODE": "1"}, cwd, limits)
+        if interface:
+            interface_seconds += time.monotonic() - started
         return (None if proc.exit_reason == "wall_seconds" else proc.returncode), proc.log
 
     cache = cache_of(course)
@@ -382,7 +400,7 @@ def build_for_checks(assignment: str, course: Path, work: Path, workdir: Path, u
     except RuntimeError as error:  # the course's fault: the checks that need messages say so
         report.log += f"\n{error}"
     path = report.write(work / "build-report.json")
-    return {REPORT_ENV: str(path)}
+    return {REPORT_ENV: str(path)}, interface_seconds
 
 
 def needed(assignment: str, workdir: Path) -> bool:

@@ -49,8 +49,18 @@ from autograder.submissions import Submission, submission_digest
 from course_lib.checks import runner
 
 
-#: Seconds one notebook may take under grading, everything included.
+#: Seconds one submission's grading may take on an idle machine, every step included (issue #14:
+#: a hostile submission must not stall the class). Each step gets at most what is left of it.
+GRADING_SECONDS = 60.0
+#: On a machine busier than its cores, the budget grows with the load (grading_budget), at most
+#: this many times: the bound is on the share of the machine a submission gets, and a reference
+#: submission that takes 6 s on an idle machine took 40 s with a load of 20 on 2 cores.
+MAX_LOAD_FACTOR = 6.0
+#: Seconds one notebook may take under grading, everything included (also bounded by what is left
+#: of GRADING_SECONDS less KEPT_FOR_CHECKS).
 NOTEBOOK_TIMEOUT = 420.0
+#: Seconds of the budget the notebook run and the build leave for the hidden checks.
+KEPT_FOR_CHECKS = 20.0
 #: Address space of each process of a submission (MB). Fast DDS + numpy + OpenCV need ~1 GB.
 MEMORY_MB = 4096
 #: Largest file a submission may write (MB).
@@ -83,6 +93,13 @@ class Grading:
     work: Path                 # the private work folder, removed at the end
     env: dict = dataclasses.field(default_factory=dict)  # for every sandboxed process
     notebook_run: object = None  # the nbgrader autograde process (course_lib.processes.NodeProcess)
+    deadline: float = 0.0      # time.monotonic() by which the grading must end (grading_budget)
+    budget: float = GRADING_SECONDS  # the seconds the grading was given
+    notebook_seconds: float = 0.0  # the wall time the notebook run was given
+
+    def seconds_left(self, keep: float = 0.0) -> float:
+        """Seconds of the submission's budget left, less `keep` for later steps (at least 1)."""
+        return max(1.0, self.deadline - time.monotonic() - keep)
 
     @property
     def root(self) -> Path:
@@ -159,8 +176,9 @@ def run_notebook(g: Grading) -> None:
 
     command = [sys.executable, "-m", "nbgrader", "autograde", g.sub.assignment, "--student", g.sub.student,
                "--force", f"--CourseDirectory.root={g.root}"]
-    limits = processes.Limits(wall_seconds=NOTEBOOK_TIMEOUT, memory_mb=MEMORY_MB, file_size_mb=FILE_MB,
-                              grace_seconds=5.0)
+    g.notebook_seconds = round(min(NOTEBOOK_TIMEOUT, g.seconds_left(keep=KEPT_FOR_CHECKS)), 1)
+    limits = processes.Limits(wall_seconds=g.notebook_seconds, memory_mb=MEMORY_MB, file_size_mb=FILE_MB,
+                              grace_seconds=2.0)
     g.notebook_run = run_sandboxed(command, g.hide, f"autograde {g.sub.key}", g.domain_id, g.env, g.root, limits)
 
 
@@ -180,7 +198,7 @@ def read_scores(g: Grading) -> None:
     if result.status == "failed":
         # The student reads the first line; nbgrader's log is for the instructor.
         result.detail = result.reason.strip() + "\n" + "\n".join(proc.log.strip().splitlines()[-15:])
-        result.reason = _explain_failure(proc.log, proc)
+        result.reason = _explain_failure(proc.log, proc, g.notebook_seconds, g.budget)
 
 
 def build_workspace(g: Grading) -> None:
@@ -188,8 +206,11 @@ def build_workspace(g: Grading) -> None:
     course's cache (autograder.packages); the checks read its report."""
     if g.failed or not packages.needed(g.sub.assignment, g.workdir):
         return
-    built = packages.build_for_checks(g.sub.assignment, g.course, g.work, g.workdir, g.result.kernel_uid,
-                                      g.domain_id, g.env, g.hide, run_sandboxed)
+    built, interface_seconds = packages.build_for_checks(
+        g.sub.assignment, g.course, g.work, g.workdir, g.result.kernel_uid, g.domain_id, g.env, g.hide,
+        run_sandboxed, seconds=g.seconds_left(keep=KEPT_FOR_CHECKS / 2))
+    # Building an interface package the cache did not have is the course's cost, not the student's.
+    g.deadline += interface_seconds
     g.env.update(built)
     g.result.detail += packages.instructor_note(built)
 
@@ -198,7 +219,8 @@ def run_hidden_checks(g: Grading) -> None:
     """The hidden checks, outside the kernel (autograder.hidden_checks)."""
     if g.failed:
         return
-    grade_outside(g.sub, g.result, g.work, g.autograded, g.workdir, g.domain_id, g.env, g.hide)
+    grade_outside(g.sub, g.result, g.work, g.autograded, g.workdir, g.domain_id, g.env, g.hide,
+                  seconds=g.seconds_left())
 
 
 def remove_grader_paths(g: Grading) -> None:
@@ -237,10 +259,14 @@ def grade_submission(sub: Submission, course: Path, domain_id: int) -> GradeResu
         keep_log(course, sub, problem.fix + "\n")
         result.seconds = round(time.monotonic() - started, 1)
         return result
-    grading = Grading(sub, course, domain_id, result, Path(tempfile.mkdtemp(prefix="autograder-work-")))
+    budget = grading_budget()
+    grading = Grading(sub, course, domain_id, result, Path(tempfile.mkdtemp(prefix="autograder-work-")),
+                      deadline=started + budget, budget=budget)
     try:
         for step in STEPS:
+            step_started = time.monotonic()
             step(grading)
+            result.steps[step.__name__] = round(time.monotonic() - step_started, 2)
     finally:
         _remove_tree(grading.work)
     result.score = round(sum(c["auto_score"] or 0 for c in result.cells), 3) if result.status != "failed" else 0.0
@@ -248,17 +274,38 @@ def grade_submission(sub: Submission, course: Path, domain_id: int) -> GradeResu
     return result
 
 
-def _explain_failure(log: str, proc) -> str:
+def grading_budget() -> float:
+    """GRADING_SECONDS, times the machine's load per core over the last minute when that is above 1
+    (at most MAX_LOAD_FACTOR): the steps' limits are wall time, and a loaded machine gives each
+    process a fraction of a core."""
+    load = os.getloadavg()[0] / (os.cpu_count() or 1)
+    return round(GRADING_SECONDS * min(MAX_LOAD_FACTOR, max(1.0, load)), 1)
+
+
+def _explain_failure(log: str, proc, seconds: float, budget: float) -> str:
     """A failed submission's reason, in the student's terms."""
     if "Kernel died" in log or "DeadKernelError" in log:
         return ("The notebook's Python kernel died while running your code (a crash such as a segfault, "
                 "os._exit() or sys.exit() at the top level, or being killed for using too much memory): "
                 "no cell after it could run, so every check scores 0.")
     if proc.exit_reason == "wall_seconds":
-        return (f"The notebook did not finish within {NOTEBOOK_TIMEOUT:g} s: something in it runs forever "
-                "or waits for input.")
+        cell = _cells_timed_out(log)
+        return (f"The notebook did not finish within the {seconds:g} s its run was given (of "
+                f"{budget:g} s for grading one submission): something in it runs forever or waits "
+                f"for input{cell}.")
     return (f"The grader could not run your notebook to its end ({proc.describe_exit()}); your instructor has "
             "the details.")
+
+
+def _cells_timed_out(log: str) -> str:
+    """What nbgrader's log says of cells stopped at their time limit (validate.cell_timeout):
+    ", and N cell(s) ran past their limit of S s", or ""."""
+    import re
+
+    limits = re.findall(r"Timeout waiting for execute reply \((\d+)s\)", log)
+    if not limits:
+        return ""
+    return f"; {len(limits)} cell(s) ran past their limit of {', '.join(sorted(set(limits)))} s and were interrupted"
 
 
 def _remove_tree(path: Path) -> None:

@@ -3,7 +3,8 @@
 One row per submission graded so far (every recorded result, not only the last run's, so a run
 of one student or one assignment drops no row): raw score, status, whether this run took it from
 an earlier one, seconds, the sandbox's isolation, the reason the student reads and the
-instructor's note (the fix, or the end of nbgrader's log). Final scores with the late penalty,
+instructor's note (the fix, or the end of nbgrader's log), and the seconds of each step of the
+pipeline (``run_notebook=5.4 build_workspace=3.6 ...``: where the time went). Final scores with the late penalty,
 for the LMS, are in grades.csv (autograder.export). The file is written to a temporary file and
 then moved into place.
 """
@@ -17,12 +18,17 @@ from pathlib import Path
 FILE_NAME = "grading_report.csv"
 
 FIELDS = ["student_id", "assignment", "score", "max_score", "status", "from_cache", "seconds", "isolation",
-          "reason", "instructor_note"]
+          "reason", "instructor_note", "step_seconds"]
 
 
 def _first_line(text: str) -> str:
     text = text.strip()
     return text.splitlines()[0] if text else ""
+
+
+def step_seconds(result) -> str:
+    """The seconds of each pipeline step that took a tenth of a second or more: "run_notebook=5.4 ..."."""
+    return " ".join(f"{name}={seconds:.1f}" for name, seconds in result.steps.items() if seconds >= 0.1)
 
 
 def write_report(course_dir, results=()) -> Path:
@@ -42,6 +48,6 @@ def write_report(course_dir, results=()) -> Path:
             r = rows[key]
             writer.writerow([r.student, r.assignment, f"{r.score:g}", f"{r.max_score:g}", r.status,
                              int(r.from_cache or key not in this_run), f"{r.seconds:g}", r.isolation,
-                             _first_line(r.reason), _first_line(r.detail)])
+                             _first_line(r.reason), _first_line(r.detail), step_seconds(r)])
     os.replace(temporary, path)
     return path

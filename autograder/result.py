@@ -20,6 +20,7 @@ class GradeResult:
     isolation: str = ""
     from_cache: bool = False     # True: an earlier run's result (the submission did not change)
     kernel_uid: int | None = None  # the uid the student's code ran as (root isolation only)
+    steps: dict = dataclasses.field(default_factory=dict)  # seconds of each pipeline step, by name
 
     @classmethod
     def from_dict(cls, data: dict) -> "GradeResult":

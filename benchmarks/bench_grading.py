@@ -10,10 +10,11 @@ the cache kept (every message package reused), and with --workers workers.
 
     .venv/bin/python benchmarks/bench_grading.py [--students 2] [--workers 2]
 
-Per assignment it prints the seconds per submission (nbgrader's notebook run, the colcon build of
-the workspace and the grader's own run of the hidden checks, as the grading report gives them):
-the first submission of the cold run, and the mean of each run; then the wall time of each run
-and the ratio of the two cached runs, which is the speed-up of the extra workers on this machine.
+Per assignment it prints the seconds per submission: the first submission of the cold run, and
+the mean of each run; then the mean seconds of each pipeline step in the cached one-worker run
+(GradeResult.steps: nbgrader's notebook run, the colcon build of the workspace, the grader's own
+run of the hidden checks, and the rest), then the wall time of each run and the ratio of the two
+cached runs, which is the speed-up of the extra workers on this machine.
 """
 
 from __future__ import annotations
@@ -32,9 +33,11 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path[:0] = [str(ROOT), str(ROOT / "tests")]  # the grader runs from the repository
 
 import zoo  # noqa: E402 (tests/zoo builds submissions from the reference solutions)
-from autograder import grading, packages, release, sandbox  # noqa: E402
+from autograder import grading, packages, pipeline, release, sandbox  # noqa: E402
 
 ASSIGNMENTS = ["brightness", "pubsub", "catdog_warp"]
+#: The steps shown on their own (autograder.pipeline.STEPS); the others are summed as "other".
+SHOWN_STEPS = ["run_notebook", "build_workspace", "run_hidden_checks"]
 
 
 def timed_grade(course: Path, workers: int) -> tuple[float, list]:
@@ -69,6 +72,14 @@ def main(argv=None) -> int:
         scores = {f"{r.score:g}/{r.max_score:g}" for _, results in runs.values() for r in results
                   if r.assignment == assignment}
         print(f"{assignment:<14}{cells[0]:>12}{cells[1]:>12}{cells[2]:>14}{cells[3]:>18}{','.join(sorted(scores)):>12}")
+    print(f"\nseconds per step, mean of the cached run with 1 worker (budget {pipeline.GRADING_SECONDS:g} s idle, "
+          f"per submission):")
+    print(f"{'assignment':<14}" + "".join(f"{name:>19}" for name in [*SHOWN_STEPS, "other"]))
+    for assignment in ASSIGNMENTS:
+        results = [r for r in runs["cached"][1] if r.assignment == assignment]
+        means = [statistics.mean(r.steps.get(name, 0.0) for r in results) for name in SHOWN_STEPS]
+        other = statistics.mean(sum(v for k, v in r.steps.items() if k not in SHOWN_STEPS) for r in results)
+        print(f"{assignment:<14}" + "".join(f"{value:>19.1f}" for value in [*means, other]))
     one, many = runs["cached"][0], runs["workers"][0]
     print(f"\nwall time: {runs['cold'][0]:.0f} s cold, {one:.0f} s cached (1 worker)")
     count = len(runs["cached"][1])

@@ -1,0 +1,43 @@
+"""autograder.pipeline's budget: one submission's grading is bounded, and a notebook stopped at its
+share says how long it was given (issue #14)."""
+
+from __future__ import annotations
+
+import sys
+import time
+
+from autograder import pipeline, report
+from autograder.result import GradeResult
+from course_lib import processes
+
+
+def test_each_step_gets_what_is_left_of_the_budget_less_what_it_keeps_for_later():
+    g = pipeline.Grading(None, None, 0, GradeResult("s", "a", ""), None, deadline=time.monotonic() + 30)
+    assert 28 < g.seconds_left() <= 30
+    assert 8 < g.seconds_left(keep=20) <= 10
+    g.deadline = time.monotonic() - 5  # spent: a later step still gets a second to say so
+    assert g.seconds_left() == 1.0
+
+
+def test_a_notebook_stopped_at_its_share_names_the_seconds_given_and_the_cells_that_ran_past_their_limit():
+    proc = processes.NodeProcess([sys.executable, "-c", "import time; time.sleep(30)"], name="budget test",
+                                 limits=processes.Limits(wall_seconds=0.5, grace_seconds=0.5))
+    proc.start()
+    proc.wait(10)
+    proc.stop(timeout=2)
+    log = "[AutogradeApp | ERROR] Timeout waiting for execute reply (30s).\n" * 2
+    reason = pipeline._explain_failure(log, proc, 37.5, 60.0)
+    assert proc.exit_reason == "wall_seconds"
+    assert "did not finish within the 37.5 s its run was given" in reason
+    assert "of 60 s for grading one submission" in reason
+    assert "2 cell(s) ran past their limit of 30 s" in reason
+
+
+def test_the_report_shows_where_the_time_went():
+    result = GradeResult("s", "a", "", steps={"stage_course_root": 0.01, "run_notebook": 5.43, "run_hidden_checks": 6.3})
+    assert report.step_seconds(result) == "run_notebook=5.4 run_hidden_checks=6.3"
+
+
+def test_the_budget_is_sixty_seconds_on_an_idle_machine_and_grows_with_the_load_up_to_a_bound():
+    budget = pipeline.grading_budget()
+    assert pipeline.GRADING_SECONDS <= budget <= pipeline.GRADING_SECONDS * pipeline.MAX_LOAD_FACTOR
