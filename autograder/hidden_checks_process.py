@@ -46,11 +46,20 @@ def budget_from_environment() -> float | None:
 
 def own_domains() -> int | None:
     """The ROS domain the grader reserved for the submission when its checks run in a network
-    namespace of their own (then every domain is theirs), else None."""
+    namespace of their own (autograder.sandbox: then every domain is theirs), else None."""
     from course_lib import rosenv
 
     domain = os.environ.get("ROS_DOMAIN_ID")
-    return int(domain) if rosenv.under_grading() and domain else None
+    return int(domain) if rosenv.under_grading() and domain and _only_loopback() else None
+
+
+def _only_loopback() -> bool:
+    """True in a network namespace of our own: this process sees no network device but lo."""
+    try:
+        lines = Path("/proc/net/dev").read_text().splitlines()[2:]
+    except OSError:
+        return False
+    return [line.split(":", 1)[0].strip() for line in lines] == ["lo"]
 
 
 def run_outside(assignment: str, names: list[str], workdir, out: Path, budget: float | None = None) -> None:
