@@ -90,6 +90,7 @@ def _endpoints(request: dict) -> dict:
 
 def answer(request: dict, inputs: Path, arrays: dict) -> dict:
     """The answer to one request (see the module docstring); the student's exceptions become its error."""
+    server = os.getpid()
     try:
         if request["kind"] == "import":
             importlib.import_module(request["module"])
@@ -100,6 +101,9 @@ def answer(request: dict, inputs: Path, arrays: dict) -> dict:
     except BaseException as error:  # SystemExit and KeyboardInterrupt are the student's too
         lines = traceback.format_exception(type(error), error, error.__traceback__)
         return {"error": f"{type(error).__name__}: {error}".strip(), "traceback": "".join(lines[-3:])}
+    finally:
+        if os.getpid() != server:  # a process the student's code forked: only the server answers
+            os._exit(0)
 
 
 def serve(job: Path) -> int:
