@@ -45,7 +45,7 @@ def _tree_digest(paths: list[Path], digest) -> None:
 
 #: The modules of course_lib.checks that run every assignment's checks (a change regrades).
 CHECK_MODULES = ["registry", "result", "runner", "check_process", "context", "student_calls", "student_processes",
-                 "probe", "student", "answers", "packages"]
+                 "student_server", "probe", "student", "answers", "packages"]
 
 
 def submission_digest(sub: Submission, course: Path) -> str:

@@ -60,7 +60,7 @@ def _test_images(rng: np.random.Generator) -> list[tuple[str, np.ndarray]]:
 def values(ctx: Context) -> None:
     """average_brightness returns the floor of the mean byte, as an int, for colour and grey images."""
     cases = _test_images(ctx.rng)
-    outcomes = ctx.call("average_brightness", [((image,), {}) for _, image in cases])
+    outcomes = ctx.call("average_brightness", [((image,), {}) for _, image in cases], labels=[label for label, _ in cases])
     for (label, image), outcome in zip(cases, outcomes):
         expected = ctx.expected("average_brightness", image)
         mean = float(image.mean())
@@ -342,9 +342,9 @@ def _start_yardstick(ctx):
     """Start the throughput yardstick on the check's /image, answering on YARDSTICK_ANSWERS."""
     from course_lib import processes
 
-    return processes.python_node("course_lib.checks.brightness:yardstick_main", "--ros-args",
+    return ctx.track(processes.python_node("course_lib.checks.brightness:yardstick_main", "--ros-args",
                                  "-r", "frames:=/image", "-r", f"answers:={YARDSTICK_ANSWERS}",
-                                 name="brightness-yardstick", domain_id=ctx.domain_id, env=student_env())
+                                 name="brightness-yardstick", domain_id=ctx.domain_id, env=student_env()))
 
 
 def yardstick_main(args=None) -> None:

@@ -119,7 +119,8 @@ def _check_scene(ctx, label: str, scene, outcome, show: bool = False) -> None:
 
 
 def _run_scenes(ctx, cases, show_first: bool = True) -> None:
-    outcomes = ctx.call("crop_pictures", [((scene.frame,), {"size": list(SIZE)}) for _, scene in cases])
+    outcomes = ctx.call("crop_pictures", [((scene.frame,), {"size": list(SIZE)}) for _, scene in cases],
+                        labels=[f"'{label}'" for label, _ in cases])
     for index, ((label, scene), outcome) in enumerate(zip(cases, outcomes)):
         _check_scene(ctx, label, scene, outcome, show=show_first and index == 0)
 
@@ -162,7 +163,7 @@ def missing_and_none(ctx: Context) -> None:
                                                                  missing_markers=list(range(1, 9)))))
     noise = ctx.rng.integers(0, 256, size=(480, 640, 3), dtype=np.uint8)
     outcomes = ctx.call("crop_pictures", [((scene.frame,), {"size": list(SIZE)}) for _, scene in cases]
-                        + [((noise,), {"size": list(SIZE)})])
+                        + [((noise,), {"size": list(SIZE)})], labels=[f"'{label}'" for label, _ in cases] + ["noise"])
     for (label, scene), outcome in zip(cases, outcomes):
         _check_scene(ctx, label, scene, outcome)
     outcome = outcomes[-1]
@@ -181,7 +182,8 @@ def noisy(ctx: Context) -> None:
     scene = scenes.render_scene(_seed(ctx), difficulty="easy", pose=base.pose, look=look)
     small = (200, 150)
     outcomes = ctx.call("crop_pictures", [((scene.frame,), {"size": list(SIZE)}),
-                                          ((scene.frame,), {"size": list(small)})])
+                                          ((scene.frame,), {"size": list(small)})],
+                        labels=["a noisy, blurred scene", f"a noisy, blurred scene at size={small}"])
     _check_scene(ctx, "noisy, blurred scene", scene, outcomes[0])
     if outcomes[1].ok and isinstance(outcomes[1].value, dict) and "cat" in outcomes[1].value:
         crop = outcomes[1].value["cat"]

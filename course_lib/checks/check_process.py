@@ -11,6 +11,7 @@ import sys
 import traceback
 from pathlib import Path
 
+from course_lib import processes
 from course_lib.checks.context import Context, StudentError
 from course_lib.checks.registry import get_check
 from course_lib.checks.result import Result
@@ -19,11 +20,14 @@ from course_lib.checks.student_processes import StudentProcesses
 
 
 def run_in_this_process(assignment: str, name: str, seed: int, workdir: Path, out: Path,
-                        students: StudentProcesses | None = None) -> Result:
+                        students: StudentProcesses | None = None, on_start=None, **context) -> Result:
     """Run a check here (the check process) and return its Result; `students` starts the student's
-    processes (default: as this process's user, course_lib.checks.student_processes)."""
+    processes (default: as this process's user, course_lib.checks.student_processes); `context`:
+    more of Context's arguments (servers, deadline, domain_id); on_start(ctx) is called first."""
     spec = get_check(assignment, name)
-    ctx = Context(spec, seed, workdir, out, students)
+    ctx = Context(spec, seed, workdir, out, students, **context)
+    if on_start is not None:
+        on_start(ctx)
     error = None
     try:
         spec.function(ctx)
@@ -54,7 +58,10 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     out = Path(args.out)
     seed = args.seed if args.seed is not None else int(os.environ.get(SEED_ENV, SELFCHECK_SEED))
-    result = run_in_this_process(args.assignment, args.check, seed, Path(args.workdir).resolve(), out)
+    try:
+        result = run_in_this_process(args.assignment, args.check, seed, Path(args.workdir).resolve(), out)
+    finally:
+        processes.stop_all(timeout=1.0)
     write_json(out / "result.json", dataclasses.asdict(result))
     return 0
 

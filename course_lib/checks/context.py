@@ -3,23 +3,25 @@ run the student's code in processes of its own, and the record of what passed.""
 
 from __future__ import annotations
 
-import json
 import os
-import shutil
-import sys
-import tempfile
 import time
 from pathlib import Path
 
-from course_lib import waiting
 from course_lib.checks import answers
 from course_lib.checks.probe import RosProbe
 from course_lib.checks.registry import Check
-from course_lib.checks.student_calls import Outcome, last_lines, read_outcomes, write_calls
+from course_lib.checks.student_calls import Outcome, call_request
 from course_lib.checks.student_processes import StudentProcesses
+from course_lib.checks.student_server import ServerError, StudentServers
 
-#: Seconds a student's module gets to import (rclpy alone needs one or two on a busy machine).
-IMPORT_TIMEOUT = 25.0
+#: Seconds a student's module gets to import (rclpy, numpy and cv2 need one to three on a busy
+#: machine); kept well below a grading's time for all checks (autograder.hidden_checks_process).
+IMPORT_TIMEOUT = 15.0
+
+#: Seconds one call of a student's function gets, unless the check says otherwise (never more
+#: than the check has left, nor than the grading's time). The contract's functions answer in
+#: milliseconds; a call that prints a gigabyte needs several seconds on a busy machine.
+CALL_TIMEOUT = 20.0
 
 #: Written into the work directory when the student's module did not import in time, so that
 #: later checks fail at once with the same reason instead of waiting again.
@@ -39,10 +41,16 @@ class Context:
         seed: this run's seed; rng: a numpy Generator seeded with it.
         workdir: the directory of the student's notebook and module files.
         domain_id: a ROS domain reserved for this check (student nodes and probes use it).
-        students: how the student's processes start (StudentProcesses; the grader passes its own).
+        students: how the student's processes start (StudentProcesses; the grader passes its own);
+            close() stops those this check started.
+        servers: the student processes that serve calls (StudentServers; shared by the checks of
+            a grading, else the check's own).
+        deadline: time.monotonic() by which all checks of the grading must end, or None.
+        doing: what the check is waiting on, in words (for the reason when the time runs out).
     """
 
-    def __init__(self, spec: Check, seed: int, workdir: Path, out: Path, students: StudentProcesses | None = None):
+    def __init__(self, spec: Check, seed: int, workdir: Path, out: Path, students: StudentProcesses | None = None,
+                 servers: StudentServers | None = None, deadline: float | None = None, domain_id: int | None = None):
         import numpy as np
 
         self.spec = spec
@@ -50,11 +58,17 @@ class Context:
         self.rng = np.random.default_rng(seed)
         self.workdir = workdir
         self.out = out
-        self.students = students or StudentProcesses()
+        self._started_processes: list = []
+        self._students = students or StudentProcesses()
+        self.students = _Started(self._students, self)
+        self.servers = servers or StudentServers(spec.timeout)
+        self._own_servers = servers is None
+        self.deadline = deadline
+        self.doing = "the check was starting"
         self.items: list[dict] = []
         self.notes: list[str] = []
         self.images: list[dict] = []
-        self._reservation = None
+        self._reservation = None if domain_id is None else _Fixed(domain_id)
         self._started = time.monotonic()
         self._answers = answers.AnswerKey(spec.assignment)
 
@@ -101,8 +115,15 @@ class Context:
         self.images.append({"label": label, "file": name})
 
     def remaining(self) -> float:
-        """Seconds left of this check's timeout (never below 1)."""
-        return max(1.0, self.spec.timeout - (time.monotonic() - self._started))
+        """Seconds left of this check's timeout and of the grading's time (never below 1)."""
+        left = self.spec.timeout - (time.monotonic() - self._started)
+        if self.deadline is not None:
+            left = min(left, self.deadline - time.monotonic())
+        return max(1.0, left)
+
+    def waiting_on(self, what: str) -> None:
+        """Say what the check waits on now (named when the grading's time runs out)."""
+        self.doing = f"{what} ({time.monotonic() - self._started:.1f} s into the check)"
 
     # -- the student's code --------------------------------------------------------------------
 
@@ -132,90 +153,107 @@ class Context:
                                "earlier check: remove code that runs forever at import (loops, spin()) "
                                "from the top level of the module; put it in main()")
 
-    def call(self, function: str, calls: list[tuple], timeout: float | None = None) -> list[Outcome]:
-        """Call the student's `function` once per entry of `calls` in one student process.
+    def call(self, function: str, calls: list[tuple], timeout: float | None = None,
+             labels: list[str] | None = None) -> list[Outcome]:
+        """Call the student's `function` once per entry of `calls`, one after the other, in the
+        student process that serves this module's calls (course_lib.checks.student_server).
 
         Args:
             function: the name of a function of the student's module.
             calls: (args, kwargs) per call; args may hold numpy arrays, kwargs plain JSON values.
-            timeout: seconds for the import and all calls together; default (and at most): what is
-                left of the check's time, so the check always has time to report.
+            timeout: seconds each call gets; default CALL_TIMEOUT, never more than the check has left.
+            labels: what each call's input is, for the feedback ("easy scene 2"); default "input i".
 
         Returns:
-            One Outcome per call. Calls that did not run because the process died or ran out of
-            time get an Outcome whose error says so.
+            One Outcome per call. A call that did not return in time, or whose process died, gets
+            an Outcome whose error says which call it was; a function that once did not return in
+            time is not called again in this grading (its later calls say so at once).
+
+        Raises:
+            StudentError: the module does not exist or did not import.
         """
-        job = Path(tempfile.mkdtemp(prefix="autograder-call-"))
+        labels = labels or [f"input {index + 1}" for index in range(len(calls))]
+        server = self.servers.server(self._students, self.module_root, None)
+        outcomes = []
+        for (args, kwargs), label in zip(calls, labels):
+            if function in self.servers.hung:
+                outcomes.append(Outcome(error=f"not run: {self.servers.hung[function]}"))
+                continue
+            with server.lock:
+                self._import(server, self.module)
+                # Leaves the check a moment to report when the grading's time is nearly up.
+                limit = min(timeout or CALL_TIMEOUT, max(0.5, self.remaining() - 0.5))
+                self.waiting_on(f"{function} on {label} was running")
+                request, arrays = call_request(self.module, function, args, kwargs)
+                try:
+                    answer = server.request(request, arrays, limit, self.domain_id)
+                except ServerError as error:
+                    if error.timed_out:
+                        self.servers.hung[function] = f"{function} did not return within {limit:.0f} s on {label} earlier"
+                    outcomes.append(Outcome(error=f"the call {function} on {label} {error}"))
+                    continue
+            outcomes.append(Outcome(value=answer.get("value"), pytype=answer.get("pytype", "NoneType"),
+                                    error=answer.get("error")))
+        return outcomes
+
+    def _import(self, server, module: str) -> None:
+        """Import `module` in `server`'s process (once per process); raise StudentError when it
+        does not (at most IMPORT_TIMEOUT seconds; a hang is marked for later checks)."""
+        self.require_module()
+        if server.proc is not None and server.proc.running() and module in server.imported:
+            if server.imported[module]:
+                raise StudentError(server.imported[module])
+            return
+        wait = min(IMPORT_TIMEOUT, self.remaining())
+        self.waiting_on(f"importing {module} was running")
         try:
-            write_calls(job, calls)
-            timeout = min(timeout or self.remaining(), self.remaining())
-            proc, call_seconds = self._run_student("call", function, job, timeout)
-            return read_outcomes(job, len(calls), proc, call_seconds)
-        finally:
-            shutil.rmtree(job, ignore_errors=True)
+            answer = server.request({"kind": "import", "module": module}, None, wait, self.domain_id)
+        except ServerError as error:
+            if not error.timed_out:
+                raise StudentError(f"{module} could not be imported: importing it {error}") from None
+            if wait < IMPORT_TIMEOUT:
+                raise StudentError(f"importing {module} did not finish within the {wait:.0f} s this check had left "
+                                   "(the machine may be busy; the import itself took long)") from None
+            _mark(self.workdir / IMPORT_HANG_MARK)
+            raise StudentError(f"importing {module} did not finish within {IMPORT_TIMEOUT:g} s: "
+                               "remove code that runs forever at import (loops, spin()) from the "
+                               "top level of the module; put it in main()") from None
+        why = None
+        if answer.get("error"):
+            why = f"{module} could not be imported ({answer['error']}):\n{answer.get('traceback', '').strip()}"
+        server.imported[module] = why
+        if why:
+            raise StudentError(why)
 
     def endpoints(self, class_name: str, timeout: float = 20.0, module: str | None = None,
                   env: dict | None = None) -> dict:
         """Construct the student's node class (not spun) in a student process and return the QoS of
         its publishers and subscriptions: {"publishers"|"subscriptions": [{"topic", "type",
-        "depth", "history", "reliability", "durability"}]}. Raises StudentError when it fails."""
-        job = Path(tempfile.mkdtemp(prefix="autograder-endpoints-"))
-        try:
-            timeout = min(timeout, self.remaining())
-            proc, _seconds = self._run_student("endpoints", class_name, job, timeout, module=module, env=env)
-            try:
-                return json.loads((job / "endpoints.json").read_text())
-            except (OSError, ValueError):
-                raise StudentError(f"{class_name}() could not be constructed ({proc.describe_exit()}):\n"
-                                   f"{last_lines(proc.log, 6)}") from None
-        finally:
-            shutil.rmtree(job, ignore_errors=True)
+        "depth", "history", "reliability", "durability"}]}. Raises StudentError when it fails.
 
-    def _run_student(self, command: str, target: str, job: Path, timeout: float, module: str | None = None,
-                     env: dict | None = None):
-        """Run ``python -m course_lib.checks.student COMMAND MODULE TARGET JOB`` to its end, or until
-        `timeout` seconds (import included, never past the check's own time) have passed.
-
-        Returns:
-            (the stopped process, the seconds its calls had after the import).
-
-        Raises:
-            StudentError: the module did not import.
-        """
-        if module is None:  # a module of a built package (env: its workspace) needs no source check
+        `module` and `env`: a module of a built package and its workspace's environment (the
+        checks' course_lib.checks.packages.endpoints); default the student's module of functions."""
+        if module is None:
             self.require_module()
         module = module or self.module
-        self.students.give(job)
-        timeout = min(timeout, self.remaining())
-        deadline = time.monotonic() + timeout
-        proc = self.students.start([sys.executable, "-m", "course_lib.checks.student", command, module, target,
-                                    str(job)], name=f"student-{target}",
-                                   cwd=self.module_root if env is None else self.workdir, domain_id=self.domain_id,
-                                   wall_seconds=timeout + 2, env=env)
-        import_wait = min(IMPORT_TIMEOUT, timeout)
-        call_seconds = 0.0
-        try:
-            imported = _wait_for_file(job / "imported", import_wait, proc)
-            if not imported and proc.running():
-                if import_wait < IMPORT_TIMEOUT:
-                    raise StudentError(f"importing {module} did not finish within the {import_wait:.0f} s "
-                                       "this check had left (the machine may be busy; the import itself took long)")
-                _mark(self.workdir / IMPORT_HANG_MARK)
-                raise StudentError(f"importing {module} did not finish within {IMPORT_TIMEOUT:g} s: "
-                                   "remove code that runs forever at import (loops, spin()) from the "
-                                   "top level of the module; put it in main()")
-            if imported:
-                call_seconds = max(0.0, deadline - time.monotonic())
-                try:
-                    proc.wait(call_seconds)
-                except TimeoutError:
-                    pass
-        finally:
-            proc.stop(timeout=1)
-        if not (job / "imported").exists():
-            raise StudentError(f"{module} could not be imported ({proc.describe_exit()}):\n"
-                               f"{last_lines(proc.log, 6)}")
-        return proc, call_seconds
+        what = f"{class_name}()"
+        if what in self.servers.hung:
+            raise StudentError(f"{what} was not constructed: {self.servers.hung[what]}")
+        server = self.servers.server(self._students, self.module_root if env is None else self.workdir, env)
+        limit = min(timeout, self.remaining())
+        self.waiting_on(f"constructing {what} was running")
+        with server.lock:
+            try:
+                answer = server.request({"kind": "endpoints", "module": module, "class": class_name}, None, limit,
+                                        self.domain_id)
+            except ServerError as error:
+                if error.timed_out:
+                    self.servers.hung[what] = f"{what} did not return within {limit:.0f} s earlier"
+                raise StudentError(f"{what} could not be constructed: it {error}") from None
+        if "endpoints" not in answer:
+            raise StudentError(f"{what} could not be constructed ({answer.get('error')}):\n"
+                               f"{answer.get('traceback', '').strip()}")
+        return answer["endpoints"]
 
     @property
     def domain_id(self) -> int:
@@ -236,12 +274,34 @@ class Context:
         self.students.probe_started()
         return probe
 
+    def track(self, process):
+        """Have close() stop `process` (a NodeProcess this check started); returns it."""
+        self._started_processes.append(process)
+        self.waiting_on(f"{process.name} was starting or running")
+        return process
+
     def close(self) -> None:
+        """Stop the processes this check started (and its own student servers)."""
         from course_lib import processes
 
-        processes.stop_all(timeout=1.0)
+        processes.stop_together(self._started_processes, timeout=1.0)
+        if self._own_servers:
+            self.servers.close()
         if self._reservation is not None:
             self._reservation.release()
+
+
+class _Started:
+    """A check's StudentProcesses that tells the check (Context.track) what it started."""
+
+    def __init__(self, students: StudentProcesses, ctx: Context):
+        self._students, self._ctx = students, ctx
+
+    def start(self, *args, **kwargs):
+        return self._ctx.track(self._students.start(*args, **kwargs))
+
+    def __getattr__(self, name):
+        return getattr(self._students, name)
 
 
 class _Fixed:
@@ -267,7 +327,3 @@ def clip(text: str, limit: int = 1500) -> str:
         return text
     return text[:limit // 3] + f" [... {len(text) - limit} characters ...] " + text[-(2 * limit) // 3:]
 
-
-def _wait_for_file(path: Path, timeout: float, proc) -> bool:
-    waiting.spin_until(lambda: path.exists() or not proc.running(), timeout, poll=0.02)
-    return path.exists()

@@ -110,7 +110,9 @@ def run(ctx, package: str, executable: str, *ros_args: str, tag: str = ""):
         command = workspace.executable_command(ws, package, executable, ros_args=ros_args)
     except FileNotFoundError as error:
         raise StudentError(f"`ros2 run {package} {executable}` cannot start: {error}") from None
-    return ctx.students.start(command, name=f"student-{package}-{executable}{tag}", cwd=ctx.workdir,
+    # Named after the check too: a process started under a name stops the earlier one of that
+    # name (course_lib.processes), and the checks of a grading run at the same time.
+    return ctx.students.start(command, name=f"student-{package}-{executable}{tag}-{ctx.spec.name}", cwd=ctx.workdir,
                               domain_id=ctx.domain_id, wall_seconds=ctx.remaining() + 5, env=student_env(ctx, ws))
 
 

@@ -35,6 +35,8 @@ RATE_HZ = 10.0
 #: Relative tolerance of the measured rate (from the message stamps).
 RATE_TOLERANCE = 0.15
 QUEUE_DEPTH = 100
+#: Messages whose stamps measure the publisher's rate (the wait ends when they arrived, or after 3 s).
+RATE_MESSAGES = 16
 #: A subscriber's log line: the stamp (seconds, and nanoseconds when shown) and the data.
 HEARD = re.compile(r"I heard:.*?stamp\D{0,4}(\d+)(?:\.(\d+))?.*?data\D{0,4}(-?\d+)")
 
@@ -113,7 +115,8 @@ def publisher(ctx: Context) -> None:
                                 f"{ {t: v for t, v in types.items() if not t.startswith('/rosout') and not t.startswith('/parameter')} }); "
                                 "publish tutorial_interfaces/msg/MsgTutorial on 'ros_tutorial_msg' from a 0.1 s timer")
                 return
-            probe.spin_for(3.0)
+            # Enough stamps for the rate (1.5 s at 10 Hz); a slower publisher gets up to 3 s.
+            probe.spin_until(lambda: len(messages) >= RATE_MESSAGES, 3.0)
     finally:
         proc.stop(timeout=2)
     types = types.get(TOPIC, [])

@@ -1,15 +1,20 @@
-"""Runs a student's code in a process of its own, for a check (course_lib.checks.context.Context).
+"""Runs a student's code for the checks: one process that serves many calls, one at a time
+(course_lib.checks.student_server is the checker's side).
 
-``python -m course_lib.checks.student call MODULE FUNCTION JOB`` calls a function;
-``python -m course_lib.checks.student endpoints MODULE CLASS JOB`` constructs a node class and reports
-the QoS of its publishers and subscriptions (what DDS discovery does not tell another process,
-such as the queue depth).
+``python -m course_lib.checks.student serve JOB`` waits for requests JOB/in/<n>.json (n = 0, 1,
+2, ...; their arrays in JOB/in/<n>.npz), handles each in turn and writes its answer as
+JOB/out/<n>.json (how the value was encoded, or the error) and JOB/out/<n>.npz (its arrays) as
+soon as it is done, so that answers given before a later hang or crash survive. A request is
 
-The check that starts it (Context.call) wrote JOB/calls.json and JOB/inputs.npz. This
-process imports the student's module from its working directory, touches JOB/imported, then for
-call i writes JOB/i.json (how the value was encoded, or the error) and JOB/i.npz (its arrays)
-as soon as the call returns, so results of earlier calls survive a later hang or crash.
-Nothing is pickled: the checker reads plain JSON and arrays only.
+- ``{"kind": "import", "module": M}``: import the student's module M from the working directory;
+- ``{"kind": "call", "module": M, "function": F, "args": [keys of in/<n>.npz], "kwargs": {...}}``:
+  call M.F(*args, **kwargs);
+- ``{"kind": "endpoints", "module": M, "class": C}``: construct node class C without arguments
+  (not spun) and answer the QoS of its publishers and subscriptions, which DDS discovery does not
+  tell another process (such as the queue depth).
+
+Nothing is pickled: the checker reads plain JSON and arrays only. The checker writes JOB/in,
+the student's process JOB/out (at grading they belong to different uids).
 """
 
 from __future__ import annotations
@@ -18,6 +23,7 @@ import importlib
 import json
 import os
 import sys
+import time
 import traceback
 from pathlib import Path
 
@@ -45,51 +51,30 @@ def _plain(value):
     return tuple(value) if isinstance(value, list) else value
 
 
-def _import_student(module: str, job: Path):
-    """Import the student's module from the working directory; JOB/imported tells the check it did."""
-    sys.path.insert(0, os.getcwd())
-    mod = importlib.import_module(module)
-    (job / "imported").touch()
-    return mod
-
-
-def call(module: str, function: str, job: Path) -> int:
+def _call(request: dict, inputs: Path, arrays: dict) -> dict:
     import numpy as np
 
-    mod = _import_student(module, job)
-    target = getattr(mod, function, None)
-    calls = json.loads((job / "calls.json").read_text())
-    inputs = np.load(job / "inputs.npz", allow_pickle=False)
-    for index, spec in enumerate(calls):
-        args = [inputs[key] for key in spec["args"]]
-        kwargs = {key: _plain(value) for key, value in spec["kwargs"].items()}
-        arrays: dict = {}
-        if target is None:
-            meta = {"value": {"type": "none"}, "error": f"{module}.py has no function {function}()"}
-        else:
-            try:
-                value = target(*args, **kwargs)
-                meta = {"value": _encode(value, arrays, f"r{index}")}
-            except BaseException as error:  # SystemExit and KeyboardInterrupt are the student's too
-                lines = traceback.format_exception(type(error), error, error.__traceback__)
-                meta = {"value": {"type": "none"}, "error": f"{type(error).__name__}: {error}".strip(),
-                        "traceback": "".join(lines[-3:])}
-        if arrays:
-            np.savez(job / f"{index}.npz", **arrays)
-        (job / f"{index}.json.tmp").write_text(json.dumps(meta))
-        os.replace(job / f"{index}.json.tmp", job / f"{index}.json")
-    return 0
+    module = importlib.import_module(request["module"])
+    target = getattr(module, request["function"], None)
+    if target is None:
+        return {"error": f"{request['module'].rsplit('.', 1)[-1]}.py has no function {request['function']}()"}
+    args = []
+    if request["args"]:
+        with np.load(inputs, allow_pickle=False) as stored:
+            args = [stored[key] for key in request["args"]]
+    kwargs = {key: _plain(value) for key, value in request["kwargs"].items()}
+    return {"value": _encode(target(*args, **kwargs), arrays, "r")}
 
 
-def endpoints(module: str, class_name: str, job: Path) -> int:
-    """Construct node class `class_name` without arguments (not spun) and write JOB/endpoints.json:
-    {"publishers"|"subscriptions": [{"topic", "type", "depth", "history", "reliability", "durability"}]}."""
+def _endpoints(request: dict) -> dict:
+    """{"endpoints": {"publishers"|"subscriptions": [{"topic", "type", "depth", "history",
+    "reliability", "durability"}]}} of node class request["class"], constructed without arguments."""
     import rclpy
 
-    mod = _import_student(module, job)
+    module = importlib.import_module(request["module"])
     rclpy.init()
     try:
-        node = getattr(mod, class_name)()
+        node = getattr(module, request["class"])()
         report = {}
         for kind, endpoints_of_kind in (("publishers", node.publishers), ("subscriptions", node.subscriptions)):
             report[kind] = [{"topic": e.topic_name, "type": f"{e.msg_type.__module__}.{e.msg_type.__name__}",
@@ -100,18 +85,55 @@ def endpoints(module: str, class_name: str, job: Path) -> int:
         node.destroy_node()
     finally:
         rclpy.try_shutdown()
-    (job / "endpoints.json").write_text(json.dumps(report))
-    return 0
+    return {"endpoints": report}
+
+
+def answer(request: dict, inputs: Path, arrays: dict) -> dict:
+    """The answer to one request (see the module docstring); the student's exceptions become its error."""
+    server = os.getpid()
+    try:
+        if request["kind"] == "import":
+            importlib.import_module(request["module"])
+            return {}
+        if request["kind"] == "endpoints":
+            return _endpoints(request)
+        return _call(request, inputs, arrays)
+    except BaseException as error:  # SystemExit and KeyboardInterrupt are the student's too
+        lines = traceback.format_exception(type(error), error, error.__traceback__)
+        return {"error": f"{type(error).__name__}: {error}".strip(), "traceback": "".join(lines[-3:])}
+    finally:
+        if os.getpid() != server:  # a process the student's code forked: only the server answers
+            os._exit(0)
+
+
+def serve(job: Path) -> int:
+    """Answer the requests of JOB/in in turn, forever (the checker stops this process)."""
+    import numpy as np
+
+    sys.path.insert(0, os.getcwd())
+    inbox, outbox = job / "in", job / "out"
+    number = 0
+    while True:
+        request_path, pause = inbox / f"{number}.json", 0.001
+        while not request_path.exists():  # polled: the checker and this process may be different uids
+            time.sleep(pause)
+            pause = min(pause * 2, 0.02)
+        request = json.loads(request_path.read_text())
+        arrays: dict = {}
+        meta = answer(request, inbox / f"{number}.npz", arrays)
+        if arrays:
+            np.savez(outbox / f"{number}.npz", **arrays)
+        (outbox / f"{number}.json.tmp").write_text(json.dumps(meta))
+        os.replace(outbox / f"{number}.json.tmp", outbox / f"{number}.json")
+        number += 1
 
 
 def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else argv
-    commands = {"call": call, "endpoints": endpoints}
-    if len(argv) != 4 or argv[0] not in commands:
-        print("usage: python -m course_lib.checks.student call MODULE FUNCTION JOB_DIR\n"
-              "       python -m course_lib.checks.student endpoints MODULE CLASS JOB_DIR", file=sys.stderr)
+    if len(argv) != 2 or argv[0] != "serve":
+        print("usage: python -m course_lib.checks.student serve JOB_DIR", file=sys.stderr)
         return 2
-    return commands[argv[0]](argv[1], argv[2], Path(argv[3]))
+    return serve(Path(argv[1]))
 
 
 if __name__ == "__main__":

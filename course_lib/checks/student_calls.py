@@ -1,11 +1,12 @@
-"""The checker's side of calling a student's function in a student process: the calls written
-to a job folder, the outcomes read back (plain JSON and arrays, nothing pickled; course_lib.checks.student
-is the other side)."""
+"""The checker's side of calling a student's function in a student process: requests written
+to the process's inbox, answers read back from its outbox (plain JSON and arrays, nothing
+pickled; course_lib.checks.student is the other side, course_lib.checks.student_server the process)."""
 
 from __future__ import annotations
 
 import dataclasses
 import json
+import os
 from pathlib import Path
 
 
@@ -29,47 +30,43 @@ class Outcome:
 
 
 
-def write_calls(job: Path, calls: list[tuple]) -> None:
-    """Write the calls, (args, kwargs) each, as JOB/calls.json and their arrays as JOB/inputs.npz."""
+def write_request(inbox: Path, number: int, request: dict, arrays: dict | None = None) -> None:
+    """Write request `number` for the student's process: its arrays as INBOX/<n>.npz first, then
+    INBOX/<n>.json (renamed into place: the student's process never reads half a request)."""
     import numpy as np
 
-    arrays, manifest = {}, []
-    for index, (args, kwargs) in enumerate(calls):
-        entry = []
-        for position, arg in enumerate(args):
-            key = f"c{index}_a{position}"
-            arrays[key] = np.asarray(arg)
-            entry.append(key)
-        manifest.append({"args": entry, "kwargs": kwargs})
-    np.savez(job / "inputs.npz", **arrays)
-    (job / "calls.json").write_text(json.dumps(manifest))
+    if arrays:
+        np.savez(inbox / f"{number}.tmp.npz", **{key: np.asarray(value) for key, value in arrays.items()})
+        os.replace(inbox / f"{number}.tmp.npz", inbox / f"{number}.npz")
+    (inbox / f"{number}.json.tmp").write_text(json.dumps(request))
+    os.replace(inbox / f"{number}.json.tmp", inbox / f"{number}.json")
 
 
-def read_outcomes(job: Path, count: int, proc, timeout: float) -> list[Outcome]:
-    """One Outcome per call, read from JOB/<i>.json and .npz; calls without a result say why (the
-    process `proc` ended or ran out of its `timeout` seconds)."""
+def call_request(module: str, function: str, args, kwargs: dict) -> tuple[dict, dict]:
+    """(request, arrays) of one call of `function` of `module`: args may hold numpy arrays,
+    kwargs plain JSON values."""
+    arrays = {f"a{position}": arg for position, arg in enumerate(args)}
+    return {"kind": "call", "module": module, "function": function, "args": list(arrays), "kwargs": kwargs}, arrays
+
+
+def read_answer(outbox: Path, number: int) -> dict | None:
+    """The student process's answer to request `number` ({"value"|"error"|"endpoints": ...}), its
+    arrays decoded; None while there is none."""
     import numpy as np
 
-    outcomes = []
-    for index in range(count):
-        meta_path = job / f"{index}.json"
-        if not meta_path.exists():
-            if proc.exit_reason == "wall_seconds" or proc.returncode is None or proc.exit_reason == "stopped":
-                why = f"did not return within {timeout:.0f} s (an endless loop?)"
-            else:
-                why = f"ended the process ({proc.describe_exit()}) before returning"
-            log = last_lines(proc.log, 4)
-            outcomes.append(Outcome(error=f"the call {why}. Last output:\n{log}"))
-            outcomes.extend(Outcome(error="not run: an earlier call did not return") for _ in range(count - index - 1))
-            break
-        try:
-            meta = json.loads(meta_path.read_text())
-            arrays = np.load(job / f"{index}.npz", allow_pickle=False) if (job / f"{index}.npz").exists() else {}
-            outcomes.append(Outcome(value=_decode(meta["value"], arrays), pytype=meta["value"].get("pytype", "?"),
-                                    error=meta.get("error")))
-        except (OSError, ValueError, KeyError, TypeError) as error:
-            outcomes.append(Outcome(error=f"its result could not be read back ({error})"))
-    return outcomes
+    meta_path = outbox / f"{number}.json"
+    if not meta_path.exists():
+        return None
+    try:
+        meta = json.loads(meta_path.read_text())
+        if "value" in meta:
+            npz = outbox / f"{number}.npz"
+            arrays = np.load(npz, allow_pickle=False) if npz.exists() else {}
+            meta["pytype"] = meta["value"].get("pytype", "?")
+            meta["value"] = _decode(meta["value"], arrays)
+        return meta
+    except (OSError, ValueError, KeyError, TypeError, AttributeError) as error:
+        return {"error": f"its result could not be read back ({error})"}
 
 
 def _decode(encoded: dict, arrays):

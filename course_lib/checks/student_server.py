@@ -1,0 +1,128 @@
+"""One student process that serves many calls (:class:`StudentServer`), and the servers of a
+grading (:class:`StudentServers`).
+
+A check calls the student's code in a process of the student (course_lib.checks.student): it
+imports the student's module once (numpy, cv2, rclpy: most of a process's start-up) and then
+answers one request after the other, each with its own time limit. A request that does not
+return in time ends that process (the next request starts a fresh one), and the function it
+called is not called again in this grading: later calls of it answer at once that it hung
+before. Answers given before a hang or crash are kept (each is written as soon as it is done).
+
+In a self-check the servers live as long as the check; at grading (autograder.hidden_checks_process)
+all checks of a submission share them.
+"""
+
+from __future__ import annotations
+
+import shutil
+import sys
+import tempfile
+import threading
+import time
+from pathlib import Path
+
+from course_lib import waiting
+from course_lib.checks.student_calls import last_lines, read_answer, write_request
+
+
+class ServerError(Exception):
+    """A request got no answer; str() says why (for the feedback)."""
+
+    def __init__(self, message: str, timed_out: bool):
+        super().__init__(message)
+        self.timed_out = timed_out
+
+
+class StudentServer:
+    """A student process that answers requests one at a time (see the module docstring).
+
+    Args:
+        students: how the process starts (course_lib.checks.student_processes.StudentProcesses).
+        cwd: its working directory (the student's module is imported from there).
+        env: variables on top of the student's (a sourced workspace), or None.
+        wall_seconds: the longest the process may live.
+    """
+
+    def __init__(self, students, cwd: Path, env: dict | None, wall_seconds: float):
+        self.students, self.cwd, self.env, self.wall_seconds = students, Path(cwd), env, wall_seconds
+        self.lock = threading.Lock()
+        self.proc = None
+        self.imported: dict[str, str | None] = {}  # module -> None (imported) or why it did not import
+        self._job: Path | None = None
+        self._number = 0
+
+    def _start(self, domain_id: int) -> None:
+        self._job = Path(tempfile.mkdtemp(prefix="autograder-student-"))
+        self._job.chmod(0o755)  # the student's uid reads the requests ...
+        (self._job / "in").mkdir(mode=0o755)
+        (self._job / "out").mkdir(mode=0o700)
+        self.students.give(self._job / "out")  # ... and writes its answers
+        self._number = 0
+        self.imported = {}
+        self.proc = self.students.start([sys.executable, "-m", "course_lib.checks.student", "serve", str(self._job)],
+                                        name=f"student-calls-{id(self):x}", cwd=self.cwd, domain_id=domain_id,
+                                        wall_seconds=self.wall_seconds, env=self.env)
+
+    def request(self, request: dict, arrays: dict | None, timeout: float, domain_id: int) -> dict:
+        """Send one request and wait at most `timeout` seconds for its answer ({"value", "pytype"} or
+        {"error"} or {"endpoints"}), starting the process first when none runs.
+
+        Raises:
+            ServerError: no answer: the process ended (timed_out False) or the time ran out
+                (timed_out True; the process is then stopped).
+        """
+        if self.proc is None or not self.proc.running():
+            self.stop()
+            self._start(domain_id)
+        number, self._number = self._number, self._number + 1
+        start_of_log = len(self.proc.log)
+        write_request(self._job / "in", number, request, arrays)
+        outbox, proc = self._job / "out", self.proc
+        waiting.spin_until(lambda: (outbox / f"{number}.json").exists() or not proc.running(), timeout, poll=0.005)
+        answer = read_answer(outbox, number)
+        if answer is not None:
+            return answer
+        timed_out = proc.running()
+        self.stop(grace=0.1)  # a hung call is not waited for
+        output = last_lines(proc.log[start_of_log:] if len(proc.log) > start_of_log else proc.log, 4)
+        if timed_out:
+            raise ServerError(f"did not return within {timeout:.0f} s (an endless loop?). Last output:\n{output}", True)
+        raise ServerError(f"ended the process ({proc.describe_exit()}) before returning. Last output:\n{output}", False)
+
+    def stop(self, grace: float = 1.0) -> None:
+        """Stop the process (SIGINT, SIGKILL after `grace` seconds) and remove its job folder."""
+        if self.proc is not None:
+            self.proc.stop(timeout=grace)
+            self.proc = None
+        if self._job is not None:
+            shutil.rmtree(self._job, ignore_errors=True)
+            self._job = None
+
+
+class StudentServers:
+    """The student servers of a grading (or of one self-check), one per working directory and
+    environment, and the functions that hung in it: {function: why}."""
+
+    def __init__(self, wall_seconds: float = 600.0):
+        self.wall_seconds = wall_seconds
+        self.hung: dict[str, str] = {}
+        self._servers: dict[tuple, StudentServer] = {}
+        self._lock = threading.Lock()
+        self._started = time.monotonic()
+
+    def server(self, students, cwd: Path, env: dict | None) -> StudentServer:
+        # The checks of a grading may each have a ROS domain: the server serves them all.
+        key = (str(cwd), tuple(sorted(((k, v) for k, v in (env or {}).items() if k != "ROS_DOMAIN_ID"), key=str)))
+        with self._lock:
+            if key not in self._servers:
+                left = self.wall_seconds - (time.monotonic() - self._started)
+                self._servers[key] = StudentServer(students, cwd, env, max(5.0, left + 5))
+            return self._servers[key]
+
+    def processes(self) -> list:
+        """The running processes of the servers (a check's clean-up must leave them running)."""
+        return [server.proc for server in self._servers.values() if server.proc is not None]
+
+    def close(self) -> None:
+        for server in self._servers.values():
+            server.stop()
