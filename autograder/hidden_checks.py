@@ -7,6 +7,7 @@ import os
 import sys
 from pathlib import Path
 
+from autograder import hidden_checks_process
 from autograder.result import GradeResult
 from autograder.sandbox import run_sandboxed
 from autograder.submissions import Submission
@@ -14,9 +15,6 @@ from course_lib.checks import registry, runner
 from course_lib.checks.result import Result, images_html, verdict_text
 
 
-#: The hidden checks' share of the submission's grading budget, float seconds, in the
-#: environment of ``python -m autograder.hidden_checks_process`` (the checks end within it).
-CHECKS_SECONDS_ENV = "AUTOGRADER_CHECKS_SECONDS"
 #: Seconds between the checks' own budget and the wall limit of their process.
 CHECKS_MARGIN = 3.0
 
@@ -31,7 +29,7 @@ def grade_outside(sub: Submission, result: GradeResult, work: Path, autograded: 
     The check runs as root in a fresh sandbox (network and mount namespaces); the student's
     processes it starts run as the worker's uid, so they cannot touch the check or its results.
     With `seconds`, the checks together get that much wall time: the process is told
-    (CHECKS_SECONDS_ENV, a little less, so that it can still write its verdicts) and stopped after it.
+    (hidden_checks_process.BUDGET_ENV, a little less, so that it can still write its verdicts) and stopped after it.
     """
     from course_lib import processes
 
@@ -50,7 +48,7 @@ def grade_outside(sub: Submission, result: GradeResult, work: Path, autograded: 
     env = {**env, runner.SEED_ENV: None, "AUTOGRADER_SEED": os.environ.get("AUTOGRADER_SEED")}
     if seconds is not None:
         wall = min(wall, seconds)
-        env[CHECKS_SECONDS_ENV] = f"{max(1.0, wall - CHECKS_MARGIN):.1f}"
+        env[hidden_checks_process.BUDGET_ENV] = f"{max(1.0, wall - CHECKS_MARGIN):.1f}"
     proc = run_sandboxed(command, hide, f"checks {sub.key}", domain_id, env, out,
                           processes.Limits(wall_seconds=wall, grace_seconds=5.0))
     verdicts = {}

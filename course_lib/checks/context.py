@@ -186,15 +186,23 @@ class Context:
                 self.waiting_on(f"{function} on {label} was running")
                 request, arrays = call_request(self.module, function, args, kwargs)
                 try:
-                    answer = server.request(request, arrays, limit, self.domain_id)
+                    answer = self._request(server, function, request, arrays, limit, f" on {label}")
                 except ServerError as error:
-                    if error.timed_out:
-                        self.servers.hung[function] = f"{function} did not return within {limit:.0f} s on {label} earlier"
                     outcomes.append(Outcome(error=f"the call {function} on {label} {error}"))
                     continue
             outcomes.append(Outcome(value=answer.get("value"), pytype=answer.get("pytype", "NoneType"),
                                     error=answer.get("error")))
         return outcomes
+
+    def _request(self, server, what: str, request: dict, arrays, limit: float, on: str = "") -> dict:
+        """server.request(...) in this check's domain; a request that did not return within `limit`
+        marks `what` as hung for the rest of the grading (its later calls are not made)."""
+        try:
+            return server.request(request, arrays, limit, self.domain_id)
+        except ServerError as error:
+            if error.timed_out:
+                self.servers.hung[what] = f"{what} did not return within {limit:.0f} s{on} earlier"
+            raise
 
     def _import(self, server, module: str) -> None:
         """Import `module` in `server`'s process (once per process); raise StudentError when it
@@ -244,11 +252,9 @@ class Context:
         self.waiting_on(f"constructing {what} was running")
         with server.lock:
             try:
-                answer = server.request({"kind": "endpoints", "module": module, "class": class_name}, None, limit,
-                                        self.domain_id)
+                answer = self._request(server, what, {"kind": "endpoints", "module": module, "class": class_name},
+                                       None, limit)
             except ServerError as error:
-                if error.timed_out:
-                    self.servers.hung[what] = f"{what} did not return within {limit:.0f} s earlier"
                 raise StudentError(f"{what} could not be constructed: it {error}") from None
         if "endpoints" not in answer:
             raise StudentError(f"{what} could not be constructed ({answer.get('error')}):\n"
