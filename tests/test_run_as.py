@@ -111,7 +111,8 @@ def test_the_child_still_dies_with_its_supervisor(token):
     leaves no process of the student behind."""
     command = run_as.command(NOBODY, [sys.executable, "-S", "-c", "import time; time.sleep(100)", token])
     process = NodeProcess(command, cwd="/").start()
-    assert wait_until(lambda: processes_with(token))
+    # Two interpreters start before the sleeper shows (the wrapper, then python): slow under load.
+    assert wait_until(lambda: processes_with(token), timeout=30), process.log
     os.kill(process._supervisor.pid, signal.SIGKILL)
     assert wait_until(lambda: not processes_with(token), timeout=10)
     process.stop()
