@@ -46,17 +46,16 @@ def wait_for_discovery(minimum: float | None = None, quiet: float = _SETTLE_QUIE
             SETTLE_SECONDS).
         quiet: then wait until the graph has not changed for this long.
         complete_within: also wait, up to this many seconds after the tool node's creation,
-            while the graph shows fewer nodes of other processes than there are other DDS
-            participants on this machine in this domain (each ROS process has one, holding its
-            nodes). On a busy machine some of them take seconds to be discovered.
+            until every other DDS participant on this machine in this domain (each ROS process
+            has one, holding its nodes) has announced its nodes. On a busy machine some of them
+            take seconds to be discovered.
 
     The wait never lasts longer than 5 s after the tool node's creation.
     """
     global _settled_node
     node = session.tool_node()
     minimum = SETTLE_SECONDS if minimum is None else minimum
-    others_here = _participants_here(node.context.get_domain_id()) - 1 if complete_within else 0
-    ours = 1 + len(session.nodes())  # the nodes of this process share its participant
+    here = _participants_here(node.context.get_domain_id()) if complete_within else 0
     seen = {"graph": _snapshot(node), "since": time.monotonic(), "checks": 0}
 
     def settled():
@@ -67,11 +66,31 @@ def wait_for_discovery(minimum: float | None = None, quiet: float = _SETTLE_QUIE
         seen["checks"] += 1
         now = time.monotonic()
         age = now - node.created_at
-        missing = age < complete_within and len(seen["graph"][0]) - ours < others_here
+        missing = age < complete_within and _participants_with_nodes(node) < here
         return age >= minimum and now - seen["since"] >= quiet and not missing
 
     waiting.spin_until(settled, max(0.0, _SETTLE_MAX - (time.monotonic() - node.created_at)), poll=_SETTLE_POLL)
     _settled_node = node
+
+
+#: Topics every node publishes on (unless told not to): their publishers show its participant.
+_EVERY_NODE_PUBLISHES = ("/rosout", "/parameter_events")
+
+
+def _participants_with_nodes(node) -> int:
+    """How many participants (this process's included) have nodes the graph can name.
+
+    An endpoint's gid begins with the 12-byte GUID prefix of its participant. A participant
+    counts once the graph knows the name of a node of it: rmw learns endpoints and node names
+    from two different messages, and a listing needs the names. Counting nodes instead would
+    not do: one process can hold several nodes.
+    """
+    prefixes = set()
+    for topic in _EVERY_NODE_PUBLISHES:
+        for info in node.get_publishers_info_by_topic(topic):
+            if info.node_name != "_NODE_NAME_UNKNOWN_":
+                prefixes.add(bytes(info.endpoint_gid)[:12])
+    return len(prefixes)
 
 
 def _participants_here(domain_id: int) -> int:

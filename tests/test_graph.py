@@ -109,6 +109,31 @@ def test_node_list_sees_a_node_in_another_process(far_talker):
     assert "/" + session.TOOL_NODE_NAME in graph.node_list(all=True)
 
 
+def test_discovery_counts_a_process_holding_three_nodes_as_one_participant(domain_id):
+    """`ros2 node list` waits until every process on the machine has shown its nodes; a process
+    is one DDS participant however many nodes it holds (counting nodes would let a listing answer
+    before a process holding one node showed, while another holding three nodes already had)."""
+    process = subprocess.Popen(
+        [sys.executable, "-c", "import rclpy, rclpy.node, time; rclpy.init(); "
+         "nodes = [rclpy.node.Node(n) for n in ('one', 'two', 'three')]; print('ready', flush=True); time.sleep(60)"],
+        stdout=subprocess.PIPE, text=True, env=rosenv.ros_environment(domain_id=domain_id))
+    try:
+        ready, _, _ = select.select([process.stdout], [], [], 60)
+        assert ready and process.stdout.readline().strip() == "ready", "the three-node process did not start"
+        session.start(domain_id=domain_id)
+        tool = session.tool_node()
+        assert session.wait_for(lambda: {"one", "two", "three"} <= set(tool.get_node_names()), timeout=15)
+        assert discovery._participants_here(domain_id) == 2  # this process and the other one
+        assert session.wait_for(lambda: discovery._participants_with_nodes(tool) == 2, timeout=5)
+        session.add_node(Node("four"))
+        session.wait_for(lambda: "four" in tool.get_node_names(), timeout=5)
+        assert discovery._participants_with_nodes(tool) == 2
+    finally:
+        process.kill()
+        process.wait(timeout=10)
+        process.stdout.close()
+
+
 def test_topic_echo_receives_the_asked_number_of_messages(far_talker):
     """topic_echo(count=3) gives three consecutive messages of the type read from the graph."""
     session.start(domain_id=far_talker)
