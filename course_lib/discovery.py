@@ -11,10 +11,14 @@ import time
 
 from course_lib import session, waiting
 
-#: Seconds a newly started tool node waits for discovery before its first answer. Fast DDS
-#: took about 2 s to show another process's node on the course machines; lower it for a
-#: quicker first answer when only this kernel's nodes matter.
-SETTLE_SECONDS = 2.5
+#: Seconds a newly started tool node waits for discovery at least before its first answer
+#: (then until every process here has shown its nodes, up to COMPLETE_SECONDS). Lower it to 0
+#: for a quicker first answer when only this kernel's nodes matter.
+SETTLE_SECONDS = 0.5
+#: Seconds after its creation up to which a new tool node waits for the nodes of every other
+#: ROS process on this machine: Fast DDS shows another process's nodes after 0.2-1 s on an idle
+#: machine (course_lib/fastdds_large_data.xml), after seconds on a busy one.
+COMPLETE_SECONDS = 3.0
 # After SETTLE_SECONDS the graph must also have stayed the same for _SETTLE_QUIET s (things
 # found late bring more with them), but the wait never lasts longer than _SETTLE_MAX s.
 _SETTLE_POLL = 0.05
@@ -34,7 +38,7 @@ def _graph_node():
 
 
 def wait_for_discovery(minimum: float | None = None, quiet: float = _SETTLE_QUIET,
-                       complete_within: float = 0.0) -> None:
+                       complete_within: float | None = None) -> None:
     """Wait until discovery has shown the graph to the tool node; later queries do not wait.
 
     The functions of this module call it on the tool node's first use, with the defaults;
@@ -47,14 +51,15 @@ def wait_for_discovery(minimum: float | None = None, quiet: float = _SETTLE_QUIE
         quiet: then wait until the graph has not changed for this long.
         complete_within: also wait, up to this many seconds after the tool node's creation,
             until every other DDS participant on this machine in this domain (each ROS process
-            has one, holding its nodes) has announced its nodes. On a busy machine some of them
-            take seconds to be discovered.
+            has one, holding its nodes) has announced its nodes (default COMPLETE_SECONDS; 0:
+            not at all). On a busy machine some of them take seconds to be discovered.
 
     The wait never lasts longer than 5 s after the tool node's creation.
     """
     global _settled_node
     node = session.tool_node()
     minimum = SETTLE_SECONDS if minimum is None else minimum
+    complete_within = COMPLETE_SECONDS if complete_within is None else complete_within
     here = _participants_here(node.context.get_domain_id()) if complete_within else 0
     seen = {"graph": _snapshot(node), "since": time.monotonic(), "checks": 0}
 

@@ -122,7 +122,7 @@ def wait_for_named_only() -> None:
     """Before a verb that names its node or topic: no general wait, it waits for that name."""
     from course_lib import discovery
 
-    discovery.wait_for_discovery(minimum=0.0, quiet=0.0)
+    discovery.wait_for_discovery(minimum=0.0, quiet=0.0, complete_within=0.0)
 
 
 # --- QoS options (ros2 topic echo / pub) -------------------------------------------------
