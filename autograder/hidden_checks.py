@@ -31,16 +31,32 @@ def grade_outside(sub: Submission, result: GradeResult, work: Path, autograded: 
     With `seconds`, the checks together get that much wall time: the process is told
     (hidden_checks_process.BUDGET_ENV, a little less, so that it can still write its verdicts) and stopped after it.
     """
-    from course_lib import processes
+    names = graded_checks(sub, result)
+    if names:
+        apply_verdicts(result, autograded, run_checks(sub, names, work / "checks", workdir, domain_id, env, hide,
+                                                      seconds))
 
+
+def graded_checks(sub: Submission, result: GradeResult | None = None) -> list[str]:
+    """The checks of the submission's graded cells (of every check of its assignment when
+    `result` has no cells yet); [] for an assignment of the instructor's own (nbgrader alone)."""
     try:
         checks = registry.checks_of(sub.assignment)
     except ModuleNotFoundError:  # an assignment of the instructor's own, graded by nbgrader alone
-        return
-    names = [name for name in (check_of(c["cell"]) for c in result.cells) if name in checks]
-    if not names:
-        return
-    out = work / "checks"
+        return []
+    if result is None:
+        return list(checks)
+    return [name for name in (check_of(c["cell"]) for c in result.cells) if name in checks]
+
+
+def run_checks(sub: Submission, names: list[str], out: Path, workdir: Path, domain_id: int, env: dict,
+               hide: list[Path], seconds: float | None = None, run=run_sandboxed) -> dict[str, Result]:
+    """Run the checks `names` against `workdir` in one sandboxed grader process (see
+    grade_outside) and return {name: Result}; `out` (new) gets their JSON; `run` is
+    autograder.sandbox.run_sandboxed or a wrapper of it."""
+    from course_lib import processes
+
+    checks = registry.checks_of(sub.assignment)
     out.mkdir(mode=0o700)
     command = [sys.executable, "-m", "autograder.hidden_checks_process", sub.assignment, *names,
                "--workdir", str(workdir), "--out", str(out)]
@@ -49,8 +65,8 @@ def grade_outside(sub: Submission, result: GradeResult, work: Path, autograded: 
     if seconds is not None:
         wall = min(wall, seconds)
         env[hidden_checks_process.BUDGET_ENV] = f"{max(1.0, wall - CHECKS_MARGIN):.1f}"
-    proc = run_sandboxed(command, hide, f"checks {sub.key}", domain_id, env, out,
-                          processes.Limits(wall_seconds=wall, grace_seconds=5.0))
+    proc = run(command, hide, f"checks {sub.key} {out.name}", domain_id, env, out,
+               processes.Limits(wall_seconds=wall, grace_seconds=5.0))
     verdicts = {}
     for name in names:
         try:
@@ -60,11 +76,16 @@ def grade_outside(sub: Submission, result: GradeResult, work: Path, autograded: 
                        f"yours may never return" if proc.exit_reason == "wall_seconds" else proc.describe_exit())
             verdicts[name] = Result(sub.assignment, name, 0.0, checks[name].points, 0,
                                     error=f"The grader could not run this check ({stopped}):\n{proc.log_tail(8)}")
+    return verdicts
+
+
+def apply_verdicts(result: GradeResult, autograded: Path, verdicts: dict[str, Result]) -> None:
+    """The checks' points in place of their cells' scores, their verdicts in place of the cells'
+    outputs in the notebooks of `autograded`."""
     for cell in result.cells:
         if check_of(cell["cell"]) in verdicts:
             cell["auto_score"] = min(verdicts[check_of(cell["cell"])].points, cell["max_score"])
     _write_verdicts(autograded, verdicts)
-
 
 
 def check_of(grade_id: str) -> str | None:

@@ -340,7 +340,7 @@ def cache_of(course: Path) -> InterfaceCache:
 
 def build_for_checks(assignment: str, course: Path, work: Path, workdir: Path, uid: int | None, domain_id: int,
                      grader_env: dict, hide: list[Path], run_sandboxed,
-                     seconds: float = BUILD_SECONDS) -> tuple[dict, float]:
+                     seconds: float = BUILD_SECONDS, prefix: str = "") -> tuple[dict, float]:
     """Build the submission's workspace (``workdir/ros2_ws``) in the sandbox as the student's uid
     (autograder.run_as),
     write the report into the grader's `work` folder, and return the variables that tell the
@@ -352,11 +352,13 @@ def build_for_checks(assignment: str, course: Path, work: Path, workdir: Path, u
         seconds: wall time for the student's own packages (at most BUILD_SECONDS each colcon run);
             an interface package missing from the course's cache is the course's cost and gets
             BUILD_SECONDS of its own, outside this budget.
+        prefix: of the names of the grader's folder and report in `work` (a second build of the
+            same submission keeps apart: autograder.early_checks).
     """
     from autograder import run_as
     from course_lib import processes
 
-    scratch = work / "colcon"
+    scratch = work / f"{prefix}colcon"
     scratch.mkdir(mode=0o711, exist_ok=True)
     home = scratch / "home"
     home.mkdir(exist_ok=True)
@@ -399,7 +401,7 @@ def build_for_checks(assignment: str, course: Path, work: Path, workdir: Path, u
         report.reference_underlays = [str(p) for p in reference_interfaces(assignment, cache, scratch)]
     except RuntimeError as error:  # the course's fault: the checks that need messages say so
         report.log += f"\n{error}"
-    path = report.write(work / "build-report.json")
+    path = report.write(work / f"{prefix}build-report.json")
     return {REPORT_ENV: str(path)}, interface_seconds
 
 

@@ -16,11 +16,13 @@ are listed in :data:`STEPS`):
    hidden test cells only say that the grader runs them (AUTOGRADER_CHECKS_OUTSIDE=1): a check
    run in the student's kernel could be faked by the student's code (patch checks.grade and
    every test cell "passes").
-4. The hidden checks run after the notebook, in a fresh sandbox of the same kind, as processes
+4. The hidden checks run in a fresh sandbox of the same kind, as processes
    of the grader (``python -m autograder.hidden_checks_process``, root), against the module the
    notebook wrote; the student's code they start runs as the worker's uid, with the same limits.
    Their points replace nbgrader's scores of those cells, and their verdicts (seed, what passed
-   and failed, pictures) replace the cells' outputs in the autograded notebook.
+   and failed, pictures) replace the cells' outputs in the autograded notebook. The workspace is
+   built and checked while nbgrader runs the notebook, from the files the notebook is predicted
+   to write (autograder.early_checks); when it wrote other files, again after it, from those.
 5. The trusted grader reads the other cells' scores from the private gradebook, copies the
    autograded notebook to COURSE_DIR/autograded/ (without the grader's temporary paths), and
    records the scores in the course gradebook as nbgrader's autograde would (autograder.gradebook:
@@ -38,10 +40,10 @@ import tempfile
 import time
 from pathlib import Path
 
-from autograder import config, gradebook, intake, kernel, packages, student_uid
+from autograder import config, early_checks, gradebook, intake, kernel, packages, student_uid
 from autograder.nbgrader_cli import env_for_tools
 from autograder.outputs import keep_autograded, keep_log, scrub_paths
-from autograder.hidden_checks import grade_outside
+from autograder.hidden_checks import apply_verdicts, grade_outside, graded_checks
 from autograder.result import GradeResult
 from autograder.sandbox import HIDDEN_FROM_STUDENTS, interpreter_exposure, isolation, run_sandboxed
 from autograder.staging import private_copy, stage_grader
@@ -96,6 +98,8 @@ class Grading:
     deadline: float = 0.0      # time.monotonic() by which the grading must end (grading_budget)
     budget: float = GRADING_SECONDS  # the seconds the grading was given
     notebook_seconds: float = 0.0  # the wall time the notebook run was given
+    early: early_checks.EarlyRun | None = None  # the build and checks of the predicted files
+    early_verdicts: dict | None = None  # their verdicts, when the notebook wrote the predicted files
 
     def seconds_left(self, keep: float = 0.0) -> float:
         """Seconds of the submission's budget left, less `keep` for later steps (at least 1)."""
@@ -170,6 +174,13 @@ def choose_environment(g: Grading) -> None:
             g.env.update(exposure, AUTOGRADER_STAGE=str(work / "stage"))
 
 
+def start_early_checks(g: Grading) -> None:
+    """Build and check the files the notebook is predicted to write while it runs
+    (autograder.early_checks); build_workspace decides afterwards whether they count."""
+    if graded_checks(g.sub) and packages.needed(g.sub.assignment, g.root / "submitted" / g.sub.student / g.sub.assignment):
+        g.early = early_checks.EarlyRun(g, KEPT_FOR_CHECKS / 2).start()
+
+
 def run_notebook(g: Grading) -> None:
     """``nbgrader autograde`` in the sandbox, within the notebook's limits."""
     from course_lib import processes
@@ -204,6 +215,20 @@ def read_scores(g: Grading) -> None:
 def build_workspace(g: Grading) -> None:
     """The student's ROS 2 workspace built with colcon in the sandbox, interface packages from the
     course's cache (autograder.packages); the checks read its report."""
+    if g.early is not None:
+        early, g.early = g.early, None
+        if g.failed:  # nothing to check: its reason is the notebook's
+            early.cancel()
+            return
+        outcome = early.outcome_for(g.workdir, graded_checks(g.sub, g.result))
+        g.result.steps["early_build_and_checks"] = early.seconds
+        g.deadline += early.interface_seconds  # the course's cost, as below
+        g.result.checked_early = outcome is not None
+        if outcome is not None:
+            built, g.early_verdicts = outcome
+            g.env.update(built)
+            g.result.detail += packages.instructor_note(built)
+            return
     if g.failed or not packages.needed(g.sub.assignment, g.workdir):
         return
     built, interface_seconds = packages.build_for_checks(
@@ -218,6 +243,9 @@ def build_workspace(g: Grading) -> None:
 def run_hidden_checks(g: Grading) -> None:
     """The hidden checks, outside the kernel (autograder.hidden_checks)."""
     if g.failed:
+        return
+    if g.early_verdicts is not None:
+        apply_verdicts(g.result, g.autograded, g.early_verdicts)
         return
     grade_outside(g.sub, g.result, g.work, g.autograded, g.workdir, g.domain_id, g.env, g.hide,
                   seconds=g.seconds_left())
@@ -243,8 +271,8 @@ def keep_outputs(g: Grading) -> None:
 
 
 #: Grading one submission, in order (each step sees what the earlier ones left in Grading).
-STEPS = (stage_course_root, choose_environment, run_notebook, read_scores, build_workspace, run_hidden_checks,
-         remove_grader_paths, note_manual_grading, keep_outputs)
+STEPS = (stage_course_root, choose_environment, start_early_checks, run_notebook, read_scores, build_workspace,
+         run_hidden_checks, remove_grader_paths, note_manual_grading, keep_outputs)
 
 
 def grade_submission(sub: Submission, course: Path, domain_id: int) -> GradeResult:
@@ -268,6 +296,8 @@ def grade_submission(sub: Submission, course: Path, domain_id: int) -> GradeResu
             step(grading)
             result.steps[step.__name__] = round(time.monotonic() - step_started, 2)
     finally:
+        if grading.early is not None:  # a step raised: stop it before its folder goes
+            grading.early.cancel()
         _remove_tree(grading.work)
     result.score = round(sum(c["auto_score"] or 0 for c in result.cells), 3) if result.status != "failed" else 0.0
     result.seconds = round(time.monotonic() - started, 1)

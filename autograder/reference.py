@@ -30,17 +30,13 @@ def source_notebook(assignment: str, source: Path = SOURCE) -> nbformat.Notebook
 
 
 def write_files(nb: nbformat.NotebookNode, folder: Path, edits=()) -> Path:
-    """Write the files of a notebook's %%writefile cells into `folder`, as running the cells would,
-    with the solution markers removed and each (old, new) edit applied to the first file that
-    holds `old`; return folder/ros2_ws."""
-    files = {}
-    for cell in nb.cells:  # the shell cell that makes the folders and the empty files
-        for line in cell.source.splitlines() if cell.cell_type == "code" else ():
-            if line.startswith("!touch "):
-                files.update({path: "" for path in line.split()[1:]})
-    for cell in writefile_cells(nb):
-        first, _, body = solution_source(cell.source).partition("\n")
-        files[first.split()[1]] = body + ("\n" if body and not body.endswith("\n") else "")
+    """Write the files of a notebook's %%writefile cells (and its !touch lines' empty files) into
+    `folder`, as running the cells would (autograder.notebook_writes), with the solution markers
+    removed and each (old, new) edit applied to the first file that holds `old`; return folder/ros2_ws."""
+    from autograder.notebook_writes import writes_of
+
+    writes = writes_of(solution_source(cell.source) for cell in nb.cells if cell.cell_type == "code")
+    files = {name: (data or b"").decode() for name, data in writes.files.items()}
     return _write(files, folder, edits, "the notebook's %%writefile cells")
 
 

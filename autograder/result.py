@@ -21,6 +21,9 @@ class GradeResult:
     from_cache: bool = False     # True: an earlier run's result (the submission did not change)
     kernel_uid: int | None = None  # the uid the student's code ran as (root isolation only)
     steps: dict = dataclasses.field(default_factory=dict)  # seconds of each pipeline step, by name
+    # The build and checks run while the notebook ran (autograder.early_checks): True when they
+    # counted, False when the notebook wrote other files and they ran again, None when not tried.
+    checked_early: bool | None = None
 
     @classmethod
     def from_dict(cls, data: dict) -> "GradeResult":

@@ -71,14 +71,18 @@ def interpreter_exposure() -> dict:
     return {}
 
 
-def run_sandboxed(command: list[str], hide: list[Path], name: str, domain_id: int, env: dict, cwd: Path, limits):
+def run_sandboxed(command: list[str], hide: list[Path], name: str, domain_id: int, env: dict, cwd: Path, limits,
+                  on_start=None):
     """Run a command in the sandbox (sandbox_command) to its end or its wall time; return the
-    stopped course_lib.processes.NodeProcess (its log, returncode, describe_exit())."""
+    stopped course_lib.processes.NodeProcess (its log, returncode, describe_exit()). `on_start`
+    gets the process once it runs (another thread may stop it)."""
     from course_lib import processes
 
     proc = processes.NodeProcess(sandbox_command(command, hide), name=name, domain_id=domain_id, env=env, cwd=cwd,
                                  limits=limits)
     proc.start()
+    if on_start is not None:
+        on_start(proc)
     try:
         proc.wait(limits.wall_seconds + 30)
     except TimeoutError:

@@ -31,6 +31,23 @@ FULL_RUN_MISTAKES = {
 #: the term (tests/test_term.py, alice), catdog_warp's here.
 FULL_RUN_REFERENCES = ["catdog_warp"]
 
+#: A last cell that rewrites the node module with Python instead of %%writefile: the grader
+#: cannot predict it (autograder.notebook_writes), so the early build and checks must not count.
+REWRITING_CELL = """from pathlib import Path
+node = Path("ros2_ws/src/brightness/brightness/brightness_node.py")
+node.write_text(node.read_text() + "\\n\\ndef average_brightness(image):\\n    return 0\\n")
+"""
+
+
+def submit_rewriting(course: Path, student: str) -> None:
+    """The brightness reference, with REWRITING_CELL at the end of its notebook."""
+    import nbformat
+
+    path = zoo.submit(course, student, "brightness")
+    nb = nbformat.read(path, as_version=4)
+    nb.cells.append(nbformat.v4.new_code_cell(REWRITING_CELL))
+    nbformat.write(nb, path)
+
 
 @pytest.fixture(scope="module")
 def course(tmp_path_factory):
@@ -40,6 +57,7 @@ def course(tmp_path_factory):
         zoo.submit(course, "reference", assignment)
     for assignment, (edits, _check, _reason) in FULL_RUN_MISTAKES.items():
         zoo.submit(course, "mistaken", assignment, edits)
+    submit_rewriting(course, "rewriting")
     results = grading.grade(course, workers=2, progress=False)
     return course, {(r.student, r.assignment): r for r in results}
 
@@ -71,6 +89,19 @@ def test_reference_solutions_get_full_marks(course, assignment):
     result = results["reference", assignment]
     assert result.status == "graded", result.reason
     assert result.score == result.max_score > 0, zoo.graded_outputs(root, "reference", assignment)
+    assert result.checked_early, "the files the notebook wrote were predicted: built and checked while it ran"
+
+
+@pytest.mark.slow
+def test_a_file_the_notebook_writes_otherwise_is_built_and_checked_as_written(course):
+    """A cell that rewrites the module with Python (not %%writefile) makes the prediction wrong:
+    the early build and checks are dropped, and the module as the notebook left it is graded."""
+    root, results = course
+    result = results["rewriting", "brightness"]
+    assert result.status == "graded", result.reason
+    assert result.checked_early is False
+    scores = {c["cell"]: c["auto_score"] for c in result.cells}
+    assert scores["check_values"] == 0 and result.score < result.max_score, zoo.graded_outputs(root, "rewriting", "brightness")
 
 
 @pytest.mark.slow

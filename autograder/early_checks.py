@@ -1,0 +1,117 @@
+"""Building and checking a submission while nbgrader runs its notebook.
+
+The checks read only files: the package the notebook writes (``ros2_ws/src/...``) and what was
+handed in beside it. Those files are predicted from the notebook without running it
+(autograder.notebook_writes: its ``%%writefile`` cells, ``!mkdir -p`` and ``!touch`` lines) and
+written into a folder of the submission's own, a copy of the submitted folder; there the
+submission is built and checked (the same build and checks as afterwards, in the same sandbox,
+as the student's uid) while nbgrader runs the notebook. When the notebook has run, the grader
+compares the files of the folder it ran in with the predicted ones
+(notebook_writes.folder_digest): equal, the early build and verdicts are the submission's;
+different (a cell wrote a file some other way, or failed), they are dropped and the grader builds
+and checks the files the notebook wrote, as it would have without this.
+
+On two cores the notebook's run (about 5 s of one core) and the build with the checks (about
+10 s, partly on both) overlap instead of following each other.
+"""
+
+from __future__ import annotations
+
+import shutil
+import threading
+import time
+from pathlib import Path
+
+from autograder import hidden_checks, kernel, notebook_writes, packages, run_as
+from autograder.sandbox import run_sandboxed
+
+#: The folder in the grader's work folder that the early build and checks run in.
+FOLDER = "early"
+
+
+class EarlyRun:
+    """The early build and checks of one submission (see the module docstring), in a thread."""
+
+    def __init__(self, g, build_keep: float):
+        """`g`: the grading (autograder.pipeline.Grading); `build_keep`: seconds of its budget the
+        build leaves for the checks."""
+        self.g, self.build_keep = g, build_keep
+        self.folder = g.work / FOLDER / kernel.WORK_SUBDIR
+        self.digest = ""
+        self.built: dict = {}
+        self.interface_seconds = 0.0
+        self.verdicts: dict | None = None
+        self.seconds = 0.0
+        self._cancelled = threading.Event()
+        self._running = []  # the sandboxed process of the current step
+        self._lock = threading.Lock()
+        self._thread = threading.Thread(target=self._run, name=f"early {g.sub.key}", daemon=True)
+
+    def start(self) -> "EarlyRun":
+        """Write the predicted folder (a copy of the submitted one with the notebook's predicted
+        files) and start building and checking it."""
+        g = self.g
+        submitted = g.root / "submitted" / g.sub.student / g.sub.assignment
+        shutil.copytree(submitted, self.folder, symlinks=True, ignore=shutil.ignore_patterns(".ipynb_checkpoints"))
+        for notebook in sorted(submitted.glob("*.ipynb")):
+            notebook_writes.predicted_writes(notebook).apply(self.folder)
+        self.digest = notebook_writes.folder_digest(self.folder)
+        if g.result.kernel_uid is not None:
+            run_as.give_tree(self.folder, g.result.kernel_uid)
+        self.folder.parent.chmod(0o711)
+        self.folder.chmod(0o700)
+        self._thread.start()
+        return self
+
+    def _sandboxed(self, *args, **kwargs):
+        """autograder.sandbox.run_sandboxed, its process kept so that cancel() can stop it."""
+        def keep(proc):
+            with self._lock:
+                self._running[:] = [proc]
+            if self._cancelled.is_set():
+                proc.stop(timeout=2)
+        return run_sandboxed(*args, **kwargs, on_start=keep)
+
+    def _run(self) -> None:
+        g = self.g
+        started = time.monotonic()
+        try:
+            if not packages.needed(g.sub.assignment, self.folder):
+                return
+            self.built, self.interface_seconds = packages.build_for_checks(
+                g.sub.assignment, g.course, g.work, self.folder, g.result.kernel_uid, g.domain_id, g.env, g.hide,
+                self._sandboxed, seconds=g.seconds_left(keep=self.build_keep), prefix=f"{FOLDER}-")
+            if self._cancelled.is_set():
+                return
+            names = hidden_checks.graded_checks(g.sub)
+            if names:
+                self.verdicts = hidden_checks.run_checks(
+                    g.sub, names, g.work / f"{FOLDER}-checks", self.folder, g.domain_id, {**g.env, **self.built},
+                    g.hide, g.seconds_left(), run=self._sandboxed)
+        finally:
+            self.seconds = round(time.monotonic() - started, 2)
+
+    def cancel(self) -> None:
+        """Stop the early run (its verdicts will not be used)."""
+        self._cancelled.set()
+        with self._lock:
+            running = list(self._running)
+        for proc in running:
+            proc.stop(timeout=2)
+        self._thread.join(10)
+
+    def outcome_for(self, workdir: Path, names: list[str]):
+        """The early (build variables, verdicts of `names`) when the notebook's run left `workdir`
+        with exactly the predicted files, else None (the early run is then stopped). Waits for the
+        early run to end, at most until the grading's deadline."""
+        same = notebook_writes.folder_digest(workdir) == self.digest if Path(workdir).is_dir() else False
+        if not same:
+            self.cancel()
+            return None
+        self._thread.join(max(0.0, self.g.deadline - time.monotonic()))
+        if self._thread.is_alive():
+            self.cancel()
+            return None
+        if names and (self.verdicts is None or not set(names) <= set(self.verdicts)):
+            return None
+        return self.built, {name: self.verdicts[name] for name in names} if names else {}
