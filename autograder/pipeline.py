@@ -63,6 +63,9 @@ MAX_LOAD_FACTOR = 6.0
 NOTEBOOK_TIMEOUT = 420.0
 #: Seconds of the budget the notebook run and the build leave for the hidden checks.
 KEPT_FOR_CHECKS = 20.0
+#: Set to 0 to build and check only after the notebook ran (autograder.early_checks), e.g. on a
+#: one-core machine, where overlapping them gains nothing.
+EARLY_CHECKS_ENV = "AUTOGRADER_EARLY_CHECKS"
 #: Address space of each process of a submission (MB). Fast DDS + numpy + OpenCV need ~1 GB.
 MEMORY_MB = 4096
 #: Largest file a submission may write (MB).
@@ -177,6 +180,8 @@ def choose_environment(g: Grading) -> None:
 def start_early_checks(g: Grading) -> None:
     """Build and check the files the notebook is predicted to write while it runs
     (autograder.early_checks); build_workspace decides afterwards whether they count."""
+    if os.environ.get(EARLY_CHECKS_ENV, "1") == "0":
+        return
     if graded_checks(g.sub) and packages.needed(g.sub.assignment, g.root / "submitted" / g.sub.student / g.sub.assignment):
         g.early = early_checks.EarlyRun(g, KEPT_FOR_CHECKS / 2).start()
 

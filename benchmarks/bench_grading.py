@@ -1,20 +1,24 @@
-"""How long the autograder takes per submission, cold and with the interface build cached, and
-what a second worker buys, in one run.
+"""How long the autograder takes per submission, cold and with the interface build cached, before
+and after the early build and checks, and what a second worker buys, in one run.
 
 Not a test: the times depend on the machine and on what else runs, so this prints them instead
 of asserting them. It releases the three assignments into a scratch course, hands in the
-reference solution of each for --students students, then grades the whole class three times with
+reference solution of each for --students students, then grades the whole class four times with
 the real nbgrader CLI, everything graded again each time: with one worker and an empty interface
-cache (cold: each assignment's first submission builds its message package), with one worker and
-the cache kept (every message package reused), and with --workers workers.
+cache (cold: each assignment's first submission builds its message package); with one worker, the
+cache kept (every message package reused) and the steps one after another
+(AUTOGRADER_EARLY_CHECKS=0: "sequential", the grader before autograder.early_checks); the same
+with the build and checks overlapping the notebook's run ("early", the default); and with
+--workers workers.
 
     .venv/bin/python benchmarks/bench_grading.py [--students 2] [--workers 2]
 
 Per assignment it prints the seconds per submission: the first submission of the cold run, and
-the mean of each run; then the mean seconds of each pipeline step in the cached one-worker run
-(GradeResult.steps: nbgrader's notebook run, the colcon build of the workspace, the grader's own
-run of the hidden checks, and the rest), then the wall time of each run and the ratio of the two
-cached runs, which is the speed-up of the extra workers on this machine.
+the mean of each run; then the mean seconds of each pipeline step in the two cached one-worker
+runs (GradeResult.steps: nbgrader's notebook run, the early build and checks beside it, the colcon
+build of the workspace and the grader's own run of the hidden checks after it, and the rest),
+then the wall time of each run and the ratio of the two early runs, which is the speed-up of the
+extra workers on this machine.
 """
 
 from __future__ import annotations
@@ -37,10 +41,11 @@ from autograder import grading, packages, pipeline, release, sandbox  # noqa: E4
 
 ASSIGNMENTS = ["brightness", "pubsub", "catdog_warp"]
 #: The steps shown on their own (autograder.pipeline.STEPS); the others are summed as "other".
-SHOWN_STEPS = ["run_notebook", "build_workspace", "run_hidden_checks"]
+SHOWN_STEPS = ["run_notebook", "early_build_and_checks", "build_workspace", "run_hidden_checks"]
 
 
-def timed_grade(course: Path, workers: int) -> tuple[float, list]:
+def timed_grade(course: Path, workers: int, early: bool = True) -> tuple[float, list]:
+    os.environ[pipeline.EARLY_CHECKS_ENV] = "1" if early else "0"
     started = time.monotonic()
     results = grading.grade(course, workers=workers, force=True, progress=False)
     return time.monotonic() - started, results
@@ -58,31 +63,38 @@ def main(argv=None) -> int:
             for assignment in ASSIGNMENTS:
                 zoo.submit(course, f"student{index}", assignment)
         shutil.rmtree(packages.cache_of(course).root, ignore_errors=True)
-        runs = {"cold": timed_grade(course, 1), "cached": timed_grade(course, 1),
-                "workers": timed_grade(course, args.workers)}
+        runs = {"cold": timed_grade(course, 1), "sequential": timed_grade(course, 1, early=False),
+                "early": timed_grade(course, 1), "workers": timed_grade(course, args.workers)}
     print(f"{platform.node()}: {os.cpu_count()} CPUs, isolation {sandbox.isolation()}, "
           f"{args.students} reference submissions per assignment\n")
-    print(f"{'assignment':<14}{'first, cold':>12}{'mean, cold':>12}{'mean, cached':>14}"
-          f"{f'mean, {args.workers} workers':>18}{'scores':>12}")
+    columns = {"cold": "mean, cold", "sequential": "cached, sequential", "early": "cached, early",
+               "workers": f"early, {args.workers} workers"}
+    print(f"{'assignment':<14}{'first, cold':>12}" + "".join(f"{title:>21}" for title in columns.values())
+          + f"{'scores':>12}")
     for assignment in ASSIGNMENTS:
         cells = [f"{[r.seconds for r in runs['cold'][1] if r.assignment == assignment][0]:.1f}"]
-        for run in ("cold", "cached", "workers"):
+        for run in columns:
             seconds = [r.seconds for r in runs[run][1] if r.assignment == assignment]
             cells.append(f"{statistics.mean(seconds):.1f}")
         scores = {f"{r.score:g}/{r.max_score:g}" for _, results in runs.values() for r in results
                   if r.assignment == assignment}
-        print(f"{assignment:<14}{cells[0]:>12}{cells[1]:>12}{cells[2]:>14}{cells[3]:>18}{','.join(sorted(scores)):>12}")
-    print(f"\nseconds per step, mean of the cached run with 1 worker (budget {pipeline.GRADING_SECONDS:g} s idle, "
+        print(f"{assignment:<14}{cells[0]:>12}" + "".join(f"{cell:>21}" for cell in cells[1:])
+              + f"{','.join(sorted(scores)):>12}")
+    early_used = sum(bool(r.checked_early) for r in runs["early"][1])
+    print(f"\nthe early build and checks counted for {early_used} of {len(runs['early'][1])} submissions")
+    print(f"\nseconds per step, mean of the cached runs with 1 worker (budget {pipeline.GRADING_SECONDS:g} s idle, "
           f"per submission):")
-    print(f"{'assignment':<14}" + "".join(f"{name:>19}" for name in [*SHOWN_STEPS, "other"]))
+    print(f"{'assignment':<14}{'run':<12}" + "".join(f"{name:>23}" for name in [*SHOWN_STEPS, "other"]))
     for assignment in ASSIGNMENTS:
-        results = [r for r in runs["cached"][1] if r.assignment == assignment]
-        means = [statistics.mean(r.steps.get(name, 0.0) for r in results) for name in SHOWN_STEPS]
-        other = statistics.mean(sum(v for k, v in r.steps.items() if k not in SHOWN_STEPS) for r in results)
-        print(f"{assignment:<14}" + "".join(f"{value:>19.1f}" for value in [*means, other]))
-    one, many = runs["cached"][0], runs["workers"][0]
-    print(f"\nwall time: {runs['cold'][0]:.0f} s cold, {one:.0f} s cached (1 worker)")
-    count = len(runs["cached"][1])
+        for run in ("sequential", "early"):
+            results = [r for r in runs[run][1] if r.assignment == assignment]
+            means = [statistics.mean(r.steps.get(name, 0.0) for r in results) for name in SHOWN_STEPS]
+            other = statistics.mean(sum(v for k, v in r.steps.items() if k not in SHOWN_STEPS) for r in results)
+            print(f"{assignment:<14}{run:<12}" + "".join(f"{value:>23.1f}" for value in [*means, other]))
+    before, one, many = runs["sequential"][0], runs["early"][0], runs["workers"][0]
+    print(f"\nwall time: {runs['cold'][0]:.0f} s cold, {before:.0f} s cached sequential, {one:.0f} s cached early "
+          f"(1 worker): {before / one:.2f}x")
+    count = len(runs["early"][1])
     print(f"\n{count} submissions: {one:.0f} s with 1 worker, {many:.0f} s with {args.workers} workers: "
           f"speed-up {one / many:.2f}x")
     return 0
