@@ -83,11 +83,13 @@ class EarlyRun:
                 self._sandboxed, seconds=g.seconds_left(keep=self.build_keep), prefix=f"{FOLDER}-")
             if self._cancelled.is_set():
                 return
+            # An interface package the cache lacked was built at the course's cost: the grading's
+            # deadline moves back by its time (build_workspace does that for the grading itself).
             names = hidden_checks.graded_checks(g.sub)
             if names:
                 self.verdicts = hidden_checks.run_checks(
                     g.sub, names, g.work / f"{FOLDER}-checks", self.folder, g.domain_id, {**g.env, **self.built},
-                    g.hide, g.seconds_left(), run=self._sandboxed)
+                    g.hide, g.seconds_left() + self.interface_seconds, run=self._sandboxed)
         finally:
             self.seconds = round(time.monotonic() - started, 2)
 
