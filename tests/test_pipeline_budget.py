@@ -41,3 +41,28 @@ def test_the_report_shows_where_the_time_went():
 def test_the_budget_is_sixty_seconds_on_an_idle_machine_and_grows_with_the_load_up_to_a_bound():
     budget = pipeline.grading_budget()
     assert pipeline.GRADING_SECONDS <= budget <= pipeline.GRADING_SECONDS * pipeline.MAX_LOAD_FACTOR
+
+
+def test_the_checks_limits_grow_with_the_load_factor_the_grader_passes_on(monkeypatch):
+    """A call's and an import's limit, and a check's own timeout, are wall time: the grader passes
+    its budget's load factor on, and the checks scale them by it (never below the idle limits)."""
+    from course_lib.checks import context
+
+    monkeypatch.delenv(context.LOAD_FACTOR_ENV, raising=False)
+    assert context.scaled(context.CALL_TIMEOUT) == context.CALL_TIMEOUT
+    monkeypatch.setenv(context.LOAD_FACTOR_ENV, "3.5")
+    assert context.scaled(context.CALL_TIMEOUT) == 3.5 * context.CALL_TIMEOUT
+    monkeypatch.setenv(context.LOAD_FACTOR_ENV, "0.2")
+    assert context.scaled(context.IMPORT_TIMEOUT) == context.IMPORT_TIMEOUT
+    monkeypatch.setenv(context.LOAD_FACTOR_ENV, "busy")
+    assert context.scaled(context.IMPORT_TIMEOUT) == context.IMPORT_TIMEOUT
+
+
+def test_the_grader_tells_the_checks_its_load_factor(tmp_path):
+    from autograder.submissions import Submission
+    from course_lib.checks import context
+
+    sub = Submission("s", "brightness", tmp_path)
+    g = pipeline.Grading(sub, tmp_path, 0, GradeResult("s", "brightness", ""), tmp_path, budget=150.0)
+    pipeline.choose_environment(g)
+    assert g.env[context.LOAD_FACTOR_ENV] == "2.50"

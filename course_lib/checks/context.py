@@ -23,6 +23,20 @@ IMPORT_TIMEOUT = 15.0
 #: milliseconds; a call that prints a gigabyte needs several seconds on a busy machine.
 CALL_TIMEOUT = 20.0
 
+#: Set by the grader: how many times the idle machine's time limits a grading gets on this
+#: machine now (its load per core, autograder.pipeline.grading_budget). The limits above are wall
+#: time, so they grow with it: a busy machine gives each process a fraction of a core.
+LOAD_FACTOR_ENV = "AUTOGRADER_LOAD_FACTOR"
+
+
+def scaled(seconds: float) -> float:
+    """`seconds` times the grader's load factor (LOAD_FACTOR_ENV; 1 when unset or not a number)."""
+    try:
+        return seconds * max(1.0, float(os.environ.get(LOAD_FACTOR_ENV) or 1.0))
+    except ValueError:
+        return seconds
+
+
 #: Written into the work directory when the student's module did not import in time, so that
 #: later checks fail at once with the same reason instead of waiting again.
 IMPORT_HANG_MARK = ".autograder-import-hang"
@@ -115,8 +129,9 @@ class Context:
         self.images.append({"label": label, "file": name})
 
     def remaining(self) -> float:
-        """Seconds left of this check's timeout and of the grading's time (never below 1)."""
-        left = self.spec.timeout - (time.monotonic() - self._started)
+        """Seconds left of this check's timeout (scaled by the grader's load factor) and of the
+        grading's time (never below 1)."""
+        left = scaled(self.spec.timeout) - (time.monotonic() - self._started)
         if self.deadline is not None:
             left = min(left, self.deadline - time.monotonic())
         return max(1.0, left)
@@ -149,7 +164,7 @@ class Context:
             raise StudentError(f"{shown} does not exist: run the cell that starts with %%writefile {shown} "
                                "(it writes your module)")
         if (self.workdir / IMPORT_HANG_MARK).exists():
-            raise StudentError(f"importing {self.module} did not finish within {IMPORT_TIMEOUT:g} s in an "
+            raise StudentError(f"importing {self.module} did not finish within {scaled(IMPORT_TIMEOUT):.0f} s in an "
                                "earlier check: remove code that runs forever at import (loops, spin()) "
                                "from the top level of the module; put it in main()")
 
@@ -182,7 +197,7 @@ class Context:
             with server.lock:
                 self._import(server, self.module)
                 # Leaves the check a moment to report when the grading's time is nearly up.
-                limit = min(timeout or CALL_TIMEOUT, max(0.5, self.remaining() - 0.5))
+                limit = min(timeout or scaled(CALL_TIMEOUT), max(0.5, self.remaining() - 0.5))
                 self.waiting_on(f"{function} on {label} was running")
                 request, arrays = call_request(self.module, function, args, kwargs)
                 try:
@@ -212,18 +227,19 @@ class Context:
             if server.imported[module]:
                 raise StudentError(server.imported[module])
             return
-        wait = min(IMPORT_TIMEOUT, self.remaining())
+        allowed = scaled(IMPORT_TIMEOUT)
+        wait = min(allowed, self.remaining())
         self.waiting_on(f"importing {module} was running")
         try:
             answer = server.request({"kind": "import", "module": module}, None, wait, self.domain_id)
         except ServerError as error:
             if not error.timed_out:
                 raise StudentError(f"{module} could not be imported: importing it {error}") from None
-            if wait < IMPORT_TIMEOUT:
+            if wait < allowed:
                 raise StudentError(f"importing {module} did not finish within the {wait:.0f} s this check had left "
                                    "(the machine may be busy; the import itself took long)") from None
             _mark(self.workdir / IMPORT_HANG_MARK)
-            raise StudentError(f"importing {module} did not finish within {IMPORT_TIMEOUT:g} s: "
+            raise StudentError(f"importing {module} did not finish within {allowed:.0f} s: "
                                "remove code that runs forever at import (loops, spin()) from the "
                                "top level of the module; put it in main()") from None
         why = None
