@@ -101,9 +101,12 @@ hub: setup hub-deps
 	@if [ "$$(id -u)" != 0 ]; then echo "make hub runs the servers as the students' Linux accounts: run it as root"; exit 1; fi
 	$(PY) -m coursehub --hub-dir $(HUB_DIR) start
 
+# After the tests, Fast DDS's own tool removes the shared-memory segments of the processes the
+# tests killed (each holds up to 32 MB of memory in /dev/shm until removed; `python -m course_lib doctor` counts them).
 test: setup browser-deps hub-deps
 	$(PY) -m ruff check .
-	$(PY) -m pytest -n $(TEST_WORKERS) --dist loadfile $(PYTEST_ARGS)
+	$(PY) -m pytest -n $(TEST_WORKERS) --dist loadfile $(PYTEST_ARGS); status=$$?; \
+	PATH="$(VENV)/bin:$$PATH" fastdds shm clean >/dev/null 2>&1; exit $$status
 
 clean:
 	rm -rf $(VENV) .pytest_cache artifacts

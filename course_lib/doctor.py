@@ -9,12 +9,15 @@ discovery and transport are tested for real in the configured ROS_DOMAIN_ID.
 from __future__ import annotations
 
 import dataclasses
+import fcntl
 import importlib
 import os
 import platform
+import re
 import sys
 import time
 import uuid
+from pathlib import Path
 
 from course_lib import rosenv, waiting
 
@@ -158,6 +161,45 @@ def _check_large_data() -> Check:
                  "then restart the kernel", warning=True)
 
 
+#: Where Fast DDS keeps its shared-memory segments on Linux, and the lock file of each segment:
+#: fastrtps_<16 characters>_el, locked (flock) while the process that opened the segment runs.
+SHM_DIR = Path("/dev/shm")
+_SEGMENT_LOCK = re.compile(r"^fastrtps_[0-9a-z]{16}_el$")
+
+
+def stale_segments(folder: Path = SHM_DIR) -> list[Path]:
+    """The Fast DDS segments in `folder` whose process has ended without closing them (it was
+    killed): their lock file is not locked. Each holds memory until it is removed."""
+    stale = []
+    for lock in sorted(folder.glob("fastrtps_*_el")):
+        if not _SEGMENT_LOCK.match(lock.name):
+            continue
+        try:
+            with open(lock, "rb") as handle:
+                fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)  # released when closed
+        except OSError:
+            continue  # locked: its process runs (or the file just went)
+        stale.append(lock.with_name(lock.name[: -len("_el")]))
+    return stale
+
+
+def _check_shared_memory() -> Check:
+    """Fast DDS segments left in /dev/shm by killed processes (memory that nothing frees)."""
+    stale = stale_segments()
+    if not stale:
+        return Check("shared memory", True, "no Fast DDS segments left behind by ended processes")
+    held = 0
+    for segment in stale:
+        try:
+            held += segment.stat().st_blocks * 512
+        except OSError:
+            pass
+    return Check("shared memory", True, f"{len(stale)} Fast DDS segment(s) of processes that were killed hold "
+                 f"{held // 2**20} MB of memory in {SHM_DIR}",
+                 "run `fastdds shm clean` (Fast DDS's own tool, in this environment's bin/; it removes only "
+                 "segments whose process has ended)", warning=True)
+
+
 def _check_opencv() -> Check:
     try:
         import cv2
@@ -268,7 +310,7 @@ def run(live: bool = True, timeout: float = 15.0) -> Report:
     checks = [_check_python(), _check_install()]
     if checks[-1].ok:
         checks += [_check_messages(), _check_rmw()]
-    checks += [_check_network_settings(), _check_large_data(), _check_opencv()]
+    checks += [_check_network_settings(), _check_large_data(), _check_shared_memory(), _check_opencv()]
     if checks[1].ok:
         checks.append(_check_interface_builds())
         if live:

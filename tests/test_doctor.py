@@ -75,3 +75,34 @@ def test_a_small_dev_shm_is_a_warning_with_the_fix(monkeypatch):
     monkeypatch.setattr(rosenv, "shared_memory_mb", lambda: 64)
     line = camera_frames_line()
     assert line.ok and line.warning and "/dev/shm has 64 MB" in line.detail and "--shm-size=1g" in line.fix
+
+
+def test_a_killed_process_leaves_its_segment_which_fastdds_shm_clean_removes(domain_id):
+    """A ROS process killed with SIGKILL cannot close its Fast DDS segment: it stays in /dev/shm,
+    holding memory. The doctor says so and names Fast DDS's own tool, which removes it."""
+    import select
+    import signal
+    from pathlib import Path
+
+    code = ("import rclpy, rclpy.node, time; rclpy.init(); node = rclpy.node.Node('killed_here'); "
+            "print('ready', flush=True); time.sleep(60)")
+    before = set(doctor.SHM_DIR.glob("fastrtps_*"))
+    process = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True,
+                               env=rosenv.ros_environment(domain_id=domain_id))
+    try:
+        ready, _, _ = select.select([process.stdout], [], [], 60)
+        assert ready and process.stdout.readline().strip() == "ready"
+        running = {p for p in doctor.SHM_DIR.glob("fastrtps_*") if p not in before}
+        own = {p for p in running if doctor._SEGMENT_LOCK.match(p.name + "_el")}
+        assert own, "the process opened no shared-memory segment"
+        assert not own & set(doctor.stale_segments()), "a running process's segment is not stale"
+    finally:
+        process.send_signal(signal.SIGKILL)
+        process.wait(timeout=10)
+        process.stdout.close()
+    assert own <= set(doctor.stale_segments())
+    line = doctor._check_shared_memory().line()
+    assert line.startswith("[warn] shared memory:") and "fastdds shm clean" in line, line
+    fastdds = Path(sys.executable).parent / "fastdds"
+    subprocess.run([str(fastdds), "shm", "clean"], check=True, capture_output=True, timeout=60)
+    assert not any(p.exists() for p in own)
