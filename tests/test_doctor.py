@@ -86,15 +86,16 @@ def test_a_killed_process_leaves_its_segment_which_fastdds_shm_clean_removes(dom
 
     code = ("import rclpy, rclpy.node, time; rclpy.init(); node = rclpy.node.Node('killed_here'); "
             "print('ready', flush=True); time.sleep(60)")
-    before = set(doctor.SHM_DIR.glob("fastrtps_*"))
     process = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True,
                                env=rosenv.ros_environment(domain_id=domain_id))
     try:
         ready, _, _ = select.select([process.stdout], [], [], 60)
         assert ready and process.stdout.readline().strip() == "ready"
-        running = {p for p in doctor.SHM_DIR.glob("fastrtps_*") if p not in before}
-        own = {p for p in running if doctor._SEGMENT_LOCK.match(p.name + "_el")}
-        assert own, "the process opened no shared-memory segment"
+        # Its own segments: the ones it maps (other tests' processes make segments meanwhile).
+        maps = Path(f"/proc/{process.pid}/maps").read_text().split()
+        own = {Path(word) for word in maps if word.startswith(f"{doctor.SHM_DIR}/fastrtps_")
+               and doctor._SEGMENT_LOCK.match(Path(word).name + "_el")}
+        assert own, "the process mapped no shared-memory segment"
         assert not own & set(doctor.stale_segments()), "a running process's segment is not stale"
     finally:
         process.send_signal(signal.SIGKILL)
