@@ -22,7 +22,7 @@ import threading
 import time
 from pathlib import Path
 
-from autograder import hidden_checks, kernel, notebook_writes, packages, run_as
+from autograder import hidden_checks, kernel, notebook_writes, run_as
 from autograder.sandbox import run_sandboxed
 
 #: The folder in the grader's work folder that the early build and checks run in.
@@ -32,18 +32,18 @@ FOLDER = "early"
 class EarlyRun:
     """The early build and checks of one submission (see the module docstring), in a thread."""
 
-    def __init__(self, g, build_keep: float):
-        """`g`: the grading (autograder.pipeline.Grading); `build_keep`: seconds of its budget the
-        build leaves for the checks."""
-        self.g, self.build_keep = g, build_keep
+    def __init__(self, g, names: list[str], build):
+        """`g`: the grading (autograder.pipeline.Grading); `names`: the checks to run; `build`:
+        autograder.pipeline.build_for_checks (it moves the grading's deadline back by a cold
+        interface build, which the checks and outcome_for then see)."""
+        self.g, self.names, self.build = g, names, build
         self.folder = g.work / FOLDER / kernel.WORK_SUBDIR
         self.digest = ""
         self.built: dict = {}
-        self.interface_seconds = 0.0
         self.verdicts: dict | None = None
         self.seconds = 0.0
         self._cancelled = threading.Event()
-        self._running = []  # the sandboxed process of the current step
+        self._current = None  # the sandboxed process of the current step
         self._lock = threading.Lock()
         self._thread = threading.Thread(target=self._run, name=f"early {g.sub.key}", daemon=True)
 
@@ -51,9 +51,8 @@ class EarlyRun:
         """Write the predicted folder (a copy of the submitted one with the notebook's predicted
         files) and start building and checking it."""
         g = self.g
-        submitted = g.root / "submitted" / g.sub.student / g.sub.assignment
-        shutil.copytree(submitted, self.folder, symlinks=True, ignore=shutil.ignore_patterns(".ipynb_checkpoints"))
-        for notebook in sorted(submitted.glob("*.ipynb")):
+        shutil.copytree(g.submitted, self.folder, symlinks=True, ignore=shutil.ignore_patterns(".ipynb_checkpoints"))
+        for notebook in sorted(g.submitted.glob("*.ipynb")):
             notebook_writes.predicted_writes(notebook).apply(self.folder)
         self.digest = notebook_writes.folder_digest(self.folder)
         if g.result.kernel_uid is not None:
@@ -67,7 +66,7 @@ class EarlyRun:
         """autograder.sandbox.run_sandboxed, its process kept so that cancel() can stop it."""
         def keep(proc):
             with self._lock:
-                self._running[:] = [proc]
+                self._current = proc
             if self._cancelled.is_set():
                 proc.stop(timeout=2)
         return run_sandboxed(*args, **kwargs, on_start=keep)
@@ -76,20 +75,12 @@ class EarlyRun:
         g = self.g
         started = time.monotonic()
         try:
-            if not packages.needed(g.sub.assignment, self.folder):
-                return
-            self.built, self.interface_seconds = packages.build_for_checks(
-                g.sub.assignment, g.course, g.work, self.folder, g.result.kernel_uid, g.domain_id, g.env, g.hide,
-                self._sandboxed, seconds=g.seconds_left(keep=self.build_keep), prefix=f"{FOLDER}-")
+            self.built = self.build(g, self.folder, self._sandboxed, prefix=f"{FOLDER}-")
             if self._cancelled.is_set():
                 return
-            # An interface package the cache lacked was built at the course's cost: the grading's
-            # deadline moves back by its time (build_workspace does that for the grading itself).
-            names = hidden_checks.graded_checks(g.sub)
-            if names:
-                self.verdicts = hidden_checks.run_checks(
-                    g.sub, names, g.work / f"{FOLDER}-checks", self.folder, g.domain_id, {**g.env, **self.built},
-                    g.hide, g.seconds_left() + self.interface_seconds, run=self._sandboxed)
+            self.verdicts = hidden_checks.run_checks(
+                g.sub, self.names, g.work / f"{FOLDER}-checks", self.folder, g.domain_id, {**g.env, **self.built},
+                g.hide, g.seconds_left(), run=self._sandboxed)
         finally:
             self.seconds = round(time.monotonic() - started, 2)
 
@@ -97,22 +88,21 @@ class EarlyRun:
         """Stop the early run (its verdicts will not be used)."""
         self._cancelled.set()
         with self._lock:
-            running = list(self._running)
-        for proc in running:
-            proc.stop(timeout=2)
+            current = self._current
+        if current is not None:
+            current.stop(timeout=2)
         self._thread.join(10)
 
     def outcome_for(self, workdir: Path, names: list[str]):
         """The early (build variables, verdicts of `names`) when the notebook's run left `workdir`
         with exactly the predicted files, else None (the early run is then stopped). Waits for the
-        early run to end, at most until the grading's deadline (moved back by the time of an
-        interface package built at the course's cost)."""
+        early run to end, at most until the grading's deadline."""
         same = notebook_writes.folder_digest(workdir) == self.digest if Path(workdir).is_dir() else False
         if not same:
             self.cancel()
             return None
-        while self._thread.is_alive():  # until the deadline, moved back by a cold interface build
-            left = self.g.deadline + self.interface_seconds - time.monotonic()
+        while self._thread.is_alive():  # the deadline moves back when the build was a cold one
+            left = self.g.deadline - time.monotonic()
             if left <= 0:
                 break
             self._thread.join(min(left, 0.5))

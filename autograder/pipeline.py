@@ -114,6 +114,11 @@ class Grading:
         return self.work / "course"
 
     @property
+    def submitted(self) -> Path:
+        """The private copy of the submission that nbgrader grades."""
+        return self.root / "submitted" / self.sub.student / self.sub.assignment
+
+    @property
     def autograded(self) -> Path:
         return self.root / "autograded" / self.sub.student / self.sub.assignment
 
@@ -142,9 +147,9 @@ def stage_course_root(g: Grading) -> None:
     config.write_config(root)
     shutil.copyfile(g.course / "gradebook.db", root / "gradebook.db")
     os.chmod(root / "gradebook.db", 0o600)
-    private_copy(g.sub.path, root / "submitted" / g.sub.student / g.sub.assignment)
+    private_copy(g.sub.path, g.submitted)
     os.chmod(root / "submitted", 0o711)
-    os.chmod(root / "submitted" / g.sub.student, 0o711)
+    os.chmod(g.submitted.parent, 0o711)
     kernels = g.work / "jupyter" / "kernels" / "python3"
     kernels.mkdir(parents=True)
     (kernels / "kernel.json").write_text(json.dumps({
@@ -180,10 +185,9 @@ def choose_environment(g: Grading) -> None:
 def start_early_checks(g: Grading) -> None:
     """Build and check the files the notebook is predicted to write while it runs
     (autograder.early_checks); build_workspace decides afterwards whether they count."""
-    if os.environ.get(EARLY_CHECKS_ENV, "1") == "0":
-        return
-    if graded_checks(g.sub) and packages.needed(g.sub.assignment, g.root / "submitted" / g.sub.student / g.sub.assignment):
-        g.early = early_checks.EarlyRun(g, KEPT_FOR_CHECKS / 2).start()
+    names = graded_checks(g.sub)
+    if os.environ.get(EARLY_CHECKS_ENV, "1") != "0" and names and packages.needed(g.sub.assignment, g.submitted):
+        g.early = early_checks.EarlyRun(g, names, build_for_checks).start()
 
 
 def run_notebook(g: Grading) -> None:
@@ -227,7 +231,6 @@ def build_workspace(g: Grading) -> None:
             return
         outcome = early.outcome_for(g.workdir, graded_checks(g.sub, g.result))
         g.result.steps["early_build_and_checks"] = early.seconds
-        g.deadline += early.interface_seconds  # the course's cost, as below
         g.result.checked_early = outcome is not None
         if outcome is not None:
             built, g.early_verdicts = outcome
@@ -236,13 +239,21 @@ def build_workspace(g: Grading) -> None:
             return
     if g.failed or not packages.needed(g.sub.assignment, g.workdir):
         return
-    built, interface_seconds = packages.build_for_checks(
-        g.sub.assignment, g.course, g.work, g.workdir, g.result.kernel_uid, g.domain_id, g.env, g.hide,
-        run_sandboxed, seconds=g.seconds_left(keep=KEPT_FOR_CHECKS / 2))
-    # Building an interface package the cache did not have is the course's cost, not the student's.
-    g.deadline += interface_seconds
+    built = build_for_checks(g, g.workdir)
     g.env.update(built)
     g.result.detail += packages.instructor_note(built)
+
+
+def build_for_checks(g: Grading, workdir: Path, run=run_sandboxed, prefix: str = "") -> dict:
+    """Build workdir's workspace for the checks (autograder.packages.build_for_checks) within what
+    is left of the budget less half of KEPT_FOR_CHECKS; return the checks' variables. Building an
+    interface package the cache did not have is the course's cost, not the student's: the
+    deadline moves back by its time (also when the early run builds, in its thread)."""
+    built, interface_seconds = packages.build_for_checks(
+        g.sub.assignment, g.course, g.work, workdir, g.result.kernel_uid, g.domain_id, g.env, g.hide, run,
+        seconds=g.seconds_left(keep=KEPT_FOR_CHECKS / 2), prefix=prefix)
+    g.deadline += interface_seconds
+    return built
 
 
 def run_hidden_checks(g: Grading) -> None:

@@ -61,7 +61,7 @@ def wait_for_discovery(minimum: float | None = None, quiet: float = _SETTLE_QUIE
     minimum = SETTLE_SECONDS if minimum is None else minimum
     complete_within = COMPLETE_SECONDS if complete_within is None else complete_within
     here = _participants_here(node.context.get_domain_id()) if complete_within else 0
-    seen = {"graph": _snapshot(node), "since": time.monotonic(), "checks": 0}
+    seen = {"graph": _snapshot(node), "since": time.monotonic(), "checks": 0, "complete": not here}
 
     def settled():
         if seen["checks"]:  # after each wait, look again; a change restarts the quiet time
@@ -71,8 +71,9 @@ def wait_for_discovery(minimum: float | None = None, quiet: float = _SETTLE_QUIE
         seen["checks"] += 1
         now = time.monotonic()
         age = now - node.created_at
-        missing = age < complete_within and _participants_with_nodes(node) < here
-        return age >= minimum and now - seen["since"] >= quiet and not missing
+        if not seen["complete"]:  # once every process has shown its nodes, no need to count again
+            seen["complete"] = age >= complete_within or _participants_with_nodes(node) >= here
+        return age >= minimum and now - seen["since"] >= quiet and seen["complete"]
 
     waiting.spin_until(settled, max(0.0, _SETTLE_MAX - (time.monotonic() - node.created_at)), poll=_SETTLE_POLL)
     _settled_node = node
