@@ -1,6 +1,7 @@
 """Tests for course_lib.doctor: it passes here, and each failure it can find names the fix."""
 
 import os
+import shutil
 import subprocess
 import sys
 
@@ -104,6 +105,8 @@ def test_a_killed_process_leaves_its_segment_which_fastdds_shm_clean_removes(dom
     assert own <= set(doctor.stale_segments())
     line = doctor._check_shared_memory().line()
     assert line.startswith("[warn] shared memory:") and "fastdds shm clean" in line, line
-    fastdds = Path(sys.executable).parent / "fastdds"
-    subprocess.run([str(fastdds), "shm", "clean"], check=True, capture_output=True, timeout=60)
+    # The pip wheels install it beside this interpreter; a system ROS install has it on PATH.
+    fastdds = shutil.which("fastdds", path=os.pathsep.join([str(Path(sys.executable).parent), os.environ["PATH"]]))
+    assert fastdds, "Fast DDS's fastdds tool is not installed"
+    subprocess.run([fastdds, "shm", "clean"], check=True, capture_output=True, timeout=60)
     assert not any(p.exists() for p in own)
