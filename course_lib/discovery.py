@@ -72,11 +72,24 @@ def wait_for_discovery(minimum: float | None = None, quiet: float = _SETTLE_QUIE
         now = time.monotonic()
         age = now - node.created_at
         if not seen["complete"]:  # once every process has shown its nodes, no need to count again
-            seen["complete"] = age >= complete_within or _participants_with_nodes(node) >= here
+            seen["complete"] = age >= complete_within or _every_process_shown(node, here)
         return age >= minimum and now - seen["since"] >= quiet and seen["complete"]
 
     waiting.spin_until(settled, max(0.0, _SETTLE_MAX - (time.monotonic() - node.created_at)), poll=_SETTLE_POLL)
     _settled_node = node
+
+
+def wait_for_every_process(timeout: float) -> bool:
+    """Wait, up to `timeout` s from now, until the tool node knows the nodes of every ROS process
+    on this machine in its domain. True if it does; a process that has called rclpy.init() but
+    made no node yet keeps it waiting until the timeout."""
+    node = session.tool_node()
+    here = _participants_here(node.context.get_domain_id())
+    return waiting.spin_until(lambda: _every_process_shown(node, here), timeout, poll=_SETTLE_POLL)
+
+
+def _every_process_shown(node, here: int) -> bool:
+    return _participants_with_nodes(node) >= here
 
 
 #: Topics every node publishes on (unless told not to): their publishers show its participant.

@@ -162,6 +162,7 @@ class NodeProcess:
         self.exit_reason: str | None = None
         self.usage: dict | None = None
         self.warned_duplicate = False  # start() said that another program runs one of this name
+        self._nodes_before: dict[str, str] = {}  # the session's nodes when start() began, by /rosout gid
         self._supervisor: subprocess.Popen | None = None
         self._control: int | None = None
         self._status: int | None = None
@@ -193,6 +194,7 @@ class NodeProcess:
                 for other in _running_processes():
                     if other is not self and other._explicit_name and other.name == self.name:
                         other.stop()
+            self._nodes_before = _session_nodes(self.domain_id)
             env = dict(self.env)
             self._log_dir = Path(tempfile.mkdtemp(prefix="course_lib-node-"))
             cleanup = [str(self._log_dir), *map(str, self._private_dirs)]
@@ -351,7 +353,9 @@ class NodeProcess:
         elif namespace is not None:
             namespace = "/" + namespace.strip("/")
         wanted = node_name if namespace is None else f"{namespace.rstrip('/')}/{node_name}"
-        already_running = _in_session_graph(node_name, namespace, self.domain_id)
+        already_running = {gid: full for gid, full in self._nodes_before.items()
+                           if full.rsplit("/", 1)[-1] == node_name
+                           and (namespace is None or full == f"{namespace.rstrip('/')}/{node_name}")}
         context = Context()
         rclpy.init(context=context, domain_id=self.domain_id)
         watcher = None
@@ -529,20 +533,23 @@ class NodeProcess:
 #: Seconds a node of the same name that ran before a new node process started may take to
 #: leave the graph (a re-run cell stopped it a moment ago) before wait_for_node warns.
 DUPLICATE_GRACE = 2.0
+#: Seconds start() waits at most for the session to see the nodes of every other ROS process on
+#: this machine (on a busy machine, discovery of a process started a moment ago takes seconds).
+EARLIER_NODES_WAIT = 2.0
 
 
-def _in_session_graph(node_name: str, namespace: str | None, domain_id: int) -> dict[str, str]:
-    """The nodes of this name that the notebook's ROS session sees (none when no session runs
-    on this domain), as {id of the node's /rosout publisher: full node name}. Node names are not
-    unique; the publisher id tells one node from another of the same name."""
-    from course_lib import graph, session
+def _session_nodes(domain_id: int) -> dict[str, str]:
+    """The nodes the notebook's ROS session sees (none when no session runs on this domain), as
+    {id of the node's /rosout publisher: full node name}, once every other ROS process on this
+    machine has shown its nodes (a node started a moment ago, in a busy machine, may take seconds).
+    Node names are not unique; the publisher id tells one node from another of the same name."""
+    from course_lib import discovery, graph, session
 
     if not session.is_running() or session.tool_node().context.get_domain_id() != domain_id:
         return {}
     graph.node_list()  # the first query waits for discovery
-    return {str(endpoint.endpoint_gid): full for endpoint, full in _rosout_publishers(session.tool_node())
-            if full.rsplit("/", 1)[-1] == node_name
-            and (namespace is None or full == f"{namespace.rstrip('/')}/{node_name}")}
+    discovery.wait_for_every_process(EARLIER_NODES_WAIT)
+    return {str(endpoint.endpoint_gid): full for endpoint, full in _rosout_publishers(session.tool_node())}
 
 
 def _rosout_publishers(node):

@@ -103,6 +103,21 @@ def test_wait_for_node_warns_when_another_program_runs_a_node_of_that_name(talke
         session.stop()
 
 
+def test_a_node_is_not_taken_for_an_earlier_one_when_its_wait_comes_late(talker_dir, domain_id, capsys):
+    """The nodes that ran before are the ones the session saw when start() began: a talker that the
+    session already sees when wait_for_node is called (a later cell) is not a second talker."""
+    from course_lib import graph, session
+
+    session.start(domain_id=domain_id)
+    try:
+        with python_node("course_talker:main", cwd=talker_dir, domain_id=domain_id, name="camera") as talker:
+            assert "/talker" in graph.node_list(wait_for=["/talker"], timeout=30)
+            talker.wait_for_node("talker", timeout=30)
+        assert "Warning" not in capsys.readouterr().out
+    finally:
+        session.stop()
+
+
 LEFT_RUNNING = """
 import sys, time
 from course_lib.processes import NodeProcess
