@@ -4,9 +4,10 @@ The checks read only files: the package the notebook writes (``ros2_ws/src/...``
 handed in beside it. Those files are predicted from the notebook without running it
 (autograder.notebook_writes: its ``%%writefile`` cells, ``!mkdir -p`` and ``!touch`` lines) and
 written into a folder of the submission's own, a copy of the submitted folder; there the
-submission is built and checked (the same build and checks as afterwards, in the same sandbox,
-as the student's uid) while nbgrader runs the notebook. When the notebook has run, the grader
-compares the files of the folder it ran in with the predicted ones
+submission is built and checked (the same build and checks as afterwards, in the same sandbox;
+as root, as a student uid of their own that the kernel's code cannot reach) while nbgrader runs
+the notebook. When the notebook has run, the grader compares the files of the folder it ran in
+with the predicted ones
 (notebook_writes.folder_digest): equal, the early build and verdicts are the submission's;
 different (a cell wrote a file some other way, or failed), they are dropped and the grader builds
 and checks the files the notebook wrote, as it would have without this.
@@ -22,7 +23,7 @@ import threading
 import time
 from pathlib import Path
 
-from autograder import hidden_checks, kernel, notebook_writes, run_as
+from autograder import hidden_checks, kernel, notebook_writes, run_as, student_uid
 from autograder.sandbox import run_sandboxed
 
 #: The folder in the grader's work folder that the early build and checks run in.
@@ -55,8 +56,8 @@ class EarlyRun:
         for notebook in sorted(g.submitted.glob("*.ipynb")):
             notebook_writes.predicted_writes(notebook).apply(self.folder)
         self.digest = notebook_writes.folder_digest(self.folder)
-        if g.result.kernel_uid is not None:
-            run_as.give_tree(self.folder, g.result.kernel_uid)
+        if g.early_uid is not None:
+            run_as.give_tree(self.folder, g.early_uid)
         self.folder.parent.chmod(0o711)
         self.folder.chmod(0o700)
         self._thread.start()
@@ -75,11 +76,14 @@ class EarlyRun:
         g = self.g
         started = time.monotonic()
         try:
-            self.built = self.build(g, self.folder, self._sandboxed, prefix=f"{FOLDER}-")
+            self.built = self.build(g, self.folder, self._sandboxed, early=True)
             if self._cancelled.is_set():
                 return
+            env = {**g.env, **self.built}
+            if g.early_uid is not None:
+                env[student_uid.STUDENT_UID_ENV] = str(g.early_uid)
             self.verdicts = hidden_checks.run_checks(
-                g.sub, self.names, g.work / f"{FOLDER}-checks", self.folder, g.domain_id, {**g.env, **self.built},
+                g.sub, self.names, g.work / f"{FOLDER}-checks", self.folder, g.domain_id, env,
                 g.hide, g.seconds_left(), run=self._sandboxed)
         finally:
             self.seconds = round(time.monotonic() - started, 2)

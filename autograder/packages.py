@@ -11,7 +11,15 @@ by the notebook's ``%%writefile`` cells). After the notebook ran, the grader bui
   package's files and of this environment), so a class that hands in identical ``.msg`` files
   costs one CMake build; the workspace's other packages are built on top of the cached install
   (an underlay, as ``source other_ws/install/setup.bash`` before ``colcon build
-  --packages-ignore <interface packages>``).
+  --packages-ignore <interface packages>``);
+- the other packages are built as the assignment's build cell builds them (``colcon build
+  --symlink-install``), and a successful build is kept too (:class:`WorkspaceBuilds`, keyed by
+  :func:`workspace_key`): with ``--symlink-install`` an ament_python build holds links to the
+  package's modules, not copies, so it depends on every file of ``src/`` except the modules'
+  contents (their names count). A class whose package.xml, setup.py and setup.cfg are the
+  release's gets one build; every later identical workspace gets a copy of it, its paths moved to
+  its own folder. (A setup.py that reads its package's modules while building, which ROS packages
+  do not do, would get the build of the first such submission.)
 
 The outcome is a :class:`BuildReport` (written as JSON for the checks, see
 course_lib.checks.packages): when the build failed, its ``reason`` quotes the first error lines of
@@ -59,6 +67,8 @@ class BuildReport:
         packages: the packages of the workspace's src/.
         cached: interface packages taken from the cache (not built again).
         built_interfaces: interface packages built now (and put in the cache).
+        reused: the other packages were not built again: an identical workspace's build was
+            copied (WorkspaceBuilds).
         seconds: wall time of the whole build.
         reference_underlays: install prefixes of the assignment's reference interface packages,
             built by the grader (the checks' own nodes use these, never code the student built).
@@ -71,6 +81,7 @@ class BuildReport:
     packages: list[str] = dataclasses.field(default_factory=list)
     cached: list[str] = dataclasses.field(default_factory=list)
     built_interfaces: list[str] = dataclasses.field(default_factory=list)
+    reused: bool = False
     seconds: float = 0.0
     reference_underlays: list[str] = dataclasses.field(default_factory=list)
     log: str = ""
@@ -150,17 +161,121 @@ class InterfaceCache:
         return None, None
 
     def store(self, key: str, install: Path | None, reason: str = "") -> None:
-        self.root.mkdir(parents=True, exist_ok=True)
-        staging = self.root / f".{key}.{os.getpid()}.{time.monotonic_ns()}"
-        staging.mkdir()
-        if install is not None:
-            shutil.copytree(install, staging / "install", symlinks=True)
-        else:
-            (staging / "failed.txt").write_text(reason)
+        def fill(staging: Path) -> None:
+            if install is not None:
+                shutil.copytree(install, staging / "install", symlinks=True)
+            else:
+                (staging / "failed.txt").write_text(reason)
+        _store_atomically(self.entry(key), fill)
+
+
+def _store_atomically(entry: Path, fill) -> None:
+    """Make the folder `entry` appear whole: `fill(folder)` fills a staging folder beside it,
+    which is then renamed; when another worker stored the same entry meanwhile, theirs stays."""
+    entry.parent.mkdir(parents=True, exist_ok=True)
+    staging = entry.parent / f".{entry.name}.{os.getpid()}.{time.monotonic_ns()}"
+    staging.mkdir()
+    try:
+        fill(staging)
+        os.rename(staging, entry)
+    except OSError:
+        shutil.rmtree(staging, ignore_errors=True)
+
+
+#: Set to 0 to build every workspace with colcon even when an identical one was built before.
+REUSE_BUILDS_ENV = "AUTOGRADER_REUSE_BUILDS"
+#: What colcon and setuptools make of a workspace depends on their versions too.
+_BUILD_TOOLS = ("colcon-core", "colcon-ros", "colcon-python-setup-py", "setuptools")
+
+
+def workspace_key(src: Path, interface_keys=()) -> str:
+    """The key of a workspace's ``colcon build --symlink-install``: the names of every file of
+    `src` and the bytes of all but the Python modules (setup.py's count), the keys of the
+    interface packages it builds on, this interpreter, the build tools' versions and
+    CACHE_VERSION."""
+    from importlib import metadata
+
+    versions = []
+    for tool in _BUILD_TOOLS:
         try:
-            os.rename(staging, self.entry(key))
-        except OSError:  # another worker stored the same key meanwhile: theirs is as good
-            shutil.rmtree(staging, ignore_errors=True)
+            versions.append(f"{tool}={metadata.version(tool)}")
+        except metadata.PackageNotFoundError:
+            versions.append(f"{tool}=none")
+    digest = hashlib.sha256(f"{CACHE_VERSION}\0{sys.version}\0{sys.prefix}\0{' '.join(versions)}\0".encode())
+    for key in interface_keys:
+        digest.update(key.encode() + b"\0")
+    for path in sorted(p for p in Path(src).rglob("*") if p.is_file() or p.is_symlink()):
+        relative = path.relative_to(src)
+        if any(part in ("__pycache__", ".ipynb_checkpoints") for part in relative.parts):
+            continue
+        digest.update(str(relative).encode() + b"\0")
+        if path.is_symlink():
+            digest.update(b"link " + os.readlink(path).encode() + b"\0")
+        elif path.suffix != ".py" or path.name == "setup.py":
+            digest.update(path.read_bytes() + b"\0")
+    return digest.hexdigest()[:32]
+
+
+class WorkspaceBuilds:
+    """Successful workspace builds (``build/`` and ``install/``), one folder per workspace_key,
+    with the folders they were built in (``paths.json``): a copy of one, those paths replaced by
+    another workspace's in every file and link, is what colcon would have built there. Written
+    by the grader only, from builds no other code of the student's uid ran beside (see
+    build_for_checks)."""
+
+    def __init__(self, root: Path):
+        self.root = Path(root)
+
+    def entry(self, key: str) -> Path:
+        return self.root / key
+
+    def restore(self, key: str, ws: Path, scratch: Path) -> bool:
+        """Copy the build of `key` into `ws` (which has neither build/ nor install/) for a build
+        whose scratch folder is `scratch`; False when there is none."""
+        entry = self.entry(key)
+        try:
+            paths = json.loads((entry / "paths.json").read_text())
+        except (OSError, ValueError):
+            return False
+        moves = sorted({paths["workspace"]: str(ws), paths["scratch"]: str(scratch)}.items(),
+                       key=lambda move: -len(move[0]))
+        for folder in ("build", "install"):
+            shutil.copytree(entry / folder, Path(ws) / folder, symlinks=True)
+            _relocate(Path(ws) / folder, moves)
+        return True
+
+    def store(self, key: str, ws: Path, scratch: Path) -> None:
+        def fill(staging: Path) -> None:
+            for folder in ("build", "install"):
+                shutil.copytree(Path(ws) / folder, staging / folder, symlinks=True)
+            (staging / "paths.json").write_text(json.dumps({"workspace": str(ws), "scratch": str(scratch)}))
+        _store_atomically(self.entry(key), fill)
+
+
+def _relocate(tree: Path, moves: list[tuple[str, str]]) -> None:
+    """Replace the old paths of `moves` by the new ones in every link target and file of `tree`."""
+    def moved(text: str) -> str:
+        for old, new in moves:
+            text = text.replace(old, new)
+        return text
+
+    for directory, dirs, files in os.walk(tree):
+        for name in [*files, *dirs]:
+            path = os.path.join(directory, name)
+            if os.path.islink(path):
+                target = os.readlink(path)
+                if moved(target) != target:
+                    os.unlink(path)
+                    os.symlink(moved(target), path)
+            elif name in files:
+                with open(path, "rb") as handle:
+                    data = handle.read()
+                changed = data
+                for old, new in moves:
+                    changed = changed.replace(old.encode(), new.encode())
+                if changed != data:
+                    with open(path, "wb") as handle:
+                        handle.write(changed)
 
 
 # ---- building ----------------------------------------------------------------------------------
@@ -224,8 +339,10 @@ def _readable(path: Path) -> None:
                 os.chmod(file, os.stat(file).st_mode | 0o444)
 
 
-def build_workspace(ws: Path, cache: InterfaceCache, scratch: Path, run, give=None) -> BuildReport:
-    """Build the workspace `ws` (interface packages from `cache`); see the module docstring.
+def build_workspace(ws: Path, cache: InterfaceCache, scratch: Path, run, give=None,
+                    builds: WorkspaceBuilds | None = None, store: bool = True) -> BuildReport:
+    """Build the workspace `ws` (interface packages from `cache`, the others' build from `builds`
+    when an identical workspace was built before); see the module docstring.
 
     Args:
         ws: the submission's workspace (``<notebook folder>/ros2_ws``), writable by the student's uid.
@@ -234,6 +351,8 @@ def build_workspace(ws: Path, cache: InterfaceCache, scratch: Path, run, give=No
         run: ``run(command, cwd, env, wall_seconds) -> (returncode or None, output)``: runs a
             command sandboxed as the student's uid (autograder.grading); a plain subprocess in tests.
         give: ``give(path)``, hands a folder the grader created to the student's uid (None: nothing).
+        builds: where successful builds are kept (None: always run colcon).
+        store: keep this build in `builds` (only when no other code of the student's ran beside it).
 
     Returns:
         The BuildReport (never raises for the student's faults).
@@ -274,9 +393,22 @@ def build_workspace(ws: Path, cache: InterfaceCache, scratch: Path, run, give=No
             _readable(underlay.parent)
         underlays.append(underlay)
     skip = ["--packages-ignore", *interfaces] if interfaces else []
-    ok, output = _colcon(ws, skip, _underlay_env(base, underlays), run)
+    key = None
+    if builds is not None and os.environ.get(REUSE_BUILDS_ENV, "1") != "0" \
+            and not (ws / "build").exists() and not (ws / "install").exists():
+        key = workspace_key(ws / "src", list(keys.values()))
+        if builds.restore(key, ws, scratch):
+            if give is not None:
+                give(ws / "build")
+                give(ws / "install")
+            report.ok = report.reused = True
+            report.seconds = round(time.monotonic() - started, 1)
+            return report
+    ok, output = _colcon(ws, ["--symlink-install", *skip], _underlay_env(base, underlays), run)
     if ok:
         report.ok = True
+        if key is not None and store:
+            builds.store(key, ws, scratch)
     else:
         report.reason = _reason(output)
         report.log = output[-4000:]
@@ -338,9 +470,14 @@ def cache_of(course: Path) -> InterfaceCache:
     return InterfaceCache(Path(course) / "autograder" / ".interface-cache")
 
 
+def builds_of(course: Path) -> WorkspaceBuilds:
+    """The course's kept workspace builds: COURSE_DIR/autograder/.workspace-builds."""
+    return WorkspaceBuilds(Path(course) / "autograder" / ".workspace-builds")
+
+
 def build_for_checks(assignment: str, course: Path, work: Path, workdir: Path, uid: int | None, domain_id: int,
                      grader_env: dict, hide: list[Path], run_sandboxed,
-                     seconds: float = BUILD_SECONDS, prefix: str = "") -> tuple[dict, float]:
+                     seconds: float = BUILD_SECONDS, prefix: str = "", store: bool = True) -> tuple[dict, float]:
     """Build the submission's workspace (``workdir/ros2_ws``) in the sandbox as the student's uid
     (autograder.run_as),
     write the report into the grader's `work` folder, and return the variables that tell the
@@ -354,6 +491,8 @@ def build_for_checks(assignment: str, course: Path, work: Path, workdir: Path, u
             BUILD_SECONDS of its own, outside this budget.
         prefix: of the names of the grader's folder and report in `work` (a second build of the
             same submission keeps apart: autograder.early_checks).
+        store: keep a successful build for identical workspaces (builds_of): only when no other
+            code runs as `uid` meanwhile (a kernel of the same uid could change the build).
     """
     from autograder import run_as
     from course_lib import processes
@@ -396,7 +535,7 @@ def build_for_checks(assignment: str, course: Path, work: Path, workdir: Path, u
         return (None if proc.exit_reason == "wall_seconds" else proc.returncode), proc.log
 
     cache = cache_of(course)
-    report = build_workspace(Path(workdir) / WORKSPACE, cache, scratch, run, give)
+    report = build_workspace(Path(workdir) / WORKSPACE, cache, scratch, run, give, builds_of(course), store)
     try:
         report.reference_underlays = [str(p) for p in reference_interfaces(assignment, cache, scratch)]
     except RuntimeError as error:  # the course's fault: the checks that need messages say so
@@ -467,12 +606,14 @@ def local_cache() -> InterfaceCache:
 
 def build_here(assignment: str, workdir: Path, cache: InterfaceCache | None = None) -> BuildReport:
     """Build workdir/ros2_ws as the grader does, without a sandbox (reference solutions, tests,
-    benchmarks). The report goes to workdir/.colcon/build-report.json; checks run with
-    REPORT_ENV set to it use this build (see course_lib.checks.packages)."""
+    benchmarks), a build of an identical workspace reused (kept beside `cache`). The report goes
+    to workdir/.colcon/build-report.json; checks run with REPORT_ENV set to it use this build
+    (see course_lib.checks.packages)."""
     scratch = Path(workdir) / ".colcon"
     scratch.mkdir(exist_ok=True)
     cache = cache or local_cache()
-    report = build_workspace(Path(workdir) / WORKSPACE, cache, scratch, run_here)
+    builds = WorkspaceBuilds(cache.root.with_name(cache.root.name + "-workspaces"))
+    report = build_workspace(Path(workdir) / WORKSPACE, cache, scratch, run_here, builds=builds)
     report.reference_underlays = [str(p) for p in reference_interfaces(assignment, cache, scratch)]
     report.write(scratch / "build-report.json")
     return report
@@ -483,11 +624,16 @@ def report_path(workdir: Path) -> Path:
     return Path(workdir) / ".colcon" / "build-report.json"
 
 
-def instructor_note(variables: dict) -> str:
-    """For the grading report: what failed in the build whose report `variables` (build_for_checks)
-    names, with the end of its output ("" when it built)."""
+def read_report(variables: dict) -> BuildReport | None:
+    """The report of the build whose variables (build_for_checks) name it; None when unreadable."""
     try:
-        report = BuildReport.read(Path(variables[REPORT_ENV]))
+        return BuildReport.read(Path(variables[REPORT_ENV]))
     except (KeyError, OSError, ValueError, TypeError):
+        return None
+
+
+def instructor_note(report: BuildReport | None) -> str:
+    """For the grading report: what failed in the build, with the end of its output ("" when it built)."""
+    if report is None or report.ok:
         return ""
-    return "" if report.ok else f"\nThe workspace did not build: {report.reason}\n{report.log[-1500:]}"
+    return f"\nThe workspace did not build: {report.reason}\n{report.log[-1500:]}"

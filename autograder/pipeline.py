@@ -74,6 +74,9 @@ FILE_MB = 256
 NPROC = 384
 #: Base of the per-worker uids (root only): uid = KERNEL_UID_BASE + reserved ROS domain id.
 KERNEL_UID_BASE = 61000
+#: The early build and checks run as the worker's uid + EARLY_UID_OFFSET: the kernel, which runs
+#: beside them, cannot change their files (a build kept for identical workspaces among them).
+EARLY_UID_OFFSET = 1000
 
 
 def _cell_scores(root: Path, sub: Submission) -> list[dict]:
@@ -117,6 +120,11 @@ class Grading:
     def submitted(self) -> Path:
         """The private copy of the submission that nbgrader grades."""
         return self.root / "submitted" / self.sub.student / self.sub.assignment
+
+    @property
+    def early_uid(self) -> int | None:
+        """The uid of the early build and checks (root only; autograder.early_checks)."""
+        return None if self.result.kernel_uid is None else self.result.kernel_uid + EARLY_UID_OFFSET
 
     @property
     def autograded(self) -> Path:
@@ -234,24 +242,35 @@ def build_workspace(g: Grading) -> None:
         g.result.checked_early = outcome is not None
         if outcome is not None:
             built, g.early_verdicts = outcome
-            g.env.update(built)
-            g.result.detail += packages.instructor_note(built)
+            _use_build(g, built)
             return
     if g.failed or not packages.needed(g.sub.assignment, g.workdir):
         return
-    built = build_for_checks(g, g.workdir)
+    _use_build(g, build_for_checks(g, g.workdir))
+
+
+def _use_build(g: Grading, built: dict) -> None:
+    """The checks' variables of a build (build_for_checks), and what the report says of it."""
     g.env.update(built)
-    g.result.detail += packages.instructor_note(built)
+    report = packages.read_report(built)
+    g.result.build_reused = bool(report and report.reused)
+    g.result.detail += packages.instructor_note(report)
 
 
-def build_for_checks(g: Grading, workdir: Path, run=run_sandboxed, prefix: str = "") -> dict:
+def build_for_checks(g: Grading, workdir: Path, run=run_sandboxed, early: bool = False) -> dict:
     """Build workdir's workspace for the checks (autograder.packages.build_for_checks) within what
     is left of the budget less half of KEPT_FOR_CHECKS; return the checks' variables. Building an
     interface package the cache did not have is the course's cost, not the student's: the
-    deadline moves back by its time (also when the early run builds, in its thread)."""
+    deadline moves back by its time (also when the early run builds, in its thread).
+
+    `early`: the build runs beside the notebook (autograder.early_checks), as Grading.early_uid,
+    with folders of its own; it is kept for identical workspaces only when that uid is not the
+    kernel's (as root)."""
+    uid = g.early_uid if early else g.result.kernel_uid
     built, interface_seconds = packages.build_for_checks(
-        g.sub.assignment, g.course, g.work, workdir, g.result.kernel_uid, g.domain_id, g.env, g.hide, run,
-        seconds=g.seconds_left(keep=KEPT_FOR_CHECKS / 2), prefix=prefix)
+        g.sub.assignment, g.course, g.work, workdir, uid, g.domain_id, g.env, g.hide, run,
+        seconds=g.seconds_left(keep=KEPT_FOR_CHECKS / 2), prefix=f"{early_checks.FOLDER}-" if early else "",
+        store=not early or uid is not None)
     g.deadline += interface_seconds
     return built
 

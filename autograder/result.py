@@ -24,6 +24,8 @@ class GradeResult:
     # The build and checks run while the notebook ran (autograder.early_checks): True when they
     # counted, False when the notebook wrote other files and they ran again, None when not tried.
     checked_early: bool | None = None
+    # The workspace build of an identical workspace was copied (autograder.packages.WorkspaceBuilds).
+    build_reused: bool = False
 
     @classmethod
     def from_dict(cls, data: dict) -> "GradeResult":

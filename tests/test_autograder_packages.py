@@ -67,7 +67,7 @@ def test_identical_interface_packages_are_built_once(tmp_path):
     interface_builds = [cwd for cwd, _ in colcon.calls if "interfaces" in cwd.parts]
     assert len(interface_builds) == 1
     workspace_builds = [args for cwd, args in colcon.calls if cwd.name == "ros2_ws"]
-    assert workspace_builds == [["--packages-ignore", "tutorial_interfaces"]] * 2
+    assert workspace_builds == [["--symlink-install", "--packages-ignore", "tutorial_interfaces"]] * 2
 
 
 def test_a_changed_message_is_built_again(tmp_path):
