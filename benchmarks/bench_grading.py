@@ -1,24 +1,26 @@
-"""How long the autograder takes per submission, cold and with the interface build cached, before
-and after the early build and checks, and what a second worker buys, in one run.
+"""How long the autograder takes per submission, cold and with the builds kept, before and after
+the early build and checks, and what a second worker buys, in one run.
 
 Not a test: the times depend on the machine and on what else runs, so this prints them instead
 of asserting them. It releases the three assignments into a scratch course, hands in the
-reference solution of each for --students students, then grades the whole class four times with
-the real nbgrader CLI, everything graded again each time: with one worker and an empty interface
-cache (cold: each assignment's first submission builds its message package); with one worker, the
-cache kept (every message package reused) and the steps one after another
-(AUTOGRADER_EARLY_CHECKS=0: "sequential", the grader before autograder.early_checks); the same
-with the build and checks overlapping the notebook's run ("early", the default); and with
---workers workers.
+reference solution of each for --students students, then grades the whole class five times with
+the real nbgrader CLI, everything graded again each time: with one worker and nothing kept (cold:
+each assignment's first submission builds its message package and its workspace); with one
+worker, the message packages kept, every workspace built by colcon and the steps one after another
+(AUTOGRADER_EARLY_CHECKS=0 and AUTOGRADER_REUSE_BUILDS=0: "sequential", the grader before
+autograder.early_checks); the same with the build and checks overlapping the notebook's run
+("built"); the same with the build of an identical workspace copied ("early", the default: a class
+whose package.xml, setup.py and setup.cfg are the release's builds once); and with --workers
+workers.
 
     .venv/bin/python benchmarks/bench_grading.py [--students 2] [--workers 2]
 
 Per assignment it prints the seconds per submission: the first submission of the cold run, and
-the mean of each run; then the mean seconds of each pipeline step in the two cached one-worker
+the mean of each run; then the mean seconds of each pipeline step in the three cached one-worker
 runs (GradeResult.steps: nbgrader's notebook run, the early build and checks beside it, the colcon
 build of the workspace and the grader's own run of the hidden checks after it, and the rest),
-then the wall time of each run and the ratio of the two early runs, which is the speed-up of the
-extra workers on this machine.
+then the wall time of each run, the ratios of the sequential run to the early ones, and the
+ratio of the two early runs, which is the speed-up of the extra workers on this machine.
 """
 
 from __future__ import annotations
@@ -44,8 +46,9 @@ ASSIGNMENTS = ["brightness", "pubsub", "catdog_warp"]
 SHOWN_STEPS = ["run_notebook", "early_build_and_checks", "build_workspace", "run_hidden_checks"]
 
 
-def timed_grade(course: Path, workers: int, early: bool = True) -> tuple[float, list]:
+def timed_grade(course: Path, workers: int, early: bool = True, reuse: bool = True) -> tuple[float, list]:
     os.environ[pipeline.EARLY_CHECKS_ENV] = "1" if early else "0"
+    os.environ[packages.REUSE_BUILDS_ENV] = "1" if reuse else "0"
     started = time.monotonic()
     results = grading.grade(course, workers=workers, force=True, progress=False)
     return time.monotonic() - started, results
@@ -63,12 +66,14 @@ def main(argv=None) -> int:
             for assignment in ASSIGNMENTS:
                 zoo.submit(course, f"student{index}", assignment)
         shutil.rmtree(packages.cache_of(course).root, ignore_errors=True)
-        runs = {"cold": timed_grade(course, 1), "sequential": timed_grade(course, 1, early=False),
-                "early": timed_grade(course, 1), "workers": timed_grade(course, args.workers)}
+        shutil.rmtree(packages.builds_of(course).root, ignore_errors=True)
+        runs = {"cold": timed_grade(course, 1), "sequential": timed_grade(course, 1, early=False, reuse=False),
+                "built": timed_grade(course, 1, reuse=False), "early": timed_grade(course, 1),
+                "workers": timed_grade(course, args.workers)}
     print(f"{platform.node()}: {os.cpu_count()} CPUs, isolation {sandbox.isolation()}, "
           f"{args.students} reference submissions per assignment\n")
-    columns = {"cold": "mean, cold", "sequential": "cached, sequential", "early": "cached, early",
-               "workers": f"early, {args.workers} workers"}
+    columns = {"cold": "mean, cold", "sequential": "cached, sequential", "built": "cached, early, built",
+               "early": "cached, early", "workers": f"early, {args.workers} workers"}
     print(f"{'assignment':<14}{'first, cold':>12}" + "".join(f"{title:>21}" for title in columns.values())
           + f"{'scores':>12}")
     for assignment in ASSIGNMENTS:
@@ -86,14 +91,14 @@ def main(argv=None) -> int:
           f"per submission):")
     print(f"{'assignment':<14}{'run':<12}" + "".join(f"{name:>23}" for name in [*SHOWN_STEPS, "other"]))
     for assignment in ASSIGNMENTS:
-        for run in ("sequential", "early"):
+        for run in ("sequential", "built", "early"):
             results = [r for r in runs[run][1] if r.assignment == assignment]
             means = [statistics.mean(r.steps.get(name, 0.0) for r in results) for name in SHOWN_STEPS]
             other = statistics.mean(sum(v for k, v in r.steps.items() if k not in SHOWN_STEPS) for r in results)
             print(f"{assignment:<14}{run:<12}" + "".join(f"{value:>23.1f}" for value in [*means, other]))
-    before, one, many = runs["sequential"][0], runs["early"][0], runs["workers"][0]
-    print(f"\nwall time: {runs['cold'][0]:.0f} s cold, {before:.0f} s cached sequential, {one:.0f} s cached early "
-          f"(1 worker): {before / one:.2f}x")
+    before, built, one, many = runs["sequential"][0], runs["built"][0], runs["early"][0], runs["workers"][0]
+    print(f"\nwall time: {runs['cold'][0]:.0f} s cold, {before:.0f} s cached sequential, {built:.0f} s cached early "
+          f"built by colcon, {one:.0f} s cached early (1 worker): {before / built:.2f}x, {before / one:.2f}x")
     count = len(runs["early"][1])
     print(f"\n{count} submissions: {one:.0f} s with 1 worker, {many:.0f} s with {args.workers} workers: "
           f"speed-up {one / many:.2f}x")
