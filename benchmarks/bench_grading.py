@@ -87,6 +87,9 @@ def main(argv=None) -> int:
               + f"{','.join(sorted(scores)):>12}")
     early_used = sum(bool(r.checked_early) for r in runs["early"][1])
     print(f"\nthe early build and checks counted for {early_used} of {len(runs['early'][1])} submissions")
+    reused = {run: sum(r.build_reused for r in runs[run][1]) for run in ("built", "early")}
+    print(f"workspace builds copied from an identical one: {reused['built']} of {len(runs['built'][1])} in the "
+          f"built run ({packages.REUSE_BUILDS_ENV}=0), {reused['early']} of {len(runs['early'][1])} in the early run")
     print(f"\nseconds per step, mean of the cached runs with 1 worker (budget {pipeline.GRADING_SECONDS:g} s idle, "
           f"per submission):")
     print(f"{'assignment':<14}{'run':<12}" + "".join(f"{name:>23}" for name in [*SHOWN_STEPS, "other"]))
