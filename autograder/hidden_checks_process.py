@@ -23,6 +23,7 @@ from pathlib import Path
 from autograder.student_uid import StudentUid
 from course_lib.checks import answers
 from course_lib.checks.check_process import write_json, run_in_this_process
+from course_lib.checks.context import number_from_environment
 from course_lib.checks.registry import get_check
 from course_lib.checks.result import Result
 from course_lib.checks.runner import embed_images, fresh_seed
@@ -37,11 +38,7 @@ MARGIN = 1.0
 
 def budget_from_environment() -> float | None:
     """AUTOGRADER_CHECKS_SECONDS as a number of seconds, or None (no bound but the checks' own)."""
-    value = os.environ.get(BUDGET_ENV)
-    try:
-        return float(value) if value else None
-    except ValueError:
-        return None
+    return number_from_environment(BUDGET_ENV)
 
 
 def own_domains() -> int | None:

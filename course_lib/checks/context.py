@@ -29,12 +29,17 @@ CALL_TIMEOUT = 20.0
 LOAD_FACTOR_ENV = "AUTOGRADER_LOAD_FACTOR"
 
 
+def number_from_environment(name: str) -> float | None:
+    """The environment variable `name` as a number; None when it is unset or not a number."""
+    try:
+        return float(os.environ.get(name) or "")
+    except ValueError:
+        return None
+
+
 def scaled(seconds: float) -> float:
     """`seconds` times the grader's load factor (LOAD_FACTOR_ENV; 1 when unset or not a number)."""
-    try:
-        return seconds * max(1.0, float(os.environ.get(LOAD_FACTOR_ENV) or 1.0))
-    except ValueError:
-        return seconds
+    return seconds * max(1.0, number_from_environment(LOAD_FACTOR_ENV) or 1.0)
 
 
 #: Written into the work directory when the student's module did not import in time, so that
