@@ -352,7 +352,8 @@ def build_workspace(ws: Path, cache: InterfaceCache, scratch: Path, run, give=No
             command sandboxed as the student's uid (autograder.grading); a plain subprocess in tests.
         give: ``give(path)``, hands a folder the grader created to the student's uid (None: nothing).
         builds: where successful builds are kept (None: always run colcon).
-        store: keep this build in `builds` (only when no other code of the student's ran beside it).
+        store: keep this build in `builds`, and new interface packages in `cache` (only when no
+            other code of the student's ran beside the build).
 
     Returns:
         The BuildReport (never raises for the student's faults).
@@ -377,7 +378,7 @@ def build_workspace(ws: Path, cache: InterfaceCache, scratch: Path, run, give=No
         install, failure = cache.lookup(key)
         if install is None and failure is None:
             install, failure = _build_interface(name, folder, key, cache, scratch, _underlay_env(base, underlays),
-                                                run, give)
+                                                run, give, store)
             if install is not None:
                 report.built_interfaces.append(name)
         else:
@@ -422,8 +423,10 @@ def _reason(log: str) -> str:
     return f"colcon build failed{where}:\n{first_error_lines(log)}"
 
 
-def _build_interface(name: str, folder: Path, key: str, cache: InterfaceCache, scratch: Path, env: dict, run, give):
-    """Build one interface package alone in a scratch workspace and store the outcome in the cache."""
+def _build_interface(name: str, folder: Path, key: str, cache: InterfaceCache, scratch: Path, env: dict, run, give,
+                     store: bool = True):
+    """Build one interface package alone in a scratch workspace and store the outcome in the cache
+    (unless not `store`: then it serves this workspace only)."""
     build_ws = scratch / "interfaces" / key
     if build_ws.exists():
         shutil.rmtree(build_ws)
@@ -432,6 +435,8 @@ def _build_interface(name: str, folder: Path, key: str, cache: InterfaceCache, s
         give(build_ws)
     ok, output = _colcon(build_ws, [], env, run)
     if ok and (build_ws / "install" / "setup.bash").is_file():
+        if not store:
+            return build_ws / "install", None
         cache.store(key, build_ws / "install")
         install, _ = cache.lookup(key)
         return install or build_ws / "install", None
@@ -491,8 +496,9 @@ def build_for_checks(assignment: str, course: Path, work: Path, workdir: Path, u
             BUILD_SECONDS of its own, outside this budget.
         prefix: of the names of the grader's folder and report in `work` (a second build of the
             same submission keeps apart: autograder.early_checks).
-        store: keep a successful build for identical workspaces (builds_of): only when no other
-            code runs as `uid` meanwhile (a kernel of the same uid could change the build).
+        store: keep a successful build for identical workspaces (builds_of), and new interface
+            packages in the course's cache: only when no other code runs as `uid` meanwhile (a
+            kernel of the same uid could change the build).
     """
     from autograder import run_as
     from course_lib import processes

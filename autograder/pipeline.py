@@ -264,8 +264,8 @@ def build_for_checks(g: Grading, workdir: Path, run=run_sandboxed, early: bool =
     deadline moves back by its time (also when the early run builds, in its thread).
 
     `early`: the build runs beside the notebook (autograder.early_checks), as Grading.early_uid,
-    with folders of its own; it is kept for identical workspaces only when that uid is not the
-    kernel's (as root)."""
+    with folders of its own; it is kept (for identical workspaces, and a new message package in
+    the course's cache) only when that uid is not the kernel's (as root)."""
     uid = g.early_uid if early else g.result.kernel_uid
     built, interface_seconds = packages.build_for_checks(
         g.sub.assignment, g.course, g.work, workdir, uid, g.domain_id, g.env, g.hide, run,

@@ -70,6 +70,18 @@ def test_identical_interface_packages_are_built_once(tmp_path):
     assert workspace_builds == [["--symlink-install", "--packages-ignore", "tutorial_interfaces"]] * 2
 
 
+def test_a_build_that_is_not_kept_leaves_the_cache_alone(tmp_path):
+    """store=False (a kernel of the same uid ran beside the build): the new interface package
+    serves this workspace, from its scratch folder, and the cache stays empty."""
+    cache = packages.InterfaceCache(tmp_path / "cache")
+    ws = tmp_path / "ros2_ws"
+    write_interface(ws)
+    write_python_package(ws)
+    report = packages.build_workspace(ws, cache, tmp_path, FakeColcon(), store=False)
+    assert report.ok and report.built_interfaces == ["tutorial_interfaces"]
+    assert not cache.root.exists()
+
+
 def test_a_changed_message_is_built_again(tmp_path):
     """One byte more in a .msg file is another cache key."""
     a, b = write_interface(tmp_path / "a"), write_interface(tmp_path / "b", msg=MSG + "int32 extra\n")
