@@ -18,3 +18,36 @@ def test_markers_touch_their_picture_corner_and_hide_none_of_it():
             mx1, my1 = square.max(axis=0)
             overlap = max(0, min(x1, mx1) - max(x0, mx0)) * max(0, min(y1, my1) - max(y0, my0))
             assert overlap == 0, f"marker {marker_id} covers part of the {name}"
+
+
+def test_a_board_with_markers_missing_is_the_whole_board_with_paper_over_them():
+    """Only the missing markers' squares differ from the whole board, they are paper, and every
+    coarser level is the finer one halved (cv2.pyrDown), as for the whole board."""
+    import cv2
+
+    board = boards.Board()
+    whole, missing = board.texture()[0][1], board.texture([1, 5])
+    scale, side = int(missing[0][0]), board.MARKER * int(missing[0][0])
+    squares = np.zeros(whole.shape[:2], bool)
+    for marker_id in (1, 5):
+        x0, y0 = (int(v) * scale for v in board.marker_square(marker_id)[0])
+        squares[y0:y0 + side, x0:x0 + side] = True
+        assert (missing[0][1][y0:y0 + side, x0:x0 + side] == (*board.PAPER, 255)).all()
+    changed = np.any(whole != missing[0][1], axis=2)
+    assert changed.any() and not changed[~squares].any()
+    for (_, finer), (_, coarser) in zip(missing, missing[1:]):
+        assert np.array_equal(coarser, cv2.pyrDown(finer))
+
+
+def test_threads_that_render_at_once_share_one_texture():
+    """The checks of a submission render scenes in threads: one texture per set of missing markers."""
+    import threading
+
+    board = boards.Board()
+    got = []
+    threads = [threading.Thread(target=lambda: got.append(board.texture([2, 6]))) for _ in range(4)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    assert len(got) == 4 and all(levels is got[0] for levels in got)
