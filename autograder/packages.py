@@ -30,6 +30,7 @@ checks of plain functions still grade.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import hashlib
 import json
 import os
@@ -193,15 +194,7 @@ def workspace_key(src: Path, interface_keys=()) -> str:
     `src` and the bytes of all but the Python modules (setup.py's count), the keys of the
     interface packages it builds on, this interpreter, the build tools' versions and
     CACHE_VERSION."""
-    from importlib import metadata
-
-    versions = []
-    for tool in _BUILD_TOOLS:
-        try:
-            versions.append(f"{tool}={metadata.version(tool)}")
-        except metadata.PackageNotFoundError:
-            versions.append(f"{tool}=none")
-    digest = hashlib.sha256(f"{CACHE_VERSION}\0{sys.version}\0{sys.prefix}\0{' '.join(versions)}\0".encode())
+    digest = hashlib.sha256(f"{CACHE_VERSION}\0{sys.version}\0{sys.prefix}\0{_build_tool_versions()}\0".encode())
     for key in interface_keys:
         digest.update(key.encode() + b"\0")
     for path in sorted(p for p in Path(src).rglob("*") if p.is_file() or p.is_symlink()):
@@ -214,6 +207,20 @@ def workspace_key(src: Path, interface_keys=()) -> str:
         elif path.suffix != ".py" or path.name == "setup.py":
             digest.update(path.read_bytes() + b"\0")
     return digest.hexdigest()[:32]
+
+
+@functools.cache
+def _build_tool_versions() -> str:
+    """"colcon-core=0.x ..." of _BUILD_TOOLS (looked up once: it reads the venv's metadata)."""
+    from importlib import metadata
+
+    versions = []
+    for tool in _BUILD_TOOLS:
+        try:
+            versions.append(f"{tool}={metadata.version(tool)}")
+        except metadata.PackageNotFoundError:
+            versions.append(f"{tool}=none")
+    return " ".join(versions)
 
 
 class WorkspaceBuilds:
@@ -254,12 +261,14 @@ class WorkspaceBuilds:
 
 def _relocate(tree: Path, moves: list[tuple[str, str]]) -> None:
     """Replace the old paths of `moves` by the new ones in every link target and file of `tree`."""
-    def moved(text: str) -> str:
-        for old, new in moves:
-            text = text.replace(old, new)
-        return text
+    encoded = [(old.encode(), new.encode()) for old, new in moves]
 
-    for directory, dirs, files in os.walk(tree):
+    def moved(data: bytes) -> bytes:
+        for old, new in encoded:
+            data = data.replace(old, new)
+        return data
+
+    for directory, dirs, files in os.walk(os.fsencode(tree)):
         for name in [*files, *dirs]:
             path = os.path.join(directory, name)
             if os.path.islink(path):
@@ -270,12 +279,9 @@ def _relocate(tree: Path, moves: list[tuple[str, str]]) -> None:
             elif name in files:
                 with open(path, "rb") as handle:
                     data = handle.read()
-                changed = data
-                for old, new in moves:
-                    changed = changed.replace(old.encode(), new.encode())
-                if changed != data:
+                if moved(data) != data:
                     with open(path, "wb") as handle:
-                        handle.write(changed)
+                        handle.write(moved(data))
 
 
 # ---- building ----------------------------------------------------------------------------------

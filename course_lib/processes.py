@@ -354,8 +354,7 @@ class NodeProcess:
             namespace = "/" + namespace.strip("/")
         wanted = node_name if namespace is None else f"{namespace.rstrip('/')}/{node_name}"
         already_running = {gid: full for gid, full in self._nodes_before.items()
-                           if full.rsplit("/", 1)[-1] == node_name
-                           and (namespace is None or full == f"{namespace.rstrip('/')}/{node_name}")}
+                           if full.rsplit("/", 1)[-1] == node_name and (namespace is None or full == wanted)}
         context = Context()
         rclpy.init(context=context, domain_id=self.domain_id)
         watcher = None
