@@ -106,15 +106,21 @@ def cheater(nb):
     nb.cells.insert(index + 1, nbformat.v4.new_code_cell(CHEAT))
 
 
+#: The throughput item's verdict, measured or not: the grading got that far. On a machine too busy
+#: for the grader's yardstick node the item is not measured (and not held against the student).
+THROUGHPUT_VERDICT = ("your node answered", "not measured, the grading machine was too busy")
+
+
 def entries(course_dir: str) -> dict[str, dict]:
     """student id -> {"edits", "values", "node", "reason"}: expected points per check (a number, a
     (low, high) range when fresh seeds decide how many items fail, or None: not asserted) and a
-    phrase the autograded notebook's outputs must contain (optional: `first_failure`, a phrase of the
+    phrase the autograded notebook's outputs must contain, or a tuple of phrases one of which it
+    must contain (optional: `first_failure`, a phrase of the
     first ✘ line of a check's verdict, and `absent`, phrases it must not contain). Entries with level="check" are typical
     mistakes in the module only: tests/test_autograder.py runs the checks on them directly (no
     nbgrader run), which is much cheaper; the rest go through the parallel nbgrader zoo run."""
     return {
-        "full": dict(edits=[], values=4, node=7, reason="answered"),
+        "full": dict(edits=[], values=4, node=7, reason=THROUGHPUT_VERDICT),
         "hostile": dict(edits=[hostile(course_dir)], values=4, node=7, reason="NETWORK: blocked"),
         "float_mean": dict(level="check", edits=[(SUM, "return image.mean()")], values=0, node=None,
                            reason="the contract asks for an int"),
@@ -160,5 +166,5 @@ def entries(course_dir: str) -> dict[str, dict]:
         "prints_gigabyte": dict(edits=[(SUM, "import sys\n    if 'ipykernel' not in sys.argv[0] and not getattr(average_brightness, 'printed', False):\n"
                                              "        average_brightness.printed = True\n"
                                              "        for _ in range(1024):\n            sys.stdout.write('x' * 2**20)\n    "
-                                             + SUM)], values=4, node=None, reason="answered"),
+                                             + SUM)], values=4, node=None, reason=THROUGHPUT_VERDICT),
     }
