@@ -261,8 +261,12 @@ def node(ctx: Context) -> None:
                 return _consequences(ctx, "the node process ended", 0)
             if not appeared or NODE_NAME not in _node_names(probe):
                 names = sorted(_node_names(probe) - {probe.node.get_name(), YARDSTICK_NODE_NAME, REMAPPED_NODE_NAME})
-                ctx.item(False, f"no node named {NODE_NAME} appeared within 25 s" +
-                         (f"; nodes seen: {names}: pass '{NODE_NAME}' to super().__init__()" if names else ""))
+                if ctx.import_hung():
+                    hint = (f"; importing {ctx.module} never finished in the values check: a spin() or loop at the "
+                            "top level of the module runs before main() does")
+                else:
+                    hint = f"; nodes seen: {names}: pass '{NODE_NAME}' to super().__init__()" if names else ""
+                ctx.item(False, f"no node named {NODE_NAME} appeared within 25 s" + hint)
                 return _consequences(ctx, f"no node named {NODE_NAME} ran", 0)
             ctx.precondition(True, f"a node named {NODE_NAME} runs")
             blocker = _topic_items(ctx, probe)

@@ -168,10 +168,14 @@ class Context:
             shown = path.relative_to(self.workdir)
             raise StudentError(f"{shown} does not exist: run the cell that starts with %%writefile {shown} "
                                "(it writes your module)")
-        if (self.workdir / IMPORT_HANG_MARK).exists():
+        if self.import_hung():
             raise StudentError(f"importing {self.module} did not finish within {scaled(IMPORT_TIMEOUT):.0f} s in an "
                                "earlier check: remove code that runs forever at import (loops, spin()) "
                                "from the top level of the module; put it in main()")
+
+    def import_hung(self) -> bool:
+        """Whether importing the student's module did not finish in an earlier check of this grading."""
+        return (self.workdir / IMPORT_HANG_MARK).exists()
 
     def call(self, function: str, calls: list[tuple], timeout: float | None = None,
              labels: list[str] | None = None) -> list[Outcome]:

@@ -143,8 +143,10 @@ def entries(course_dir: str) -> dict[str, dict]:
         # Points come from the grader's own run of the checks, not from what the kernel reports;
         # and the grader's answer key is out of the student's reach (else values would be 4).
         "cheater": dict(edits=[(SUM, STEAL_ANSWER), cheater], values=0, node=None, reason="returned 0, expected"),
-        "import_loop": dict(edits=[(IMPORTS, IMPORTS + "while True:\n    pass\n")], values=0, node=0,
-                            reason="did not finish within"),
+        # The classic slip of a module that spins at import instead of in main(): the import never
+        # returns (it waits, as a spin does, rather than burning a core for the whole time limit).
+        "import_loop": dict(edits=[(IMPORTS, IMPORTS + "rclpy.init()\nrclpy.spin(rclpy.create_node('spun_at_import'))\n")],
+                            values=0, node=0, reason="did not finish within"),
         # A callback that never returns: the endpoints' points only; what needs answers is named
         # as following from the unanswered frames (run through the checks: no kernel involved).
         "callback_loop": dict(level="check", edits=[(CALLBACK, "        while True:\n            pass")], values=None,
