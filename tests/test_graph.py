@@ -146,10 +146,16 @@ def test_topic_echo_receives_the_asked_number_of_messages(far_talker):
 
 
 def test_topic_hz_measures_a_10hz_timer_publisher(far_talker):
-    """topic_hz() reports close to 10 Hz for a 0.1 s timer (a loose bound: it is a measurement)."""
+    """topic_hz() reports close to 10 Hz for a 0.1 s timer (a loose bound: it is a measurement, and
+    on a busy machine the talker's timer may lag for a while, so up to three windows are measured)."""
     session.start(domain_id=far_talker)
-    stats = graph.topic_hz("/far_chatter", duration=2.0, timeout=15)
-    assert 7.0 < stats.rate < 13.0, stats
+    measured = []
+    for _ in range(3):
+        stats = graph.topic_hz("/far_chatter", duration=2.0, timeout=15)
+        measured.append(stats)
+        if 7.0 < stats.rate < 13.0:
+            break
+    assert 7.0 < stats.rate < 13.0, measured
     assert stats.samples >= 5
     assert stats.min_period <= 1 / stats.rate <= stats.max_period
     assert str(stats).startswith(f"average rate: {stats.rate:.3f}\n\tmin: ")
