@@ -5,8 +5,8 @@ The pieces, each usable on its own:
 - ``find_chromium`` / ``launched_chromium``: Debian's chromium driven by Playwright;
 - ``running_jupyterlab``: a JupyterLab server on a directory, with a token and a free port,
   whose settings and workspaces live in a scratch directory (nothing in ~/.jupyter changes);
-- ``open_notebook`` and ``click_toolbar_button``: open a notebook by path, press a notebook
-  toolbar button by its label (the way in for nbgrader's "Validate" button);
+- ``open_notebook`` / ``close_notebook`` and ``click_toolbar_button``: open a notebook by path
+  (in one JupyterLab page per server, as a student does), press a notebook toolbar button by its label (the way in for nbgrader's "Validate" button);
 - ``run_notebook``: Run > Run All Cells, wait for the kernel, and report what the student sees;
 - ``validate``: press nbgrader's Validate button and read the dialog it answers with;
 - ``open_assignment_list`` / ``wait_for_assignment``: nbgrader's Assignments panel and its lists.
@@ -295,16 +295,49 @@ _KERNEL_READY_OR_DIALOG_JS = f"""(notebookSelector) =>
   !!document.querySelector('.jp-Dialog .jp-mod-accept') || ({_KERNEL_READY_JS})(notebookSelector)"""
 
 
+#: One JupyterLab page per Chromium context and server, kept between notebooks: a notebook opens in
+#: it as a student opens one from the file browser. (Loading JupyterLab costs Chromium about 7 s of
+#: CPU; opening a notebook in a loaded JupyterLab, a fraction of that.)
+_LAB_PAGES: dict[tuple[int, str], object] = {}
+
+_OPEN_JS = "(path) => { window.jupyterapp.commands.execute('docmanager:open', {path}); }"
+
+_CURRENT_IS_JS = """(path) => {
+  const widget = window.jupyterapp && window.jupyterapp.shell.currentWidget;
+  return !!(widget && widget.context && widget.context.path === path);
+}"""
+
+# Disposing skips the "save your changes?" question that closing a run notebook asks.
+_DISPOSE_JS = """(path) => {
+  for (const widget of [...window.jupyterapp.shell.widgets('main')])
+    if (widget.context && widget.context.path === path) widget.dispose();
+}"""
+
+
 def open_notebook(context, lab: JupyterLab, path: str, timeout: float = 120):
-    """Open the notebook at path (relative to lab.root_dir) in a new tab; wait until its kernel is idle.
+    """Open the notebook at path (relative to lab.root_dir) and wait until its kernel is idle: in
+    the JupyterLab page this context already has on lab, else in a new page (a tab of its own).
+    Close it with close_notebook.
 
     Returns:
         the Playwright page showing it.
     """
-    page = context.new_page()
+    key = (id(context), lab.url)
+    page = _LAB_PAGES.pop(key, None)
+    if page is not None and (page.is_closed() or page.context is not context
+                             or page.locator(".jp-Dialog").count()):
+        if not page.is_closed():
+            page.close()
+        page = None
     try:
-        page.set_default_timeout(timeout * 1000)
-        page.goto(lab.lab_url(path), wait_until="domcontentloaded")
+        if page is None:
+            page = context.new_page()
+            page.set_default_timeout(timeout * 1000)
+            page.goto(lab.lab_url(path), wait_until="domcontentloaded")
+        else:
+            page.set_default_timeout(timeout * 1000)
+            page.evaluate(_OPEN_JS, path)
+            page.wait_for_function(_CURRENT_IS_JS, arg=path, polling=100)
         page.locator(f"{NOTEBOOK} .jp-Notebook .jp-Cell").first.wait_for(state="attached")
         # A notebook without kernel metadata asks which kernel to use; take the suggested one.
         page.wait_for_function(_KERNEL_READY_OR_DIALOG_JS, arg=NOTEBOOK, polling=250)
@@ -316,7 +349,20 @@ def open_notebook(context, lab: JupyterLab, path: str, timeout: float = 120):
     except BaseException:
         page.close()
         raise
+    _LAB_PAGES[key] = page
     return page
+
+
+def close_notebook(page, lab: JupyterLab, path: str) -> None:
+    """Close path's notebook in page and shut its kernel down. The page stays open for the next
+    notebook, unless something is left on it (a dialog): then it is closed too."""
+    try:
+        if not page.is_closed():
+            page.evaluate(_DISPOSE_JS, path)
+    finally:
+        lab.shut_down_kernels_of(path)
+        if not page.is_closed() and page.locator(".jp-Dialog").count():
+            page.close()
 
 
 def toolbar_labels(page) -> list[str]:
@@ -539,8 +585,7 @@ def run_in_lab(context, lab: JupyterLab, path: str, screenshot: Path | None = No
     try:
         run = run_notebook(page, path, code_cell_count(lab.root_dir / path), LESSON_RUN_TIMEOUT, screenshot)
     finally:
-        lab.shut_down_kernels_of(path)
-        page.close()
+        close_notebook(page, lab, path)
     print(f"\n{path}: Run All Cells took {run.seconds:.1f} s")
     return run
 

@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 
 from browser_support import (LESSON_RUN_TIMEOUT, NOTEBOOK, SCREENSHOTS, assert_lesson_runs_clean,
-                             click_toolbar_button, copy_lessons, course_lessons, open_notebook, run_in_lab,
+                             click_toolbar_button, close_notebook, copy_lessons, course_lessons, open_notebook, run_in_lab,
                              run_notebook, running_jupyterlab, toolbar_labels, write_notebook)
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -134,8 +134,7 @@ def test_a_camera_left_running_by_lesson_02_is_named_when_lesson_03_starts_its_o
         assert first.problems() == [], first.problems()
         second = run_in_lab(browser, lab, "checker/lesson03_camera.ipynb")
     finally:
-        lab.shut_down_kernels_of(left)
-        page.close()
+        close_notebook(page, lab, left)
     said = second.outputs[1]
     assert "another node process named 'camera'" in said and "lesson02_left_running.ipynb" in said, said
     assert "Shut Down Kernel" in said
@@ -190,5 +189,4 @@ def test_toolbar_buttons_are_clicked_by_their_label(browser, lab):
         with pytest.raises(LookupError, match="Insert a cell below"):
             click_toolbar_button(page, "No such button")
     finally:
-        lab.shut_down_kernels_of("checker/prints.ipynb")
-        page.close()
+        close_notebook(page, lab, "checker/prints.ipynb")

@@ -9,7 +9,8 @@ from pathlib import Path
 
 import pytest
 
-from browser_support import NOTEBOOK, code_cell_count, open_notebook, run_notebook, running_jupyterlab, write_notebook
+from browser_support import (NOTEBOOK, close_notebook, code_cell_count, open_notebook, run_notebook, running_jupyterlab,
+                             write_notebook)
 
 SCREENSHOTS = Path(__file__).resolve().parents[1] / "artifacts" / "browser"
 CAMERA_SIZE = (320, 240)
@@ -60,5 +61,4 @@ def test_live_image_view_picture_changes_while_the_camera_runs(browser, tmp_path
             assert sources[0] != sources[1]
             assert shots[0] != shots[1], "the picture on screen changed (the simulated camera moves)"
         finally:
-            lab.shut_down_kernels_of("live_view.ipynb")
-            page.close()
+            close_notebook(page, lab, "live_view.ipynb")

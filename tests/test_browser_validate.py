@@ -17,7 +17,8 @@ from pathlib import Path
 
 import pytest
 
-from browser_support import open_assignment_list, open_notebook, running_jupyterlab, validate, wait_for_assignment
+from browser_support import (close_notebook, open_assignment_list, open_notebook, running_jupyterlab, validate,
+                             wait_for_assignment)
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
@@ -83,8 +84,7 @@ def validate_in_lab(browser, lab, student):
     try:
         result = validate(page, VALIDATE_TIMEOUT, SCREENSHOTS / f"validate_{student}.png")
     finally:
-        lab.shut_down_kernels_of(path)
-        page.close()
+        close_notebook(page, lab, path)
     print(f"\n{path}: Validate answered after {result.seconds:.1f} s: {result.title}\n{result.text}")
     return result
 
