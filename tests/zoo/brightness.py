@@ -165,8 +165,10 @@ def entries(course_dir: str) -> dict[str, dict]:
         "fork_bomb": dict(edits=[(SUM, "import os, sys\n    while 'ipykernel' not in sys.argv[0]:\n        os.fork()\n    "
                                        + SUM)], values=0, node=None,
                           reason="average_brightness failed"),
-        "prints_gigabyte": dict(edits=[(SUM, "import sys\n    if 'ipykernel' not in sys.argv[0] and not getattr(average_brightness, 'printed', False):\n"
-                                             "        average_brightness.printed = True\n"
-                                             "        for _ in range(1024):\n            sys.stdout.write('x' * 2**20)\n    "
-                                             + SUM)], values=4, node=None, reason=THROUGHPUT_VERDICT),
+        # 256 MB of output from each of the grader's student processes, 800 times what the grader
+        # keeps of a log (course_lib.bounded_log): neither memory nor disk fills, the answers count.
+        "prints_flood": dict(edits=[(SUM, "import sys\n    if 'ipykernel' not in sys.argv[0] and not getattr(average_brightness, 'printed', False):\n"
+                                          "        average_brightness.printed = True\n"
+                                          "        for _ in range(256):\n            sys.stdout.write('x' * 2**20)\n    "
+                                          + SUM)], values=4, node=None, reason=THROUGHPUT_VERDICT),
     }
