@@ -273,15 +273,17 @@ def _relocate(tree: Path, moves: list[tuple[str, str]]) -> None:
             path = os.path.join(directory, name)
             if os.path.islink(path):
                 target = os.readlink(path)
-                if moved(target) != target:
+                new_target = moved(target)
+                if new_target != target:
                     os.unlink(path)
-                    os.symlink(moved(target), path)
+                    os.symlink(new_target, path)
             elif name in files:
                 with open(path, "rb") as handle:
                     data = handle.read()
-                if moved(data) != data:
+                new_data = moved(data)
+                if new_data != data:
                     with open(path, "wb") as handle:
-                        handle.write(moved(data))
+                        handle.write(new_data)
 
 
 # ---- building ----------------------------------------------------------------------------------

@@ -6,7 +6,8 @@ The pieces, each usable on its own:
 - ``running_jupyterlab``: a JupyterLab server on a directory, with a token and a free port,
   whose settings and workspaces live in a scratch directory (nothing in ~/.jupyter changes);
 - ``open_notebook`` / ``close_notebook`` and ``click_toolbar_button``: open a notebook by path
-  (in one JupyterLab page per server, as a student does), press a notebook toolbar button by its label (the way in for nbgrader's "Validate" button);
+  (in one JupyterLab page per server, as a student does), press a notebook toolbar button by its
+  label (the way in for nbgrader's "Validate" button);
 - ``run_notebook``: Run > Run All Cells, wait for the kernel, and report what the student sees;
 - ``validate``: press nbgrader's Validate button and read the dialog it answers with;
 - ``open_assignment_list`` / ``wait_for_assignment``: nbgrader's Assignments panel and its lists.
@@ -329,13 +330,14 @@ def open_notebook(context, lab: JupyterLab, path: str, timeout: float = 120):
         if not page.is_closed():
             page.close()
         page = None
+    fresh = page is None
+    if fresh:
+        page = context.new_page()
     try:
-        if page is None:
-            page = context.new_page()
-            page.set_default_timeout(timeout * 1000)
+        page.set_default_timeout(timeout * 1000)
+        if fresh:
             page.goto(lab.lab_url(path), wait_until="domcontentloaded")
         else:
-            page.set_default_timeout(timeout * 1000)
             page.evaluate(_OPEN_JS, path)
             page.wait_for_function(_CURRENT_IS_JS, arg=path, polling=100)
         page.locator(f"{NOTEBOOK} .jp-Notebook .jp-Cell").first.wait_for(state="attached")
