@@ -193,26 +193,31 @@ def _gamma_table(gamma: float) -> np.ndarray:
 
 
 def _apply_look(frame: np.ndarray, look: Look, rng: np.random.Generator, noise_tile=None) -> np.ndarray:
+    # Grey levels (0-255) in float32 throughout: light, then noise, then rounded and saturated.
+    # One gain map (gradient x gain x tint, built per channel and merged) and OpenCV's passes over
+    # the frame take about 3 ms for 640x480, a third of numpy's step-by-step arithmetic.
     height, width = frame.shape[:2]
-    image = frame.astype(np.float32) * (1 / 255)
+    image = frame.astype(np.float32)
     if look.blur > 0:
         image = cv2.GaussianBlur(image, (0, 0), look.blur)
-    light = np.float32(look.gain) * np.asarray(look.tint, np.float32)[None, None, :]
+    light = [look.gain * t for t in look.tint]  # per channel
     if look.gradient:
         a = math.radians(look.gradient_angle)
         x = (np.arange(width, dtype=np.float32) + 0.5) / width - 0.5
         y = (np.arange(height, dtype=np.float32) + 0.5) / height - 0.5
-        ramp = 1 + look.gradient * (math.cos(a) * x[None, :] + math.sin(a) * y[:, None])
-        image *= ramp[:, :, None]
-    image *= light
+        ramp = np.add((np.float32(look.gradient * math.sin(a)) * y + 1)[:, None],
+                      np.float32(look.gradient * math.cos(a)) * x, dtype=np.float32)
+        cv2.multiply(image, cv2.merge([ramp * np.float32(v) for v in light]), dst=image)
+    else:
+        image *= np.asarray(light, np.float32)
     if look.noise > 0:
         if noise_tile is None:
             noise = rng.standard_normal(image.shape, dtype=np.float32)
         else:  # video: a random window of a fixed noise field is 5x cheaper and looks the same
             dy, dx = rng.integers(0, _NOISE_PAD, 2)
             noise = noise_tile[dy:dy + height, dx:dx + width]
-        image += noise * np.float32(look.noise / 255 * (1 if rng.random() < 0.5 else -1))
-    out = cv2.convertScaleAbs(image, alpha=255)  # rounds and saturates to 0..255
+        cv2.scaleAdd(noise, look.noise * (1 if rng.random() < 0.5 else -1), image, dst=image)
+    out = cv2.convertScaleAbs(image)  # rounds and saturates to 0..255
     if look.gamma != 1:
         out = cv2.LUT(out, _gamma_table(look.gamma))
     if look.jpeg_quality is not None:

@@ -231,12 +231,14 @@ def _render(board: Board, pose: Pose, look: Look, size, *, missing, occluded, du
         corners = _square(origin[0] + Board.QUIET, origin[1] + Board.QUIET, Board.MARKER)
         duplicate_truth.append((marker_id, _project(_EDGE_TO_CENTRE @ H, corners).astype(np.float32)))
 
-    finger_mask = np.zeros(image.shape[:2], np.uint8)
-    for marker_id in occluded:
-        _draw_finger(image, finger_mask, _project(to_super, board.marker_square(marker_id)),
-                     _project(to_super, [np.array(board.size) / 2])[0], finger_rng)
-    frame = cv2.resize(image, size, interpolation=cv2.INTER_AREA)
-    finger_mask = cv2.resize(finger_mask, size, interpolation=cv2.INTER_AREA)
+    finger_mask = None  # where fingers cover the board (only drawn when a marker is occluded)
+    if occluded:
+        finger_mask = np.zeros(image.shape[:2], np.uint8)
+        for marker_id in occluded:
+            _draw_finger(image, finger_mask, _project(to_super, board.marker_square(marker_id)),
+                         _project(to_super, [np.array(board.size) / 2])[0], finger_rng)
+        finger_mask = cv2.resize(finger_mask, size, interpolation=cv2.INTER_AREA)
+    frame = image if k == 1 else cv2.resize(image, size, interpolation=cv2.INTER_AREA)
     frame = _apply_look(frame, look, noise_rng, noise_tile)
 
     marker_corners, covered = {}, set()
@@ -244,7 +246,7 @@ def _render(board: Board, pose: Pose, look: Look, size, *, missing, occluded, du
         if marker_id in missing:
             continue
         corners = _project(_EDGE_TO_CENTRE @ H, board.marker_square(marker_id)).astype(np.float32)
-        if marker_id in occluded or _covered(finger_mask, corners):
+        if marker_id in occluded or (finger_mask is not None and _covered(finger_mask, corners)):
             covered.add(marker_id)
         else:
             marker_corners[marker_id] = corners
@@ -286,10 +288,20 @@ def _pick_level(levels, to_super):
 
 
 def _composite(image: np.ndarray, levels, to_super, super_size) -> np.ndarray:
-    """Paste a BGRA texture (a list of levels) through a homography onto image; returns the new image."""
-    layer = _warp_levels(levels, to_super, super_size)
+    """Paste a BGRA texture (a list of levels) through a homography onto image, in place; returns
+    image. Only the texture's bounding box (2 pixels more for the interpolated edge) is warped and
+    blended: outside it the layer is fully transparent."""
+    scale, texture = levels[0]
+    outline = _project(to_super, _square(0, 0, 1) * [texture.shape[1] / scale, texture.shape[0] / scale])
+    x0, y0 = np.maximum(np.floor(outline.min(axis=0)).astype(int) - 2, 0)
+    x1, y1 = np.minimum(np.ceil(outline.max(axis=0)).astype(int) + 3, super_size)
+    if x1 <= x0 or y1 <= y0:
+        return image
+    layer = _warp_levels(levels, _translation(-x0, -y0) @ to_super, (int(x1 - x0), int(y1 - y0)))
     alpha = layer[:, :, 3].astype(np.float32) * np.float32(1 / 255)
-    return cv2.blendLinear(layer[:, :, :3], image, alpha, 1 - alpha)
+    box = image[y0:y1, x0:x1]
+    box[:] = cv2.blendLinear(layer[:, :, :3], box, alpha, 1 - alpha)
+    return image
 
 
 def _sticker(marker_id: int) -> np.ndarray:
