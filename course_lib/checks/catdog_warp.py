@@ -219,6 +219,10 @@ def node(ctx: Context) -> None:
                 lambda msg: got[numbers[msg.picture]].append(msg.image) if msg.picture in numbers else None,
                 QoSProfile(depth=10, reliability=ReliabilityPolicy.BEST_EFFORT))
             names = lambda: {n for n, _ in probe.node.get_node_names_and_namespaces()}  # noqa: E731
+            # The frame is drawn while the node's process starts (it takes about a second).
+            scene = scenes.render_scene(_seed(ctx), difficulty="easy")
+            expected = scene.expected_crops(SIZE)
+            msg = images.image_to_msg(scene.frame, "bgr8")
             probe.spin_until(lambda: "marker_reader" in names() or not proc.running(), 25.0)
             if not proc.running():
                 ctx.item(False, f"the node process ended ({proc.describe_exit()}):\n{clip(proc.log_tail(6))}")
@@ -226,9 +230,6 @@ def node(ctx: Context) -> None:
             if not ctx.precondition("marker_reader" in names(), "node marker_reader runs" if "marker_reader" in names() else
                             f"no node named marker_reader (nodes: {sorted(names())})"):
                 return
-            scene = scenes.render_scene(_seed(ctx), difficulty="easy")
-            expected = scene.expected_crops(SIZE)
-            msg = images.image_to_msg(scene.frame, "bgr8")
             probe.resend_until(pub, msg, lambda: bool(got["cat"] and got["dog"]), 8.0, every=0.5)
             types = dict(probe.node.get_topic_names_and_types())
     finally:
