@@ -21,14 +21,15 @@ _GRAIN: dict = {}
 
 
 def _wood_grain(size) -> np.ndarray:
-    """Brightness pattern of a wooden table top around 1.0, the same for every table of that size."""
+    """Brightness pattern of a wooden table top around 1.0 (one channel, float32), the same for
+    every table of that size."""
     if size not in _GRAIN:
         rng = np.random.default_rng(12345)
         width, height = size
         blotches = cv2.resize(rng.normal(0, 1, (6, 8)).astype(np.float32), size, interpolation=cv2.INTER_CUBIC)
         y = np.arange(height, dtype=np.float32)[:, None]
         grain = np.sin(y * np.float32(0.2) + 3 * blotches) * 0.5 + rng.normal(0, 0.15, (height, 1)).astype(np.float32)
-        _GRAIN[size] = cv2.merge([1 + 0.08 * blotches + 0.06 * grain] * 3)
+        _GRAIN[size] = np.ascontiguousarray(1 + 0.08 * blotches + 0.06 * grain, dtype=np.float32)
     return _GRAIN[size]
 
 
@@ -49,7 +50,8 @@ def _table(board: Board, entropy: list[int]):
         origin = (-bw, -2.0 * bh)
         width, height = int(3 * bw * _TABLE_SCALE), int(5 * bh * _TABLE_SCALE)
         wood = rng.uniform([60, 90, 120], [110, 140, 180])
-        texture = cv2.convertScaleAbs(cv2.multiply(_wood_grain((width, height)), (*wood, 0.0)))
+        grain = _wood_grain((width, height))  # each channel: the grain times that channel's wood colour
+        texture = cv2.merge([cv2.convertScaleAbs(grain, alpha=float(level)) for level in wood])
         board_box = np.array([-origin[0], -origin[1], -origin[0] + bw, -origin[1] + bh]) * _TABLE_SCALE
         for _ in range(int(rng.integers(40, 60))):
             _clutter_item(texture, rng, board_box)
