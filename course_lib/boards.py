@@ -88,11 +88,8 @@ class Board:
         if key not in self._textures:
             scale = 4
             if key:  # the whole board with paper over the missing markers: the same pixels, made faster
-                image = self._levels(frozenset())[0][1].copy()
-                for marker_id in key:
-                    x0, y0 = (int(v) * scale for v in self.marker_square(marker_id)[0])
-                    side = self.MARKER * scale
-                    image[y0:y0 + side, x0:x0 + side] = (*self.PAPER, 255)
+                self._keep(key, self._with_paper(self._levels(frozenset()), key, scale))
+                return self._textures[key]
             else:
                 width, height = self.size
                 image = np.empty((height * scale, width * scale, 4), np.uint8)
@@ -107,10 +104,50 @@ class Board:
             levels = [(float(scale), image)]
             while levels[-1][1].shape[1] > 64:
                 levels.append((levels[-1][0] / 2, cv2.pyrDown(levels[-1][1])))
-            if len(self._textures) >= self.KEPT_TEXTURES:  # the oldest board with markers missing goes
-                self._textures.pop(next((k for k in self._textures if k), next(iter(self._textures))))
-            self._textures[key] = levels
+            self._keep(key, levels)
         return self._textures[key]
+
+    def _keep(self, key: frozenset, levels) -> None:
+        if len(self._textures) >= self.KEPT_TEXTURES:  # the oldest board with markers missing goes
+            self._textures.pop(next((k for k in self._textures if k), next(iter(self._textures))))
+        self._textures[key] = levels
+
+    def _with_paper(self, whole, key: frozenset, scale: int) -> list[tuple[float, np.ndarray]]:
+        """The levels of the whole board with paper over the markers of `key`: level 0 patched,
+        and each coarser level recomputed (cv2.pyrDown) only around the patches, so the pixels
+        are those of a full pyramid of the patched image at a fraction of its cost."""
+        side = self.MARKER * scale
+        regions = []  # changed areas of the current level: (y0, y1, x0, x1)
+        levels = []
+        for index, (level_scale, image) in enumerate(whole):
+            image = image.copy()
+            if index == 0:
+                for marker_id in key:
+                    x0, y0 = (int(v) * scale for v in self.marker_square(marker_id)[0])
+                    image[y0:y0 + side, x0:x0 + side] = (*self.PAPER, 255)
+                    regions.append((y0, y0 + side, x0, x0 + side))
+            else:
+                finer = levels[-1][1]
+                regions = [_pyr_down_region(finer, image, region) for region in regions]
+            levels.append((level_scale, image))
+        return levels
+
+
+def _pyr_down_region(finer: np.ndarray, coarser: np.ndarray, region) -> tuple[int, int, int, int]:
+    """Recompute in `coarser` (cv2.pyrDown of `finer` before `region` of it changed) the pixels
+    that the change reaches, from a window of `finer` around it; return the changed region of
+    `coarser`. pyrDown's 5x5 kernel makes coarse pixel i from fine pixels 2i-2..2i+2, so a window
+    with an even start and 8 pixels more on each side gives those pixels exactly (its own border
+    handling touches only pixels 2 from its edge, which are the image's own edge or not used)."""
+    y0, y1, x0, x1 = region
+    height, width = finer.shape[:2]
+    wy0, wx0 = max(0, (y0 - 8) & ~1), max(0, (x0 - 8) & ~1)
+    wy1, wx1 = min(height, y1 + 8), min(width, x1 + 8)
+    small = cv2.pyrDown(finer[wy0:wy1, wx0:wx1])
+    cy0, cx0 = max(0, (y0 - 2) // 2), max(0, (x0 - 2) // 2)  # coarse pixels the change reaches
+    cy1, cx1 = min(coarser.shape[0], (y1 + 2) // 2 + 1), min(coarser.shape[1], (x1 + 2) // 2 + 1)
+    coarser[cy0:cy1, cx0:cx1] = small[cy0 - wy0 // 2:cy1 - wy0 // 2, cx0 - wx0 // 2:cx1 - wx0 // 2]
+    return cy0, cy1, cx0, cx1
 
 
 def _square(x0: float, y0: float, side: float) -> np.ndarray:

@@ -1,6 +1,7 @@
 """Tests for course_lib.boards: the printed board follows the marker convention."""
 
 import numpy as np
+import pytest
 
 from course_lib import boards, marker_board
 
@@ -20,16 +21,18 @@ def test_markers_touch_their_picture_corner_and_hide_none_of_it():
             assert overlap == 0, f"marker {marker_id} covers part of the {name}"
 
 
-def test_a_board_with_markers_missing_is_the_whole_board_with_paper_over_them():
+@pytest.mark.parametrize("gone", [(1, 5), (4, 8), tuple(range(1, 9))])
+def test_a_board_with_markers_missing_is_the_whole_board_with_paper_over_them(gone):
     """Only the missing markers' squares differ from the whole board, they are paper, and every
-    coarser level is the finer one halved (cv2.pyrDown), as for the whole board."""
+    coarser level is the finer one halved (cv2.pyrDown), as for the whole board (the coarser
+    levels are recomputed only around the squares)."""
     import cv2
 
     board = boards.Board()
-    whole, missing = board.texture()[0][1], board.texture([1, 5])
+    whole, missing = board.texture()[0][1], board.texture(gone)
     scale, side = int(missing[0][0]), board.MARKER * int(missing[0][0])
     squares = np.zeros(whole.shape[:2], bool)
-    for marker_id in (1, 5):
+    for marker_id in gone:
         x0, y0 = (int(v) * scale for v in board.marker_square(marker_id)[0])
         squares[y0:y0 + side, x0:x0 + side] = True
         assert (missing[0][1][y0:y0 + side, x0:x0 + side] == (*board.PAPER, 255)).all()
