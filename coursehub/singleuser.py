@@ -3,7 +3,8 @@ the course's ROS environment, then JupyterHub's single-user server (``jupyterhub
 
 Started by the spawner as ``python -m coursehub.singleuser [server args]`` with
 COURSEHUB_SERVER_SOCKET and COURSEHUB_HUB_SOCKET set. The doors run in a thread of the server's
-own process, so they live exactly as long as the server.
+own process, so they live exactly as long as the server; so does the sweep of the namespace's
+/dev/shm (the Fast DDS segments of killed kernels).
 """
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ import asyncio
 import os
 import sys
 import threading
+import time
 from urllib.parse import urlparse
 
 from coursehub import forward
@@ -38,6 +40,24 @@ def _open_doors(ready: threading.Event, failed: list) -> None:
         loop.run_forever()
 
 
+#: Seconds between two sweeps of the server's /dev/shm.
+SWEEP_SECONDS = 60.0
+
+
+def _sweep_shared_memory(interval: float = SWEEP_SECONDS) -> None:
+    """A kernel killed with a ROS session open (restarted while stuck in a call, or out of memory)
+    cannot close its Fast DDS segments: up to 32 MB each stay in the namespace's private /dev/shm
+    until the server stops. Remove them every `interval` seconds (course_lib.doctor)."""
+    from course_lib import doctor
+
+    while True:
+        time.sleep(interval)
+        try:
+            doctor.remove_stale_segments()
+        except Exception as error:  # noqa: BLE001 - a missed sweep costs memory, not the server
+            print(f"coursehub.singleuser: could not remove stale Fast DDS segments: {error}", file=sys.stderr)
+
+
 def main() -> int:
     ready, failed = threading.Event(), []
     threading.Thread(target=_open_doors, args=(ready, failed), name="coursehub-doors", daemon=True).start()
@@ -49,6 +69,7 @@ def main() -> int:
 
     # Kernels, terminals and `!` commands inherit these, as under `make lab`.
     rosenv.prepare_current_process()
+    threading.Thread(target=_sweep_shared_memory, name="coursehub-shm-sweep", daemon=True).start()
     from jupyterhub.singleuser import main as singleuser_main
 
     sys.argv[0] = "jupyterhub-singleuser"
