@@ -37,6 +37,8 @@ class Board:
     #: Textures kept (each set of levels takes ~46 MB): the whole board and the five boards with
     #: markers missing that the catdog_warp checks show in every grading.
     KEPT_TEXTURES = 6
+    #: Texture pixels per board unit of the finest level.
+    SCALE = 4
 
     def __init__(self, cat: np.ndarray | None = None, dog: np.ndarray | None = None):
         self.pictures: dict[str, np.ndarray] = {
@@ -86,36 +88,36 @@ class Board:
 
     def _levels(self, key: frozenset) -> list[tuple[float, np.ndarray]]:
         if key not in self._textures:
-            scale = 4
-            if key:  # the whole board with paper over the missing markers: the same pixels, made faster
-                self._keep(key, self._with_paper(self._levels(frozenset()), key, scale))
-                return self._textures[key]
-            else:
-                width, height = self.size
-                image = np.empty((height * scale, width * scale, 4), np.uint8)
-                image[:] = (*self.PAPER, 255)  # BGRA: the alpha channel gives the board anti-aliased edges
-                for name, picture in self.pictures.items():
-                    x0, y0, x1, y1 = (v * scale for v in self._slots[name])
-                    image[y0:y1, x0:x1, :3] = cv2.resize(picture, (x1 - x0, y1 - y0), interpolation=cv2.INTER_AREA
-                                                     if picture.shape[1] > x1 - x0 else cv2.INTER_CUBIC)
-                for marker_id in sorted(i for ids in PICTURES.values() for i in ids):
-                    x0, y0 = (int(v) * scale for v in self.marker_square(marker_id)[0])
-                    _paste_marker(image, marker_id, x0, y0, self.MARKER * scale)
-            levels = [(float(scale), image)]
-            while levels[-1][1].shape[1] > 64:
-                levels.append((levels[-1][0] / 2, cv2.pyrDown(levels[-1][1])))
-            self._keep(key, levels)
+            # With markers missing: the whole board with paper over them, the same pixels made faster.
+            levels = self._with_paper(self._levels(frozenset()), key) if key else self._whole()
+            if len(self._textures) >= self.KEPT_TEXTURES:  # the oldest board with markers missing goes
+                self._textures.pop(next((k for k in self._textures if k), next(iter(self._textures))))
+            self._textures[key] = levels
         return self._textures[key]
 
-    def _keep(self, key: frozenset, levels) -> None:
-        if len(self._textures) >= self.KEPT_TEXTURES:  # the oldest board with markers missing goes
-            self._textures.pop(next((k for k in self._textures if k), next(iter(self._textures))))
-        self._textures[key] = levels
+    def _whole(self) -> list[tuple[float, np.ndarray]]:
+        """The levels of the whole board: drawn at SCALE, then halved (cv2.pyrDown) down to 64 pixels wide."""
+        scale = self.SCALE
+        width, height = self.size
+        image = np.empty((height * scale, width * scale, 4), np.uint8)
+        image[:] = (*self.PAPER, 255)  # BGRA: the alpha channel gives the board anti-aliased edges
+        for name, picture in self.pictures.items():
+            x0, y0, x1, y1 = (v * scale for v in self._slots[name])
+            image[y0:y1, x0:x1, :3] = cv2.resize(picture, (x1 - x0, y1 - y0), interpolation=cv2.INTER_AREA
+                                             if picture.shape[1] > x1 - x0 else cv2.INTER_CUBIC)
+        for marker_id in sorted(i for ids in PICTURES.values() for i in ids):
+            x0, y0 = (int(v) * scale for v in self.marker_square(marker_id)[0])
+            _paste_marker(image, marker_id, x0, y0, self.MARKER * scale)
+        levels = [(float(scale), image)]
+        while levels[-1][1].shape[1] > 64:
+            levels.append((levels[-1][0] / 2, cv2.pyrDown(levels[-1][1])))
+        return levels
 
-    def _with_paper(self, whole, key: frozenset, scale: int) -> list[tuple[float, np.ndarray]]:
+    def _with_paper(self, whole, key: frozenset) -> list[tuple[float, np.ndarray]]:
         """The levels of the whole board with paper over the markers of `key`: level 0 patched,
         and each coarser level recomputed (cv2.pyrDown) only around the patches, so the pixels
         are those of a full pyramid of the patched image at a fraction of its cost."""
+        scale = self.SCALE
         side = self.MARKER * scale
         regions = []  # changed areas of the current level: (y0, y1, x0, x1)
         levels = []
