@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import dataclasses
 import re
-import shutil
 import subprocess
 import sys
 import threading
@@ -78,12 +77,9 @@ def colcon_executable() -> Path:
     Raises:
         FileNotFoundError: colcon is not installed here.
     """
-    candidate = Path(sys.executable).parent / "colcon"
-    if candidate.is_file():
-        return candidate
-    found = shutil.which("colcon")
-    if found:
-        return Path(found)
+    found = rosenv.environment_tool("colcon")
+    if found is not None:
+        return found
     raise FileNotFoundError("colcon is not installed in this environment: run `make setup` "
                             "(it installs colcon-common-extensions from environment.txt)")
 

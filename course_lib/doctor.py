@@ -14,7 +14,6 @@ import importlib
 import os
 import platform
 import re
-import shutil
 import subprocess
 import sys
 import time
@@ -197,8 +196,7 @@ def remove_stale_segments() -> int:
     stale = stale_segments()
     if not stale:
         return 0
-    path = os.pathsep.join([str(Path(sys.executable).parent), os.environ.get("PATH", "")])
-    fastdds = shutil.which("fastdds", path=path)
+    fastdds = rosenv.environment_tool("fastdds")
     if fastdds is None:
         raise FileNotFoundError("Fast DDS's fastdds tool is not installed here: run `make setup` (the pip wheels "
                                 "bring it) or source a ROS 2 install")

@@ -21,6 +21,7 @@ import fcntl
 import importlib.util
 import os
 import shlex
+import shutil
 import sys
 import tempfile
 from pathlib import Path
@@ -110,6 +111,17 @@ def _pip_wheels_installed(rclpy_path: Path) -> bool:
     (A look at one folder: importlib.metadata would cost every process that imports course_lib
     about 50 ms of imports and a scan of every installed distribution.)"""
     return any(rclpy_path.parent.glob("ros_jazzy_rclpy-*.dist-info"))
+
+
+def environment_tool(name: str) -> Path | None:
+    """The command `name` of this environment: beside this interpreter (the venv's bin/, where
+    `make setup` and the pip wheels put colcon, fastdds and ros2), else on PATH (a sourced ROS
+    install); None when neither has it."""
+    candidate = Path(sys.executable).parent / name
+    if candidate.is_file():
+        return candidate
+    found = shutil.which(name)
+    return Path(found) if found else None
 
 
 def unique(items) -> list:
