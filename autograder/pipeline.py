@@ -50,6 +50,7 @@ from autograder.result import GradeResult
 from autograder.sandbox import HIDDEN_FROM_STUDENTS, interpreter_exposure, isolation, run_sandboxed
 from autograder.staging import private_copy, stage_grader
 from autograder.submissions import Submission, submission_digest
+from course_lib import rosenv
 from course_lib.checks import context, runner
 
 
@@ -345,8 +346,7 @@ def grading_budget() -> float:
     """GRADING_SECONDS, times the machine's load per core over the last minute when that is above 1
     (at most MAX_LOAD_FACTOR): the steps' limits are wall time, and a loaded machine gives each
     process a fraction of a core."""
-    load = os.getloadavg()[0] / (os.cpu_count() or 1)
-    return round(GRADING_SECONDS * min(MAX_LOAD_FACTOR, max(1.0, load)), 1)
+    return round(GRADING_SECONDS * rosenv.load_factor(MAX_LOAD_FACTOR), 1)
 
 
 def _explain_failure(log: str, proc, seconds: float, budget: float) -> str:

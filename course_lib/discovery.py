@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import time
 
-from course_lib import session, waiting
+from course_lib import rosenv, session, waiting
 
 #: Seconds a newly started tool node waits for discovery at least before its first answer
 #: (then until every process here has shown its nodes, up to COMPLETE_SECONDS). Lower it to 0
@@ -24,6 +24,9 @@ COMPLETE_SECONDS = 3.0
 _SETTLE_POLL = 0.05
 _SETTLE_QUIET = 0.3
 _SETTLE_MAX = 5.0
+#: On a busy machine discovery between processes takes longer: COMPLETE_SECONDS and _SETTLE_MAX
+#: grow with the load per core (rosenv.load_factor), up to this many times.
+MAX_LOAD_FACTOR = 3.0
 _settled_node = None
 
 
@@ -54,12 +57,15 @@ def wait_for_discovery(minimum: float | None = None, quiet: float = _SETTLE_QUIE
             has one, holding its nodes) has announced its nodes (default COMPLETE_SECONDS; 0:
             not at all). On a busy machine some of them take seconds to be discovered.
 
-    The wait never lasts longer than 5 s after the tool node's creation.
+    The wait never lasts longer than 5 s after the tool node's creation. On a machine loaded
+    above one process per core, complete_within and that limit grow with the load per core (at
+    most MAX_LOAD_FACTOR times); the wait still ends as soon as every process has shown its nodes.
     """
     global _settled_node
     node = session.tool_node()
     minimum = SETTLE_SECONDS if minimum is None else minimum
-    complete_within = COMPLETE_SECONDS if complete_within is None else complete_within
+    busy = rosenv.load_factor(MAX_LOAD_FACTOR)
+    complete_within = (COMPLETE_SECONDS if complete_within is None else complete_within) * busy
     here = _participants_here(node.context.get_domain_id()) if complete_within else 0
     seen = {"graph": _snapshot(node), "since": time.monotonic(), "checks": 0, "complete": not here}
 
@@ -75,7 +81,8 @@ def wait_for_discovery(minimum: float | None = None, quiet: float = _SETTLE_QUIE
             seen["complete"] = age >= complete_within or _every_process_shown(node, here)
         return age >= minimum and now - seen["since"] >= quiet and seen["complete"]
 
-    waiting.spin_until(settled, max(0.0, _SETTLE_MAX - (time.monotonic() - node.created_at)), poll=_SETTLE_POLL)
+    waiting.spin_until(settled, max(0.0, _SETTLE_MAX * busy - (time.monotonic() - node.created_at)),
+                       poll=_SETTLE_POLL)
     _settled_node = node
 
 

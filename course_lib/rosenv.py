@@ -124,6 +124,13 @@ def environment_tool(name: str) -> Path | None:
     return Path(found) if found else None
 
 
+def load_factor(maximum: float) -> float:
+    """The machine's load per core over the last minute, kept between 1 and `maximum`: how many
+    times longer than on an idle machine a wait on other processes may take (each of them gets
+    that fraction of a core)."""
+    return min(maximum, max(1.0, os.getloadavg()[0] / (os.cpu_count() or 1)))
+
+
 def unique(items) -> list:
     """The items in their first order, each once (for PATH-like lists)."""
     return list(dict.fromkeys(items))

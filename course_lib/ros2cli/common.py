@@ -17,7 +17,8 @@ DEFAULT_SPIN_TIME = 0.5
 QUIET_SECONDS = 0.2
 
 #: Seconds after its start up to which a listing verb waits for the nodes of the other ROS
-#: processes on this machine (course_lib.discovery.wait_for_discovery counts them).
+#: processes on this machine (course_lib.discovery.wait_for_discovery counts them; longer on a
+#: busy machine).
 COMPLETE_SECONDS = 4.0
 
 #: Seconds a verb that names a node or topic waits for discovery to show it, after --spin-time.
