@@ -100,11 +100,14 @@ class Board:
         scale = self.SCALE
         width, height = self.size
         image = np.empty((height * scale, width * scale, 4), np.uint8)
-        image[:] = (*self.PAPER, 255)  # BGRA: the alpha channel gives the board anti-aliased edges
+        # BGRA: the alpha channel gives the board anti-aliased edges. Filled as one 32-bit value
+        # per pixel: numpy fills with a 4-tuple eight times slower.
+        image.view(np.uint32)[:] = np.array([(*self.PAPER, 255)], np.uint8).view(np.uint32)
         for name, picture in self.pictures.items():
             x0, y0, x1, y1 = (v * scale for v in self._slots[name])
-            image[y0:y1, x0:x1, :3] = cv2.resize(picture, (x1 - x0, y1 - y0), interpolation=cv2.INTER_AREA
-                                             if picture.shape[1] > x1 - x0 else cv2.INTER_CUBIC)
+            resized = cv2.resize(picture, (x1 - x0, y1 - y0), interpolation=cv2.INTER_AREA
+                                 if picture.shape[1] > x1 - x0 else cv2.INTER_CUBIC)
+            cv2.cvtColor(resized, cv2.COLOR_BGR2BGRA, dst=image[y0:y1, x0:x1])  # opaque, written in place
         for marker_id in sorted(i for ids in PICTURES.values() for i in ids):
             x0, y0 = (int(v) * scale for v in self.marker_square(marker_id)[0])
             _paste_marker(image, marker_id, x0, y0, self.MARKER * scale)

@@ -80,27 +80,20 @@ class Scene:
         """(width, height) of the frame."""
         return self.frame.shape[1], self.frame.shape[0]
 
-    def _inside(self, corners: np.ndarray, margin: float) -> bool:
-        width, height = self.size
-        return bool(np.all(corners >= margin) and np.all(corners[:, 0] <= width - 1 - margin)
-                    and np.all(corners[:, 1] <= height - 1 - margin))
-
     @property
     def visible_ids(self) -> tuple[int, ...]:
         """Board markers printed, not occluded and with all four corners inside the frame."""
-        return tuple(i for i, c in sorted(self.marker_corners.items()) if self._inside(c, 0.0))
+        return tuple(i for i, c in sorted(self.marker_corners.items()) if _inside(c, self.size, 0.0))
 
     @property
     def detectable_ids(self) -> tuple[int, ...]:
         """Visible board markers FRAME_MARGIN pixels from the border and big enough (see MIN_MARKER_SIDE)."""
-        return tuple(i for i, c in sorted(self.marker_corners.items())
-                     if self._inside(c, FRAME_MARGIN) and _shortest_side(c) >= MIN_MARKER_SIDE)
+        return _detectable_ids(self.marker_corners, self.size)
 
     @property
     def fully_framed(self) -> tuple[str, ...]:
         """Pictures whose four markers are all detectable: a correct detector must find these."""
-        ids = set(self.detectable_ids)
-        return tuple(name for name, markers in PICTURES.items() if ids.issuperset(markers))
+        return _framed(self.detectable_ids)
 
     def picture_corners(self, picture: str) -> np.ndarray:
         """True corners of a picture in frame pixels (even if off-frame or hidden), float32 (4, 2)."""
@@ -140,6 +133,27 @@ class Scene:
 _EDGE_TO_CENTRE = np.array([[1, 0, -0.5], [0, 1, -0.5], [0, 0, 1.0]])
 
 
+def _inside(corners: np.ndarray, size: tuple[int, int], margin: float) -> bool:
+    width, height = size
+    return bool(np.all(corners >= margin) and np.all(corners[:, 0] <= width - 1 - margin)
+                and np.all(corners[:, 1] <= height - 1 - margin))
+
+
+def _detectable_ids(marker_corners: dict[int, np.ndarray], size: tuple[int, int]) -> tuple[int, ...]:
+    return tuple(i for i, c in sorted(marker_corners.items())
+                 if _inside(c, size, FRAME_MARGIN) and _shortest_side(c) >= MIN_MARKER_SIDE)
+
+
+def _framed(ids) -> tuple[str, ...]:
+    ids = set(ids)
+    return tuple(name for name, markers in PICTURES.items() if ids.issuperset(markers))
+
+
+def _marker_corners(board: Board, H: np.ndarray, marker_id: int) -> np.ndarray:
+    """A board marker's corners in frame pixels (OpenCV order, float32) for the board homography H."""
+    return _project(_EDGE_TO_CENTRE @ H, board.marker_square(marker_id)).astype(np.float32)
+
+
 def _shortest_side(corners: np.ndarray) -> float:
     return float(np.linalg.norm(corners - np.roll(corners, -1, axis=0), axis=1).min())
 
@@ -174,8 +188,7 @@ def render_scene(seed: int | Sequence[int] = 0, *, size: tuple[int, int] = (640,
     _check_difficulty(difficulty)
     size = _check_size(size, "frame size")
     board = board or default_board()
-    pose_rng, look_rng, table_rng, finger_rng, noise_rng = (
-        np.random.default_rng(s) for s in np.random.SeedSequence(_seed_entropy(seed)).spawn(5))
+    pose_rng, look_rng, table_rng, finger_rng, noise_rng = _generators(seed)
     sampled_pose = sample_pose(pose_rng, difficulty, size, board)
     sampled_look = sample_look(look_rng, difficulty)
     occluded = set(_check_ids(occluded_markers, "occluded_markers", board_only=True))
@@ -186,6 +199,28 @@ def render_scene(seed: int | Sequence[int] = 0, *, size: tuple[int, int] = (640,
                    occluded=tuple(sorted(occluded)), duplicates=_check_ids(duplicate_markers, "duplicate_markers"),
                    table=lambda: _table(board, _seed_entropy(seed)), finger_rng=finger_rng, noise_rng=noise_rng,
                    seed=seed, difficulty=difficulty)
+
+
+def scene_pose(seed: int | Sequence[int] = 0, *, size: tuple[int, int] = (640, 480), difficulty: str = "easy",
+               board: Board | None = None) -> Pose:
+    """The camera pose of render_scene(seed, size=size, difficulty=difficulty, board=board), without drawing it."""
+    _check_difficulty(difficulty)
+    return sample_pose(_generators(seed)[0], difficulty, _check_size(size, "frame size"), board or default_board())
+
+
+def framed_from(pose: Pose, *, size: tuple[int, int] = (640, 480), board: Board | None = None) -> tuple[str, ...]:
+    """The pictures whose four markers are detectable from `pose` when all are printed and none is
+    covered: a scene's fully_framed with that pose is these or fewer. Draws nothing."""
+    size = _check_size(size, "frame size")
+    board = board or default_board()
+    H = pose.homography(board.size, size)
+    corners = {i: _marker_corners(board, H, i) for ids in PICTURES.values() for i in ids}
+    return _framed(_detectable_ids(corners, size))
+
+
+def _generators(seed) -> list[np.random.Generator]:
+    """The random generators of a scene's pose, look, table, finger and noise."""
+    return [np.random.default_rng(s) for s in np.random.SeedSequence(_seed_entropy(seed)).spawn(5)]
 
 
 def _seed_entropy(seed) -> list[int]:
@@ -245,7 +280,7 @@ def _render(board: Board, pose: Pose, look: Look, size, *, missing, occluded, du
     for marker_id in sorted(i for ids in PICTURES.values() for i in ids):
         if marker_id in missing:
             continue
-        corners = _project(_EDGE_TO_CENTRE @ H, board.marker_square(marker_id)).astype(np.float32)
+        corners = _marker_corners(board, H, marker_id)
         if marker_id in occluded or (finger_mask is not None and _covered(finger_mask, corners)):
             covered.add(marker_id)
         else:

@@ -47,6 +47,26 @@ def test_same_seed_same_frame_other_seed_other_frame(difficulty):
     assert np.abs(a.frame.astype(int) - c.frame.astype(int)).mean() > 5
 
 
+@pytest.mark.parametrize("difficulty", ["easy", "hard"])
+def test_the_pose_and_framed_pictures_of_a_seed_are_known_without_drawing(difficulty):
+    """scene_pose is the pose render_scene draws; framed_from names the scene's fully framed pictures,
+    and more only when a finger covers a marker (the 24 hard seeds hold scenes with no, one and two
+    whole pictures, and one whose only whole picture a finger covers)."""
+    framed_counts, covered = set(), 0
+    for seed in range(24 if difficulty == "hard" else 6):
+        scene = scenes.render_scene(seed, difficulty=difficulty)
+        pose = scenes.scene_pose(seed, difficulty=difficulty)
+        assert pose == scene.pose
+        framed = scenes.framed_from(pose)
+        if scene.occluded_markers:
+            assert set(scene.fully_framed) <= set(framed)
+            covered += len(framed) - len(scene.fully_framed)
+        else:
+            assert framed == scene.fully_framed
+        framed_counts.add(len(framed))
+    assert (framed_counts, covered > 0) == (({0, 1, 2}, True) if difficulty == "hard" else ({2}, False))
+
+
 @pytest.mark.parametrize("size", [(64, 48), (320, 240), (1920, 1080)])
 def test_frame_sizes_from_tiny_to_full_hd_render(size):
     scene = scenes.render_scene(3, size=size, difficulty="hard")

@@ -140,7 +140,10 @@ def hard(ctx: Context) -> None:
 
     cases = []
     for attempt in range(40):  # two scenes that show a whole picture, then one of any kind
-        scene = scenes.render_scene(_seed(ctx), difficulty="hard")
+        seed = _seed(ctx)
+        if len(cases) < 2 and not scenes.framed_from(scenes.scene_pose(seed, difficulty="hard")):
+            continue  # no picture can be whole in view: drawing the scene would be wasted
+        scene = scenes.render_scene(seed, difficulty="hard")
         if scene.fully_framed or len(cases) >= 2:
             cases.append((f"hard scene {len(cases) + 1}", scene))
         if len(cases) == 3:
@@ -177,9 +180,9 @@ def noisy(ctx: Context) -> None:
     """crop_pictures copes with sensor noise, blur and JPEG artefacts, and with another crop size."""
     from course_lib import camera_views, scenes
 
-    base = scenes.render_scene(_seed(ctx), difficulty="easy")
+    pose = scenes.scene_pose(_seed(ctx), difficulty="easy")
     look = camera_views.Look(noise=7.0, blur=1.0, jpeg_quality=60, gain=0.9)
-    scene = scenes.render_scene(_seed(ctx), difficulty="easy", pose=base.pose, look=look)
+    scene = scenes.render_scene(_seed(ctx), difficulty="easy", pose=pose, look=look)
     small = (200, 150)
     outcomes = ctx.call("crop_pictures", [((scene.frame,), {"size": list(SIZE)}),
                                           ((scene.frame,), {"size": list(small)})],
