@@ -11,11 +11,12 @@ When the grader runs as root it sets AUTOGRADER_KERNEL_UID, and this launcher (s
   through. Modules the notebook writes (%%writefile) land in WORK_SUBDIR, where the grader's
   checks find them,
 - drops to the uid with no supplementary groups and sets RLIMIT_NPROC (the kernel enforces it for
-  non-root users only: a fork bomb stops there) with autograder.run_as.become, and execs ipykernel.
+  non-root users only: a fork bomb stops there) with autograder.run_as.become, and execs ipykernel
+  (KERNEL_CODE: without its debugger).
 
 So the student's code never runs as root: it cannot read the gradebook (0600, root) or other
 students' files, and its process count is bounded per worker (each worker has its own uid).
-Without AUTOGRADER_KERNEL_UID (not root), it execs ipykernel unchanged.
+Without AUTOGRADER_KERNEL_UID (not root), it execs that kernel unchanged.
 """
 
 from __future__ import annotations
@@ -29,6 +30,17 @@ from autograder import run_as
 
 #: The kernel's working directory, inside the notebook's folder (see the module docstring).
 WORK_SUBDIR = ".autograder-cwd"
+
+#: What ``python -m ipykernel_launcher`` runs, without the debugger: nobody attaches one to a
+#: graded kernel, and importing debugpy costs each grading about 0.15 s of processor time
+#: (ipykernel offers no debugger when debugpy does not import). The kernel runs as the student's
+#: uid, which cannot read the grader's copy of this package: hence code, not a module.
+KERNEL_CODE = ("import sys\n"
+               "if sys.path[0] == '':\n"
+               "    del sys.path[0]  # as ipykernel_launcher: the notebook's folder shadows no module\n"
+               "sys.modules['debugpy'] = None\n"
+               "from ipykernel import kernelapp\n"
+               "kernelapp.launch_new_instance()\n")
 
 
 def main(argv=None) -> int:
@@ -60,7 +72,7 @@ def main(argv=None) -> int:
         os.environ.pop("ROS_LOG_DIR", None)
         run_as.become(uid, uid, int(os.environ.get("AUTOGRADER_KERNEL_NPROC", "512")))
         connection = copy
-    os.execv(sys.executable, [sys.executable, "-m", "ipykernel_launcher", "-f", connection])
+    os.execv(sys.executable, [sys.executable, "-c", KERNEL_CODE, "-f", connection])
     return 1  # not reached
 
 

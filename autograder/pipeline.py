@@ -182,7 +182,7 @@ def choose_environment(g: Grading) -> None:
              "JUPYTER_PATH": str(work / "jupyter"), "JUPYTER_RUNTIME_DIR": str(work / "runtime"),
              "JUPYTER_CONFIG_DIR": str(work / "jupyter-config"), "AUTOGRADER_KERNEL_TMP": str(work / "kernel-tmp"),
              "PYTHONPATH": os.pathsep.join([str(grader), env_for_tools()["PYTHONPATH"]]), "HOME": str(work),
-             "PYDEVD_DISABLE_FILE_VALIDATION": "1", context.LOAD_FACTOR_ENV: f"{g.budget / GRADING_SECONDS:.2f}"}
+             context.LOAD_FACTOR_ENV: f"{g.budget / GRADING_SECONDS:.2f}"}
     if g.result.isolation == "root":
         g.result.kernel_uid = KERNEL_UID_BASE + g.domain_id
         g.env.update(AUTOGRADER_KERNEL_UID=str(g.result.kernel_uid), AUTOGRADER_KERNEL_NPROC=str(NPROC))
