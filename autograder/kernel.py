@@ -31,13 +31,15 @@ from autograder import run_as
 #: The kernel's working directory, inside the notebook's folder (see the module docstring).
 WORK_SUBDIR = ".autograder-cwd"
 
-#: What ``python -m ipykernel_launcher`` runs, without the debugger: nobody attaches one to a
-#: graded kernel, and importing debugpy costs each grading about 0.15 s of processor time
-#: (ipykernel offers no debugger when debugpy does not import). The kernel runs as the student's
-#: uid, which cannot read the grader's copy of this package: hence code, not a module.
-KERNEL_CODE = ("import sys\n"
-               "if sys.path[0] == '':\n"
-               "    del sys.path[0]  # as ipykernel_launcher: the notebook's folder shadows no module\n"
+#: ``python -m ipykernel_launcher`` without the debugger: nobody attaches one to a graded kernel,
+#: and importing debugpy costs each grading about 0.15 s of processor time (ipykernel offers no
+#: debugger when debugpy does not import). sys.argv[0] and sys.path[0] are what ``-m`` gives (the
+#: launcher's path, the working directory): code that tells a kernel by them sees one. The kernel
+#: runs as the student's uid, which cannot read the grader's copy of this package: hence code.
+KERNEL_CODE = ("import os, sys\n"
+               "from importlib.util import find_spec\n"
+               "sys.argv[0] = find_spec('ipykernel_launcher').origin\n"
+               "sys.path[0] = os.getcwd()\n"
                "sys.modules['debugpy'] = None\n"
                "from ipykernel import kernelapp\n"
                "kernelapp.launch_new_instance()\n")

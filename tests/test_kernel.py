@@ -9,7 +9,8 @@ from autograder.nbgrader_cli import env_for_tools
 
 def test_the_graded_kernel_runs_code_and_offers_no_debugger(tmp_path, monkeypatch):
     """The kernelspec the grader writes starts a kernel that runs a cell and prints; it never
-    imports debugpy (KERNEL_CODE), so it offers no debugger."""
+    imports debugpy (KERNEL_CODE), so it offers no debugger; sys.argv[0] and sys.path[0] are those
+    of ``python -m ipykernel_launcher`` (student code may tell a kernel by them)."""
     from jupyter_client import KernelManager
 
     spec = tmp_path / "jupyter" / "kernels" / "graded"
@@ -27,12 +28,12 @@ def test_the_graded_kernel_runs_code_and_offers_no_debugger(tmp_path, monkeypatc
         client.wait_for_ready(timeout=60)
         info = client.kernel_info(reply=True, timeout=30)["content"]
         outputs = []
-        client.execute_interactive("import sys; print(6 * 7, any(m.startswith(('debugpy.', '_pydevd')) for m in sys.modules))",
-                                   timeout=30,
+        client.execute_interactive("import os, sys; print(6 * 7, any(m.startswith(('debugpy.', '_pydevd')) for m in sys.modules), "
+                                   "os.path.basename(sys.argv[0]), sys.path[0] == os.getcwd())", timeout=30,
                                    output_hook=lambda msg: outputs.append(msg["content"].get("text", "")))
     finally:
         client.stop_channels()
         manager.shutdown_kernel(now=True)
-    assert "".join(outputs).split() == ["42", "False"]
+    assert "".join(outputs).split() == ["42", "False", "ipykernel_launcher.py", "True"]
     assert "debugger" not in info.get("supported_features", []) and not info.get("debugger")
     assert "debugpy" in kernel.KERNEL_CODE
