@@ -76,9 +76,9 @@ def run_outside(assignment: str, names: list[str], workdir, out: Path, budget: f
                StudentServers(budget or sum(get_check(assignment, name).timeout for name in names)))
     base = own_domains()
     if base is None:  # one domain: one check at a time
-        workers = [threading.Thread(target=lambda: [run.check(name, None) for name in names], daemon=True)]
+        workers = [threading.Thread(target=lambda: [run.check(name, None, None) for name in names], daemon=True)]
     else:
-        workers = [threading.Thread(target=run.check, args=(name, _domain(base, index)), daemon=True)
+        workers = [threading.Thread(target=run.check, args=(name, *_domains(base, index)), daemon=True)
                    for index, name in enumerate(names)]
     for worker in workers:
         worker.start()
@@ -96,9 +96,10 @@ def run_outside(assignment: str, names: list[str], workdir, out: Path, budget: f
     os._exit(0)  # the checks still running are threads of this process: end them with it
 
 
-def _domain(base: int, index: int) -> int:
-    """The ROS domain of the index-th check (the submission's own namespace has all 233)."""
-    return (base + index) % 233
+def _domains(base: int, index: int) -> tuple[int, int]:
+    """The two ROS domains of the index-th check (Context's domain_id and second_domain_id; the
+    submission's own namespace has all 233)."""
+    return (base + 2 * index) % 233, (base + 2 * index + 1) % 233
 
 
 class _Run:
@@ -111,14 +112,15 @@ class _Run:
         self.running: dict[str, tuple] = {}  # name -> (Context, seed)
         self.finished: set[str] = set()
 
-    def check(self, name: str, domain_id: int | None) -> None:
+    def check(self, name: str, domain_id: int | None, second_domain_id: int | None) -> None:
         spec = get_check(self.assignment, name)
         scratch = Path(tempfile.mkdtemp(prefix=f"autograder-{name}-"))
         started, seed = time.monotonic(), fresh_seed()
         try:
             result = run_in_this_process(self.assignment, name, seed, self.workdir, scratch, self.students,
                                          on_start=lambda ctx: self.running.__setitem__(name, (ctx, seed)),
-                                         servers=self.servers, deadline=self.deadline, domain_id=domain_id)
+                                         servers=self.servers, deadline=self.deadline, domain_id=domain_id,
+                                         second_domain_id=second_domain_id)
             embed_images(result, scratch)
         finally:
             shutil.rmtree(scratch, ignore_errors=True)

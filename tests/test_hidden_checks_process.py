@@ -64,3 +64,11 @@ def test_the_budget_comes_from_the_environment(monkeypatch):
     assert hidden_checks_process.budget_from_environment() == 12.5
     monkeypatch.delenv(BUDGET_ENV)
     assert hidden_checks_process.budget_from_environment() is None
+
+
+def test_each_check_of_a_grading_gets_two_domains_no_other_check_uses():
+    """In the submission's own namespace, a check's domain and its second domain (a launch file's
+    nodes beside a single node) are used by no other check of the grading, wherever the base lies."""
+    for base in (0, 101, 230):
+        domains = [d for index in range(6) for d in hidden_checks_process._domains(base, index)]
+        assert len(set(domains)) == len(domains) and all(0 <= d <= 232 for d in domains)

@@ -60,6 +60,8 @@ class Context:
         seed: this run's seed; rng: a numpy Generator seeded with it.
         workdir: the directory of the student's notebook and module files.
         domain_id: a ROS domain reserved for this check (student nodes and probes use it).
+        second_domain_id: another one, for nodes that must not hear those of domain_id while both
+            run (see second_domain_id; reserved when first asked for if not given).
         students: how the student's processes start (StudentProcesses; the grader passes its own);
             close() stops those this check started.
         servers: the student processes that serve calls (StudentServers; shared by the checks of
@@ -69,7 +71,8 @@ class Context:
     """
 
     def __init__(self, spec: Check, seed: int, workdir: Path, out: Path, students: StudentProcesses | None = None,
-                 servers: StudentServers | None = None, deadline: float | None = None, domain_id: int | None = None):
+                 servers: StudentServers | None = None, deadline: float | None = None, domain_id: int | None = None,
+                 second_domain_id: int | None = None):
         import numpy as np
 
         self.spec = spec
@@ -88,6 +91,7 @@ class Context:
         self.notes: list[str] = []
         self.images: list[dict] = []
         self._reservation = None if domain_id is None else _Fixed(domain_id)
+        self._second_reservation = None if second_domain_id is None else _Fixed(second_domain_id)
         self._started = time.monotonic()
         self._answers = answers.AnswerKey(spec.assignment)
 
@@ -299,9 +303,20 @@ class Context:
                 self._reservation = rosenv.reserve_domain_id()
         return self._reservation.domain_id
 
-    def probe(self):
-        """A ROS node of the checker in this check's domain (see RosProbe); close() it or use `with`."""
-        probe = RosProbe(self.domain_id)
+    @property
+    def second_domain_id(self) -> int:
+        """A second ROS domain of this check's own, e.g. for a launch file's nodes while a single
+        node of the same names runs in domain_id: given by the grader, else reserved on this machine."""
+        if self._second_reservation is None:
+            from course_lib import rosenv
+
+            self._second_reservation = rosenv.reserve_domain_id()
+        return self._second_reservation.domain_id
+
+    def probe(self, domain_id: int | None = None):
+        """A ROS node of the checker in this check's domain, or in `domain_id` (see RosProbe);
+        close() it or use `with`."""
+        probe = RosProbe(self.domain_id if domain_id is None else domain_id)
         self.students.probe_started()
         return probe
 
@@ -318,8 +333,9 @@ class Context:
         processes.stop_together(self._started_processes, timeout=1.0)
         if self._own_servers:
             self.servers.close()
-        if self._reservation is not None:
-            self._reservation.release()
+        for reservation in (self._reservation, self._second_reservation):
+            if reservation is not None:
+                reservation.release()
 
 
 class _Started:
