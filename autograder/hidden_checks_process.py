@@ -76,7 +76,7 @@ def run_outside(assignment: str, names: list[str], workdir, out: Path, budget: f
                StudentServers(budget or sum(get_check(assignment, name).timeout for name in names)))
     base = own_domains()
     if base is None:  # one domain: one check at a time
-        workers = [threading.Thread(target=lambda: [run.check(name, None, None) for name in names], daemon=True)]
+        workers = [threading.Thread(target=lambda: [run.check(name) for name in names], daemon=True)]
     else:
         workers = [threading.Thread(target=run.check, args=(name, *_domains(base, index)), daemon=True)
                    for index, name in enumerate(names)]
@@ -112,7 +112,7 @@ class _Run:
         self.running: dict[str, tuple] = {}  # name -> (Context, seed)
         self.finished: set[str] = set()
 
-    def check(self, name: str, domain_id: int | None, second_domain_id: int | None) -> None:
+    def check(self, name: str, domain_id: int | None = None, second_domain_id: int | None = None) -> None:
         spec = get_check(self.assignment, name)
         scratch = Path(tempfile.mkdtemp(prefix=f"autograder-{name}-"))
         started, seed = time.monotonic(), fresh_seed()

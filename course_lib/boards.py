@@ -100,9 +100,7 @@ class Board:
         scale = self.SCALE
         width, height = self.size
         image = np.empty((height * scale, width * scale, 4), np.uint8)
-        # BGRA: the alpha channel gives the board anti-aliased edges. Filled as one 32-bit value
-        # per pixel: numpy fills with a 4-tuple eight times slower.
-        image.view(np.uint32)[:] = np.array([(*self.PAPER, 255)], np.uint8).view(np.uint32)
+        self._paper(image)  # BGRA: the alpha channel gives the board anti-aliased edges
         for name, picture in self.pictures.items():
             x0, y0, x1, y1 = (v * scale for v in self._slots[name])
             resized = cv2.resize(picture, (x1 - x0, y1 - y0), interpolation=cv2.INTER_AREA
@@ -115,6 +113,11 @@ class Board:
         while levels[-1][1].shape[1] > 64:
             levels.append((levels[-1][0] / 2, cv2.pyrDown(levels[-1][1])))
         return levels
+
+    def _paper(self, area: np.ndarray) -> None:
+        """Fill a BGRA area (rows of contiguous pixels) with opaque paper, one 32-bit value per
+        pixel: numpy fills with a 4-tuple eight times slower."""
+        area.view(np.uint32)[:] = np.array([(*self.PAPER, 255)], np.uint8).view(np.uint32)
 
     def _with_paper(self, whole, key: frozenset) -> list[tuple[float, np.ndarray]]:
         """The levels of the whole board with paper over the markers of `key`: level 0 patched,
@@ -129,7 +132,7 @@ class Board:
             if index == 0:
                 for marker_id in key:
                     x0, y0 = (int(v) * scale for v in self.marker_square(marker_id)[0])
-                    image[y0:y0 + side, x0:x0 + side] = (*self.PAPER, 255)
+                    self._paper(image[y0:y0 + side, x0:x0 + side])
                     regions.append((y0, y0 + side, x0, x0 + side))
             else:
                 finer = levels[-1][1]

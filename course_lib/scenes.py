@@ -204,7 +204,6 @@ def render_scene(seed: int | Sequence[int] = 0, *, size: tuple[int, int] = (640,
 def scene_pose(seed: int | Sequence[int] = 0, *, size: tuple[int, int] = (640, 480), difficulty: str = "easy",
                board: Board | None = None) -> Pose:
     """The camera pose of render_scene(seed, size=size, difficulty=difficulty, board=board), without drawing it."""
-    _check_difficulty(difficulty)
     return sample_pose(_generators(seed)[0], difficulty, _check_size(size, "frame size"), board or default_board())
 
 
