@@ -59,13 +59,15 @@ def wait_for_discovery(minimum: float | None = None, quiet: float = _SETTLE_QUIE
 
     The wait never lasts longer than 5 s after the tool node's creation. On a machine loaded
     above one process per core, complete_within and that limit grow with the load per core (at
-    most MAX_LOAD_FACTOR times); the wait still ends as soon as every process has shown its nodes.
+    most MAX_LOAD_FACTOR times), and so does quiet; the wait still ends as soon as every process has shown its
+    nodes and the graph has stayed the same for that long.
     """
     global _settled_node
     node = session.tool_node()
     minimum = SETTLE_SECONDS if minimum is None else minimum
     busy = rosenv.load_factor(MAX_LOAD_FACTOR)
     complete_within = (COMPLETE_SECONDS if complete_within is None else complete_within) * busy
+    quiet *= busy  # on a busy machine the announcements of one process come further apart
     here = _participants_here(node.context.get_domain_id()) if complete_within else 0
     seen = {"graph": _snapshot(node), "since": time.monotonic(), "checks": 0, "complete": not here}
 
@@ -141,5 +143,9 @@ def _participants_here(domain_id: int) -> int:
 
 
 def _snapshot(node):
+    """What the graph shows: node names, topics with their types and how many publishers and
+    subscriptions each has (a process announces its publishers and its subscriptions apart, so a
+    topic can show with its publisher before its subscription)."""
     return (sorted(node.get_fully_qualified_node_names()),
-            sorted((name, tuple(types)) for name, types in node.get_topic_names_and_types()))
+            sorted((name, tuple(types), node.count_publishers(name), node.count_subscribers(name))
+                   for name, types in node.get_topic_names_and_types()))

@@ -134,6 +134,17 @@ def test_discovery_counts_a_process_holding_three_nodes_as_one_participant(domai
         process.stdout.close()
 
 
+def test_the_settling_wait_sees_a_subscription_arrive_on_a_topic_it_already_knows(local_session):
+    """A process announces its publishers and its subscriptions apart: a listing that settled on
+    the topic alone answered "Subscription count: 0" when the subscription came a moment later."""
+    session.add_node(Talker(name="snap_talker", topic="snap_chatter"))
+    tool = session.tool_node()
+    assert session.wait_for(lambda: tool.count_publishers("/snap_chatter") == 1, timeout=5)
+    before = discovery._snapshot(tool)
+    session.add_node(Listener(name="snap_listener", topic="snap_chatter"))
+    assert session.wait_for(lambda: tool.count_subscribers("/snap_chatter") == 1, timeout=5)
+    assert discovery._snapshot(tool)[1] != before[1]  # the topics part changed, not only the node names
+
 def test_topic_echo_receives_the_asked_number_of_messages(far_talker):
     """topic_echo(count=3) gives three consecutive messages of the type read from the graph."""
     session.start(domain_id=far_talker)
