@@ -15,7 +15,8 @@ LAB_PORT ?= 8888
 PYTEST_ARGS ?=
 # Most tests wait on discovery, timers and child processes, so more workers than cores pay off;
 # each worker reserves a ROS domain of its own (conftest.py). --dist loadfile keeps a file's
-# shared fixtures (a colcon build, a JupyterLab server, a grading run) on one worker.
+# shared fixtures (a colcon build, a JupyterLab server, a grading run) on one worker, and
+# --no-loadscope-reorder hands the files out in the order conftest.py gives (longest first).
 TEST_WORKERS ?= 4
 # Where ROS 2 comes from: pip (the ros-jazzy-* wheels, default), system (/opt/ros/jazzy, sourced
 # first) or conda (an activated RoboStack environment). With system/conda the virtual environment
@@ -105,7 +106,7 @@ hub: setup hub-deps
 # tests killed (each holds up to 32 MB of memory in /dev/shm until removed; `python -m course_lib doctor` counts them).
 test: setup browser-deps hub-deps
 	$(PY) -m ruff check .
-	$(PY) -m pytest -n $(TEST_WORKERS) --dist loadfile $(PYTEST_ARGS); status=$$?; \
+	$(PY) -m pytest -n $(TEST_WORKERS) --dist loadfile --no-loadscope-reorder $(PYTEST_ARGS); status=$$?; \
 	PATH="$(VENV)/bin:$$PATH" fastdds shm clean >/dev/null 2>&1; exit $$status
 
 clean:
