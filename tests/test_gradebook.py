@@ -20,7 +20,7 @@ SCORES = {("hw", "check_a"): 3.0, ("hw", "check_b"): 1.5}
 def template(tmp_path_factory):
     """A course with assignment hw (notebook hw: check_a 4 points, check_b 2), due 2025-03-14 12:00
     UTC, 50 % late penalty per day, and alice's submission handed in on 2025-03-15 10:00 UTC.
-    (Creating a gradebook runs alembic, seconds: each test gets a copy.)"""
+    Each test gets a copy."""
     root = tmp_path_factory.mktemp("template")
     config.write_config(root)
     with open(root / "nbgrader_config.py", "a") as handle:
@@ -136,3 +136,23 @@ def test_no_sqlalchemy_warning_when_a_submission_is_created(course):
             "gradebook.record(Path(sys.argv[1]), 'alice', 'hw', {}, None, Config())")
     done = subprocess.run([sys.executable, "-c", code, str(course)], capture_output=True, text=True, timeout=120)
     assert done.returncode == 0 and "SAWarning" not in done.stderr, done.stderr
+
+
+def test_a_new_gradebook_is_stamped_with_the_revision_alembic_heads_names(tmp_path):
+    """A gradebook created by the grader carries the schema revision nbgrader's own creation
+    would ask of the `alembic heads` command (the grader reads it without starting alembic)."""
+    from pathlib import Path
+
+    from nbgrader import dbutil
+    from sqlalchemy import create_engine, text
+
+    with dbutil._temp_alembic_ini("sqlite:///unused.db") as ini:
+        heads = subprocess.run([str(Path(sys.executable).parent / "alembic"), "-c", ini, "heads"],
+                               capture_output=True, text=True, timeout=120, check=True).stdout
+    with gradebook.open_gradebook(tmp_path):
+        pass
+    engine = create_engine(gradebook.db_url(tmp_path))
+    with engine.connect() as connection:
+        stamped = connection.execute(text("SELECT version_num FROM alembic_version")).scalar_one()
+    engine.dispose()
+    assert stamped == heads.split()[0] == gradebook.schema_head()
