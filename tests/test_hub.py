@@ -190,8 +190,9 @@ def test_students_submit_in_the_assignments_panel_and_each_fetches_only_their_fe
     shown = instructor.get(f"{hub.url}/user/{hub.instructor}/formgrader/api/submissions/{ASSIGNMENT}",
                            headers={"X-XSRFToken": xsrf}, timeout=60).json()
     scores = {row["student"]: (row["score"], row["max_score"]) for row in shown}
-    assert scores[alice][0] == scores[alice][1] > 0, shown
-    assert 0 <= scores[bob][0] < scores[bob][1], shown
+    # On failure, the grader's verdicts say which item cost the points.
+    assert scores[alice][0] == scores[alice][1] > 0, (shown, zoo.graded_outputs(hub.course_dir, alice, ASSIGNMENT)[-3000:])
+    assert 0 <= scores[bob][0] < scores[bob][1], (shown, zoo.graded_outputs(hub.course_dir, bob, ASSIGNMENT)[-3000:])
 
     for user, page in pages.items():
         _press(page, "submitted", "Fetch Feedback")

@@ -109,10 +109,13 @@ def test_a_program_the_user_cannot_execute_is_named_with_the_fix(tmp_path):
 def test_the_child_still_dies_with_its_supervisor(token):
     """Switching uid clears PR_SET_PDEATHSIG; the wrapper arms it again, so a killed supervisor
     leaves no process of the student behind."""
-    command = run_as.command(NOBODY, [sys.executable, "-S", "-c", "import time; time.sleep(100)", token])
+    # A shell, not this interpreter: nobody cannot run a virtual environment whose Python lies
+    # under /root. The token is the shell's $0; its `sleep 1` children end within a second of it.
+    command = run_as.command(NOBODY, ["sh", "-c", "while :; do sleep 1; done", token])
     process = NodeProcess(command, cwd="/").start()
-    # Two interpreters start before the sleeper shows (the wrapper, then python): slow under load.
-    assert wait_until(lambda: processes_with(token), timeout=30), process.log
+    # The child, as nobody: the wrapper (root until it switches) carries the token too, and found
+    # alone it let this test pass while the child could not even start.
+    assert wait_until(lambda: [p for p in processes_with(token) if p.uids().real == NOBODY], timeout=30), process.log
     os.kill(process._supervisor.pid, signal.SIGKILL)
     assert wait_until(lambda: not processes_with(token), timeout=10)
     process.stop()

@@ -110,9 +110,11 @@ THROUGHPUT_RATE = 30.0
 #: drops large best-effort frames and the nodes compete for the processor, costs both alike; a
 #: per-byte Python loop (seconds per frame) falls far short.
 THROUGHPUT_SHARE = 0.4
-#: Bursts at most: a node that falls short gets one more burst, its better one counts (a busy
-#: grading machine's scheduler favours one process or the other for a second or two).
-THROUGHPUT_BURSTS = 2
+#: Bursts at most: a node that falls short gets another burst, its best one counts (a busy
+#: grading machine's scheduler favours one process or the other for a second or two; graded
+#: beside the whole test suite, at a load of about 10 on 2 cores, the reference once lost 2 of the
+#: node check's 7 points, the weight of this item, when two bursts were the most).
+THROUGHPUT_BURSTS = 3
 #: Below this many answers from the yardstick node, the machine was too busy to measure.
 THROUGHPUT_MIN_REFERENCE = 20
 YARDSTICK_NODE_NAME = "brightness_yardstick"
