@@ -61,6 +61,16 @@ def test_outside_a_kernel_the_console_keeps_the_lines():
     assert not node_logs.in_kernel() and node_logs.init_arguments() == []
 
 
+def test_outside_a_kernel_asking_imports_no_ipython():
+    """A process that is no kernel (a `ros2` call, a node) learns it without importing IPython."""
+    import subprocess
+    import sys
+
+    code = "import sys; from course_lib import node_logs; print(node_logs.in_kernel(), 'IPython' in sys.modules)"
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert done.stdout.split() == ["False", "False"], done.stderr
+
+
 def test_a_record_reads_like_the_console_line():
     record = Log(stamp=Time(sec=12, nanosec=5), level=30, name="robot1.talker", msg="careful")
     assert node_logs.format_record(record) == "[WARN] [12.000000005] [robot1.talker]: careful"
