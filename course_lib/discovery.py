@@ -58,9 +58,9 @@ def wait_for_discovery(minimum: float | None = None, quiet: float = _SETTLE_QUIE
             not at all). On a busy machine some of them take seconds to be discovered.
 
     The wait never lasts longer than 5 s after the tool node's creation. On a machine loaded
-    above one process per core, complete_within and that limit grow with the load per core (at
-    most MAX_LOAD_FACTOR times), and so does quiet; the wait still ends as soon as every process has shown its
-    nodes and the graph has stayed the same for that long.
+    above one process per core, complete_within, quiet and that limit grow with the load per core
+    (at most MAX_LOAD_FACTOR times); the wait still ends as soon as every process has shown its
+    nodes and the graph has stayed the same for the quiet time.
     """
     global _settled_node
     node = session.tool_node()

@@ -13,12 +13,14 @@ def marker() -> str:
     return f"course-lib-test-{uuid.uuid4().hex}"
 
 
-def processes_with(token: str) -> list[psutil.Process]:
+def processes_with(token: str, uid: int | None = None) -> list[psutil.Process]:
+    """The live processes whose command line carries `token` (and that run as `uid`, if given)."""
     found = []
-    for process in psutil.process_iter(["cmdline", "status"]):
+    for process in psutil.process_iter(["cmdline", "status", "uids"]):
         try:
             if process.info["status"] != psutil.STATUS_ZOMBIE and any(
-                    token in part for part in process.info["cmdline"] or ()):
+                    token in part for part in process.info["cmdline"] or ()) and (
+                    uid is None or (process.info["uids"] and process.info["uids"].real == uid)):
                 found.append(process)
         except (psutil.NoSuchProcess, psutil.AccessDenied):
             pass

@@ -145,6 +145,7 @@ def test_the_settling_wait_sees_a_subscription_arrive_on_a_topic_it_already_know
     assert session.wait_for(lambda: tool.count_subscribers("/snap_chatter") == 1, timeout=5)
     assert discovery._snapshot(tool)[1] != before[1]  # the topics part changed, not only the node names
 
+
 def test_topic_echo_receives_the_asked_number_of_messages(far_talker):
     """topic_echo(count=3) gives three consecutive messages of the type read from the graph."""
     session.start(domain_id=far_talker)

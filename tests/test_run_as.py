@@ -115,7 +115,7 @@ def test_the_child_still_dies_with_its_supervisor(token):
     process = NodeProcess(command, cwd="/").start()
     # The child, as nobody: the wrapper (root until it switches) carries the token too, and found
     # alone it let this test pass while the child could not even start.
-    assert wait_until(lambda: [p for p in processes_with(token) if p.uids().real == NOBODY], timeout=30), process.log
+    assert wait_until(lambda: processes_with(token, uid=NOBODY), timeout=30), process.log
     os.kill(process._supervisor.pid, signal.SIGKILL)
     assert wait_until(lambda: not processes_with(token), timeout=10)
     process.stop()
