@@ -257,6 +257,17 @@ class NodeProcess:
         """True between start() and the moment the child (and its leftovers) are gone."""
         return self._supervisor is not None and self.returncode is None
 
+    def cpu_seconds(self) -> float:
+        """Processor time the child and its descendants have used so far (user + system; see
+        course_lib.process_tree.cpu_seconds): what a computation costs whatever the machine's
+        load. Counts descendants that left the child's group too (the supervisor adopts them);
+        0.0 before start and after the end."""
+        if self._supervisor is None or not self.running():
+            return 0.0
+        from course_lib.process_tree import cpu_seconds
+
+        return cpu_seconds(self._supervisor.pid, include_self=False)
+
     @property
     def log(self) -> str:
         """Everything the child wrote to stdout and stderr so far, with the middle of a very

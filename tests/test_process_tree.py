@@ -40,3 +40,51 @@ def test_signalling_a_group_that_has_gone_does_nothing():
     process_tree.signal_group(done.pid, signal.SIGKILL)
     process_tree.signal_tree(done.pid, signal.SIGKILL)
     assert process_tree.stop_group(done) == 0
+
+
+def test_cpu_seconds_counts_the_whole_tree_and_what_it_reaped():
+    """A parent that burns 0.3 s of processor time, a child of a second thread that burns 0.4 s and
+    stays, and a reaped child that burned 0.2 s: all of it counts; a process that sleeps adds
+    nothing; a grandchild whose parent exited (re-parented to init: course_lib.supervisor is a
+    subreaper so that a node's such leftovers stay in its tree) is no longer part of it."""
+    code = """
+import os, sys, threading, time
+def burn(seconds):
+    start = time.process_time()
+    while time.process_time() - start < seconds:
+        pass
+def stay(seconds, setsid=False):
+    if os.fork() == 0:
+        if setsid:
+            os.setsid()
+            if os.fork() == 0:
+                burn(seconds); print('burnt', flush=True); time.sleep(60)
+            os._exit(0)
+        burn(seconds); print('burnt', flush=True); time.sleep(60)
+thread = threading.Thread(target=stay, args=(0.4,)); thread.start(); thread.join()
+stay(0.2, setsid=True)
+if os.fork() == 0:
+    burn(0.2); os._exit(0)
+os.wait()
+burn(0.3)
+print('burnt', flush=True)
+time.sleep(60)
+"""
+    parent = subprocess.Popen([sys.executable, "-S", "-c", code], stdout=subprocess.PIPE, text=True,
+                              start_new_session=True)
+    try:
+        assert [parent.stdout.readline() for _ in range(3)] == ["burnt\n"] * 3
+        used = process_tree.cpu_seconds(parent.pid)
+        # Each process's time is counted in clock ticks (10 ms), rounded down.
+        assert 0.85 <= used < 1.1, used
+        assert process_tree.cpu_seconds(parent.pid) - used < 0.05  # asleep now: nothing more
+        assert process_tree.cpu_seconds(parent.pid, include_self=False) <= used - 0.25  # not its own 0.3 s
+    finally:
+        process_tree.signal_tree(parent.pid, signal.SIGKILL)
+        parent.wait(timeout=10)
+
+
+def test_cpu_seconds_of_a_process_that_has_gone_is_zero():
+    proc = subprocess.Popen([sys.executable, "-S", "-c", "pass"])
+    proc.wait(timeout=10)
+    assert process_tree.cpu_seconds(proc.pid) == 0.0

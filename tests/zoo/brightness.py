@@ -106,9 +106,8 @@ def cheater(nb):
     nb.cells.insert(index + 1, nbformat.v4.new_code_cell(CHEAT))
 
 
-#: The throughput item's verdict, measured or not: the grading got that far. On a machine too busy
-#: for the grader's yardstick node the item is not measured (and not held against the student).
-THROUGHPUT_VERDICT = ("your node answered", "not measured, the grading machine was too busy")
+#: The throughput item's verdict: the grading got that far.
+THROUGHPUT_VERDICT = "your node used"
 
 
 def entries(course_dir: str) -> dict[str, dict]:
@@ -147,6 +146,10 @@ def entries(course_dir: str) -> dict[str, dict]:
         # returns (it waits, as a spin does, rather than burning a core for the whole time limit).
         "import_loop": dict(edits=[(IMPORTS, IMPORTS + "rclpy.init()\nrclpy.spin(rclpy.create_node('spun_at_import'))\n")],
                             values=0, node=0, reason="did not finish within"),
+        # A callback that computes with Python's sum() over msg.data: right answers, 6-9 times the
+        # processor time per frame of the grader's yardstick (the throughput item allows 3).
+        "slow_callback": dict(level="check", edits=[(CALLBACK, "        self.publisher.publish(UInt8(data=sum(msg.data) // len(msg.data)))")],
+                              values=None, node=5.0, reason="too slow"),
         # A callback that never returns: the endpoints' points only; what needs answers is named
         # as following from the unanswered frames (run through the checks: no kernel involved).
         "callback_loop": dict(level="check", edits=[(CALLBACK, "        while True:\n            pass")], values=None,
