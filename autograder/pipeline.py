@@ -58,9 +58,10 @@ from course_lib.checks import context, runner
 #: a hostile submission must not stall the class). Each step gets at most what is left of it.
 GRADING_SECONDS = 60.0
 #: On a machine busier than its cores, the budget grows with the load (grading_budget), at most
-#: this many times: the bound is on the share of the machine a submission gets, and a reference
-#: submission that takes 6 s on an idle machine took 40 s with a load of 20 on 2 cores.
-MAX_LOAD_FACTOR = 6.0
+#: this many times (the checks' backstops grow alike): the bound is on the share of the machine a
+#: submission gets, and a reference submission that takes 6 s on an idle machine took 40 s with a
+#: load of 20 on 2 cores.
+MAX_LOAD_FACTOR = context.MAX_LOAD_FACTOR
 #: Seconds one notebook may take under grading, everything included (also bounded by what is left
 #: of GRADING_SECONDS less KEPT_FOR_CHECKS).
 NOTEBOOK_TIMEOUT = 420.0

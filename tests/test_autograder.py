@@ -173,7 +173,7 @@ PUBSUB_MISTAKES = {
     "best_effort": ([("self.create_publisher(MsgTutorial, TOPIC, QUEUE_DEPTH)",
                       "self.create_publisher(MsgTutorial, TOPIC, rclpy.qos.qos_profile_sensor_data)")], "publisher",
                     "publisher queue depth 5"),
-    "one_hertz": ([("create_timer(0.1,", "create_timer(1.0,")], "publisher", "cannot measure a 10 Hz rate"),
+    "one_hertz": ([("create_timer(0.1,", "create_timer(1.0,")], "publisher", "rate 1.00 Hz from the stamps of 3"),
     "counter_stuck": ([("        self.count += 1\n", "")], "publisher", "add one per message"),
     # Package-level mistakes (a missing <depend>, a wrong entry point, a wrong message field, a
     # build error) go through the whole pipeline in the zoo (tests/zoo/pubsub.py), with these phrases.

@@ -44,18 +44,27 @@ def test_the_budget_is_sixty_seconds_on_an_idle_machine_and_grows_with_the_load_
 
 
 def test_the_checks_limits_grow_with_the_load_factor_the_grader_passes_on(monkeypatch):
-    """A call's and an import's limit, and a check's own timeout, are wall time: the grader passes
-    its budget's load factor on, and the checks scale them by it (never below the idle limits)."""
+    """A call's and an import's wall-clock backstop, and a check's own timeout, grow with the load
+    factor the grader passes on (never below the idle limits, at most MAX_LOAD_FACTOR times); a
+    self-check, which has none, takes the machine's load per core now."""
+    import os
+
     from course_lib.checks import context
 
+    cores = os.cpu_count() or 1
     monkeypatch.delenv(context.LOAD_FACTOR_ENV, raising=False)
+    monkeypatch.setattr(os, "getloadavg", lambda: (0.1, 0.1, 0.1))
     assert context.scaled(context.CALL_TIMEOUT) == context.CALL_TIMEOUT
+    monkeypatch.setattr(os, "getloadavg", lambda: (2.0 * cores, 0.1, 0.1))
+    assert context.scaled(context.CALL_TIMEOUT) == 2.0 * context.CALL_TIMEOUT
     monkeypatch.setenv(context.LOAD_FACTOR_ENV, "3.5")
     assert context.scaled(context.CALL_TIMEOUT) == 3.5 * context.CALL_TIMEOUT
     monkeypatch.setenv(context.LOAD_FACTOR_ENV, "0.2")
     assert context.scaled(context.IMPORT_TIMEOUT) == context.IMPORT_TIMEOUT
+    monkeypatch.setenv(context.LOAD_FACTOR_ENV, "100")
+    assert context.scaled(context.IMPORT_TIMEOUT) == context.MAX_LOAD_FACTOR * context.IMPORT_TIMEOUT
     monkeypatch.setenv(context.LOAD_FACTOR_ENV, "busy")
-    assert context.scaled(context.IMPORT_TIMEOUT) == context.IMPORT_TIMEOUT
+    assert context.scaled(context.IMPORT_TIMEOUT) == 2.0 * context.IMPORT_TIMEOUT
 
 
 def test_the_grader_tells_the_checks_its_load_factor(tmp_path):

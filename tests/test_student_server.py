@@ -5,6 +5,7 @@ and not called again, answers kept across a crash."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from course_lib.checks import context
 from course_lib.checks.context import Context, StudentError
@@ -18,6 +19,13 @@ def average_brightness(image):
         time.sleep(100)
     if image.size == 5:
         os._exit(3)
+    if image.size == 11:  # computes 0.3 s, then answers
+        start = time.process_time()
+        while time.process_time() - start < 0.3:
+            pass
+    if image.size == 13:  # computes forever
+        while True:
+            pass
     return os.getpid()
 """
 
@@ -40,13 +48,41 @@ def test_calls_share_one_process_and_a_hung_function_is_named_and_not_called_aga
         first, second, hung, later = ctx.call("average_brightness", [((i,), {}) for i in images], timeout=1.5,
                                               labels=["'one'", "'two'", "'the slow one'", "'four'"])
         assert first.ok and second.ok and first.value == second.value  # one process, imported once
-        assert "average_brightness on 'the slow one' did not return within 2 s" in hung.error
-        assert later.error == "not run: average_brightness did not return within 2 s on 'the slow one' earlier"
+        assert "average_brightness on 'the slow one' did not return within 2 s, waiting rather than computing" \
+            in hung.error
+        assert later.error.startswith("not run: average_brightness on 'the slow one' earlier did not return within 2 s")
         again = _context(tmp_path / "next", MODULE, servers)  # a later check of the same grading
         assert again.call("average_brightness", [((images[0],), {})])[0].error.startswith("not run: ")
     finally:
         ctx.close()
         servers.close()
+
+
+def test_a_call_that_computes_is_judged_by_its_processor_time_not_the_clock(tmp_path, monkeypatch):
+    """Processor time decides for code that computes: 0.3 s of it within a budget of 1 s answers
+    (however long a busy machine makes that in wall time: the wall-clock backstop is far off), an
+    endless loop is stopped when it has used the budget, and the feedback names the budget."""
+    monkeypatch.setattr(context, "CALL_CPU_SECONDS", 1.0)
+    ctx = _context(tmp_path, MODULE)
+    try:
+        computes, loops, later = ctx.call("average_brightness", [((np.zeros(n),), {}) for n in (11, 13, 3)],
+                                          timeout=120, labels=["'the long one'", "'the endless one'", "'three'"])
+        assert computes.ok, computes.error
+        assert "average_brightness on 'the endless one' used 1 s of processor time without returning" in loops.error
+        assert later.error.startswith("not run: average_brightness on 'the endless one' earlier used 1 s of processor")
+    finally:
+        ctx.close()
+
+
+def test_a_call_that_waits_is_not_stopped_by_the_processor_budget(tmp_path, monkeypatch):
+    """sleep() uses no processor time: only the wall-clock backstop ends it."""
+    monkeypatch.setattr(context, "CALL_CPU_SECONDS", 0.2)
+    ctx = _context(tmp_path, MODULE)
+    try:
+        (hung,) = ctx.call("average_brightness", [((np.zeros(7),), {})], timeout=1.5)
+        assert "did not return within 2 s, waiting rather than computing" in hung.error
+    finally:
+        ctx.close()
 
 
 def test_after_a_crash_the_next_call_runs_in_a_fresh_process(tmp_path):
@@ -59,15 +95,24 @@ def test_after_a_crash_the_next_call_runs_in_a_fresh_process(tmp_path):
         ctx.close()
 
 
-def test_an_import_that_never_ends_is_marked_for_later_checks(tmp_path, monkeypatch):
-    monkeypatch.setattr(context, "IMPORT_TIMEOUT", 2.0)
-    ctx = _context(tmp_path, "while True:\n    pass\n")
+@pytest.mark.parametrize("code, reason", [
+    ("while True:\n    pass\n", "used 1 s of processor time without finishing"),
+    ("import time\ntime.sleep(100)\n", "did not finish within 2 s, waiting rather than computing")])
+def test_an_import_that_never_ends_is_marked_for_later_checks(tmp_path, monkeypatch, code, reason):
+    """An import that computes forever ends at its processor budget, one that waits at the
+    wall-clock backstop; either is marked, and later checks fail at once with the fix."""
+    monkeypatch.setattr(context, "IMPORT_CPU_SECONDS", 1.0)
+    monkeypatch.setattr(context, "IMPORT_TIMEOUT", 2.0 if "sleep" in code else 120.0)
+    monkeypatch.setenv(context.LOAD_FACTOR_ENV, "1")  # the backstop as given, however busy the machine
+    ctx = _context(tmp_path, code)
     try:
         try:
             ctx.call("average_brightness", [((np.zeros(3),), {})])
             raise AssertionError("the import did not fail")
         except StudentError as error:
-            assert "did not finish within 2 s" in str(error)
+            assert reason in str(error) and "put it in main()" in str(error)
         assert (tmp_path / context.IMPORT_HANG_MARK).exists()
+        with pytest.raises(StudentError, match="did not finish in an earlier check"):
+            ctx.require_module()
     finally:
         ctx.close()

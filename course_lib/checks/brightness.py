@@ -23,7 +23,7 @@ import time
 import numpy as np
 
 from course_lib.checks import packages, runner
-from course_lib.checks.context import Context
+from course_lib.checks.context import Context, scaled
 from course_lib.checks.registry import check
 from course_lib.checks.student_processes import student_env
 
@@ -161,7 +161,7 @@ def _exchange(ctx, probe, node, publisher, replies: list, frames, encoding: str,
         # Resent every 0.3 s (best effort may drop a frame); WRONG_ANSWERS wrong answers end the
         # wait early. `earlier` collects the right answers of all frames sent before.
         wrong = lambda: _wrong(replies, earlier - {expected}) >= WRONG_ANSWERS  # noqa: E731
-        probe.resend_until(publisher, msg, lambda: expected in replies or not node.running() or wrong(), 4.0)
+        probe.resend_until(publisher, msg, lambda: expected in replies or not node.running() or wrong(), scaled(4.0))
         earlier.add(expected)
         if not node.running():
             return None
@@ -169,7 +169,7 @@ def _exchange(ctx, probe, node, publisher, replies: list, frames, encoding: str,
             if replies:
                 return ctx.item(False, f"{label}: for a frame of brightness {expected} the node published "
                                        f"{sorted(set(replies))[:5]}")
-            return ctx.item(False, f"{label}: no value on /brightness within 4 s of publishing a {encoding} frame "
+            return ctx.item(False, f"{label}: no value on /brightness within {scaled(4):.0f} s of publishing a {encoding} frame "
                                    f"on /image, while the node runs; see the node's output below")
     return ctx.item(True, f"{label}: the right brightness for {len(frames)} {encoding} frames")
 
@@ -184,7 +184,7 @@ def _topic_items(ctx, probe) -> str | None:
         return ([i for i in probe.node.get_subscriptions_info_by_topic("/image") if i.node_name == NODE_NAME],
                 [i for i in probe.node.get_publishers_info_by_topic("/brightness") if i.node_name == NODE_NAME])
 
-    probe.spin_until(lambda: all(endpoints()), 3.0)
+    probe.spin_until(lambda: all(endpoints()), scaled(3.0))
     subs, pubs = endpoints()
     topics = {name: types for name, types in probe.node.get_topic_names_and_types()}
     blocker = None
@@ -264,7 +264,7 @@ def node(ctx: Context) -> None:
         with ctx.probe() as probe:
             publisher, replies = _frames_and_replies(probe, "/image", "/brightness")
             yardstick_replies = _replies(probe, YARDSTICK_ANSWERS)
-            appeared = probe.spin_until(lambda: NODE_NAME in _node_names(probe) or not node.running(), 25.0)
+            appeared = ctx.wait_for_node(probe, node, NODE_NAME)
             if _node_died(ctx, node):
                 crashed = True
                 return _consequences(ctx, "the node process ended", 0)
@@ -275,7 +275,7 @@ def node(ctx: Context) -> None:
                             "top level of the module runs before main() does")
                 else:
                     hint = f"; nodes seen: {names}: pass '{NODE_NAME}' to super().__init__()" if names else ""
-                ctx.item(False, f"no node named {NODE_NAME} appeared within 25 s" + hint)
+                ctx.item(False, f"no node named {NODE_NAME} appeared within {scaled(25):.0f} s" + hint)
                 return _consequences(ctx, f"no node named {NODE_NAME} ran", 0)
             ctx.precondition(True, f"a node named {NODE_NAME} runs")
             blocker = _topic_items(ctx, probe)
@@ -428,7 +428,8 @@ def _throughput(ctx, probe, node, yardstick, publisher, replies, yardstick_repli
     expected = {ctx.expected("average_brightness", image) for image in images}
     # The yardstick started with the student's node: it has long been up, unless it could not start.
     if not probe.spin_until(lambda: (YARDSTICK_NODE_NAME in _node_names(probe)
-                                     and publisher.get_subscription_count() >= 2) or not yardstick.running(), 30.0) \
+                                     and publisher.get_subscription_count() >= 2) or not yardstick.running(),
+                            scaled(30.0)) \
             or not yardstick.running():
         ctx.item(True, f"{label}: not measured, the grader's yardstick node did not start ({yardstick.describe_exit()}); "
                        "not held against you", weight=2.0)
@@ -467,14 +468,13 @@ def _remapped(ctx, probe, remapped, image) -> None:
 
     label = "remapped names"
     publisher, replies = _frames_and_replies(probe, REMAPPED_IMAGE, REMAPPED_BRIGHTNESS)
-    if not probe.spin_until(lambda: REMAPPED_NODE_NAME in _node_names(probe) or not remapped.running(), 10.0) \
-            or not remapped.running():
+    if not ctx.wait_for_node(probe, remapped, REMAPPED_NODE_NAME, 10.0) or not remapped.running():
         ctx.item(False, f"{label}: started with --ros-args -r __node:={REMAPPED_NODE_NAME}, no node of that name "
                         "appeared: call rclpy.init(args=args) and pass args from main(args=None)")
         return
     expected = ctx.expected("average_brightness", image)
     msg = images.image_to_msg(image, "bgr8")
-    probe.resend_until(publisher, msg, lambda: expected in replies or len(replies) >= WRONG_ANSWERS, 4.0)
+    probe.resend_until(publisher, msg, lambda: expected in replies or len(replies) >= WRONG_ANSWERS, scaled(4.0))
     if expected in replies:
         ctx.item(True, f"{label}: {REMAPPED_IMAGE} -> {REMAPPED_BRIGHTNESS} works")
         return

@@ -30,7 +30,7 @@ from __future__ import annotations
 import numpy as np
 
 from course_lib.checks import packages, runner
-from course_lib.checks.context import Context, clip
+from course_lib.checks.context import Context, clip, scaled
 from course_lib.checks.registry import check
 
 ASSIGNMENT = "catdog_warp"
@@ -243,14 +243,15 @@ def _single_node_items(ctx: Context, proc, message_type) -> bool:
             scene = scenes.render_scene(_seed(ctx), difficulty="easy")
             expected = scene.expected_crops(SIZE)
             msg = images.image_to_msg(scene.frame, "bgr8")
-            probe.spin_until(lambda: "marker_reader" in names() or not proc.running(), 25.0)
+            ctx.wait_for_node(probe, proc, "marker_reader")
             if not proc.running():
                 ctx.item(False, f"the node process ended ({proc.describe_exit()}):\n{clip(proc.log_tail(6))}")
                 return False
             if not ctx.precondition("marker_reader" in names(), "node marker_reader runs" if "marker_reader" in names() else
                             f"no node named marker_reader (nodes: {sorted(names())})"):
                 return False
-            probe.resend_until(pub, msg, lambda: bool(got["cat"] and got["dog"]), 8.0, every=0.5)
+            probe.resend_until(pub, msg, lambda: bool(got["cat"] and got["dog"]) or not proc.running(), scaled(8.0),
+                               every=0.5)
             types = dict(probe.node.get_topic_names_and_types())
     finally:
         proc.stop(timeout=2)
@@ -259,7 +260,8 @@ def _single_node_items(ctx: Context, proc, message_type) -> bool:
         topic = f"/cropped_img ({name}, picture {PICTURE_NUMBERS[name]})"
         if not got[name]:
             seen = types.get("/cropped_img")
-            ctx.item(False, f"no {name} (picture = {PICTURE_NUMBERS[name]}) arrived on /cropped_img within 8 s" +
+            ctx.item(False, f"no {name} (picture = {PICTURE_NUMBERS[name]}) arrived on /cropped_img within "
+                            f"{scaled(8):.0f} s" +
                      (f" (it carries {seen}; the contract says {wanted[0]})" if seen and seen != wanted else
                       "" if seen else f" (topics: {sorted(t for t in types if not t.startswith(('/rosout', '/parameter')))})") +
                      "; the node's output:\n" + clip(proc.log_tail(4)))
@@ -291,11 +293,12 @@ def _launch_item(ctx: Context, message_type) -> tuple[bool, str]:
     launch = ctx.students.start(command, name="student-launch", cwd=ctx.workdir, domain_id=domain_id,
                                 wall_seconds=ctx.remaining() + 5, env=packages.student_env(ctx, ws))
     crops = []
+    backstop = min(scaled(20.0), ctx.remaining() - 3)
     try:
         with ctx.probe(domain_id) as probe:
             probe.node.create_subscription(message_type, "cropped_img", crops.append,
                                            QoSProfile(depth=10, reliability=ReliabilityPolicy.BEST_EFFORT))
-            probe.spin_until(lambda: bool(crops) or not launch.running(), min(20.0, ctx.remaining() - 3))
+            probe.spin_until(lambda: bool(crops) or not launch.running(), backstop)
             nodes = {n for n, _ in probe.node.get_node_names_and_namespaces()}
     finally:
         launch.stop(timeout=3)
@@ -303,6 +306,6 @@ def _launch_item(ctx: Context, message_type) -> tuple[bool, str]:
     if crops:
         return True, f"{shown} starts image_publisher and marker_reader; crops arrive on /cropped_img"
     missing = sorted({"image_publisher", "marker_reader"} - nodes)
-    return False, (f"{shown}: no crop arrived on /cropped_img within 20 s"
+    return False, (f"{shown}: no crop arrived on /cropped_img within {backstop:.0f} s"
                    + (f"; nodes missing: {missing}" if missing else "")
                    + f". Its output:\n{clip(launch.log_tail(6))}")

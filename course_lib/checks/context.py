@@ -12,20 +12,28 @@ from course_lib.checks.probe import RosProbe
 from course_lib.checks.registry import Check
 from course_lib.checks.student_calls import Outcome, call_request
 from course_lib.checks.student_processes import StudentProcesses
-from course_lib.checks.student_server import ServerError, StudentServers
+from course_lib.checks.student_server import ProcessorTime, ServerError, StudentServers
 
-#: Seconds a student's module gets to import (rclpy, numpy and cv2 need one to three on a busy
-#: machine); kept well below a grading's time for all checks (autograder.hidden_checks_process).
+#: Processor seconds a student's module may use to import (rclpy, numpy and cv2 take about one),
+#: and the wall-clock backstop for an import that waits instead (a spin() at the top level),
+#: kept well below a grading's time for all checks (autograder.hidden_checks_process).
+IMPORT_CPU_SECONDS = 10.0
 IMPORT_TIMEOUT = 15.0
 
-#: Seconds one call of a student's function gets, unless the check says otherwise (never more
-#: than the check has left, nor than the grading's time). The contract's functions answer in
-#: milliseconds; a call that prints a gigabyte needs several seconds on a busy machine.
+#: Processor seconds one call of a student's function may use, and the wall-clock backstop for a
+#: call that waits instead (sleep, spin, input), unless the check says otherwise (never more than
+#: the check has left, nor than the grading's time). The contract's functions answer in
+#: milliseconds; the processor budget decides for code that computes, whatever the machine's load.
+CALL_CPU_SECONDS = 5.0
 CALL_TIMEOUT = 20.0
 
+#: Processor seconds a node's process may use before its node appears (Python, rclpy, numpy and
+#: the student's module take one or two): more is a loop before the node is created.
+NODE_START_CPU_SECONDS = 10.0
+
 #: Set by the grader: how many times the idle machine's time limits a grading gets on this
-#: machine now (its load per core, autograder.pipeline.grading_budget). The limits above are wall
-#: time, so they grow with it: a busy machine gives each process a fraction of a core.
+#: machine now (its load per core, autograder.pipeline.grading_budget). The wall-clock backstops
+#: above grow with it: a busy machine gives each process a fraction of a core.
 LOAD_FACTOR_ENV = "AUTOGRADER_LOAD_FACTOR"
 
 
@@ -37,9 +45,21 @@ def number_from_environment(name: str) -> float | None:
         return None
 
 
+#: At most this many times the idle machine's backstop (autograder.pipeline.MAX_LOAD_FACTOR).
+MAX_LOAD_FACTOR = 6.0
+
+
 def scaled(seconds: float) -> float:
-    """`seconds` times the grader's load factor (LOAD_FACTOR_ENV; 1 when unset or not a number)."""
-    return seconds * max(1.0, number_from_environment(LOAD_FACTOR_ENV) or 1.0)
+    """A wall-clock backstop of `seconds` on an idle machine, times the grader's load factor
+    (LOAD_FACTOR_ENV), or in a self-check this machine's load per core now (between 1 and
+    MAX_LOAD_FACTOR): a legitimate answer that needs a little processor time comes later on a busy
+    machine, and a backstop must never be what decides against it."""
+    factor = number_from_environment(LOAD_FACTOR_ENV)
+    if factor is None:
+        from course_lib import rosenv
+
+        factor = rosenv.load_factor(MAX_LOAD_FACTOR)
+    return seconds * min(MAX_LOAD_FACTOR, max(1.0, factor))
 
 
 #: Written into the work directory when the student's module did not import in time, so that
@@ -173,9 +193,8 @@ class Context:
             raise StudentError(f"{shown} does not exist: run the cell that starts with %%writefile {shown} "
                                "(it writes your module)")
         if self.import_hung():
-            raise StudentError(f"importing {self.module} did not finish within {scaled(IMPORT_TIMEOUT):.0f} s in an "
-                               "earlier check: remove code that runs forever at import (loops, spin()) "
-                               "from the top level of the module; put it in main()")
+            raise StudentError(f"importing {self.module} did not finish in an earlier check: remove code that "
+                               "runs forever at import (loops, spin()) from the top level of the module; put it in main()")
 
     def import_hung(self) -> bool:
         """Whether importing the student's module did not finish in an earlier check of this grading."""
@@ -189,13 +208,15 @@ class Context:
         Args:
             function: the name of a function of the student's module.
             calls: (args, kwargs) per call; args may hold numpy arrays, kwargs plain JSON values.
-            timeout: seconds each call gets; default CALL_TIMEOUT, never more than the check has left.
+            timeout: wall-clock seconds each call gets at most; default CALL_TIMEOUT (scaled), never
+                more than the check has left. Each call may also use CALL_CPU_SECONDS of processor time.
             labels: what each call's input is, for the feedback ("easy scene 2"); default "input i".
 
         Returns:
-            One Outcome per call. A call that did not return in time, or whose process died, gets
-            an Outcome whose error says which call it was; a function that once did not return in
-            time is not called again in this grading (its later calls say so at once).
+            One Outcome per call. A call that used up its processor time or waited past its
+            backstop, or whose process died, gets an Outcome whose error says which call it was and
+            what it had; a function that once did not return is not called again in this grading
+            (its later calls say so at once).
 
         Raises:
             StudentError: the module does not exist or did not import.
@@ -214,7 +235,8 @@ class Context:
                 self.waiting_on(f"{function} on {label} was running")
                 request, arrays = call_request(self.module, function, args, kwargs)
                 try:
-                    answer = self._request(server, function, request, arrays, limit, f" on {label}")
+                    answer = self._request(server, function, request, arrays, limit, f" on {label}",
+                                           cpu_seconds=CALL_CPU_SECONDS)
                 except ServerError as error:
                     outcomes.append(Outcome(error=f"the call {function} on {label} {error}"))
                     continue
@@ -222,14 +244,16 @@ class Context:
                                     error=answer.get("error")))
         return outcomes
 
-    def _request(self, server, what: str, request: dict, arrays, limit: float, on: str = "") -> dict:
-        """server.request(...) in this check's domain; a request that did not return within `limit`
-        marks `what` as hung for the rest of the grading (its later calls are not made)."""
+    def _request(self, server, what: str, request: dict, arrays, limit: float, on: str = "",
+                 cpu_seconds: float | None = None) -> dict:
+        """server.request(...) in this check's domain; a request that did not return (its processor
+        time or its wall-clock `limit` ran out) marks `what` as hung for the rest of the grading
+        (its later calls are not made, and say what the first one had)."""
         try:
-            return server.request(request, arrays, limit, self.domain_id)
+            return server.request(request, arrays, limit, self.domain_id, cpu_seconds=cpu_seconds)
         except ServerError as error:
             if error.timed_out:
-                self.servers.hung[what] = f"{what} did not return within {limit:.0f} s{on} earlier"
+                self.servers.hung[what] = f"{what}{on} earlier {error.reason}"
             raise
 
     def _import(self, server, module: str) -> None:
@@ -244,23 +268,41 @@ class Context:
         wait = min(allowed, self.remaining())
         self.waiting_on(f"importing {module} was running")
         try:
-            answer = server.request({"kind": "import", "module": module}, None, wait, self.domain_id)
+            answer = server.request({"kind": "import", "module": module}, None, wait, self.domain_id,
+                                    cpu_seconds=IMPORT_CPU_SECONDS)
         except ServerError as error:
             if not error.timed_out:
                 raise StudentError(f"{module} could not be imported: importing it {error}") from None
-            if wait < allowed:
+            computing = error.reason.startswith("used")
+            if wait < allowed and not computing:
                 raise StudentError(f"importing {module} did not finish within the {wait:.0f} s this check had left "
                                    "(the machine may be busy; the import itself took long)") from None
             _mark(self.workdir / IMPORT_HANG_MARK)
-            raise StudentError(f"importing {module} did not finish within {allowed:.0f} s: "
-                               "remove code that runs forever at import (loops, spin()) from the "
-                               "top level of the module; put it in main()") from None
+            how = (f"used {IMPORT_CPU_SECONDS:g} s of processor time without finishing" if computing else
+                   f"did not finish within {allowed:.0f} s, waiting rather than computing")
+            raise StudentError(f"importing {module} {how}: remove code that runs forever at import (loops, "
+                               "spin()) from the top level of the module; put it in main()") from None
         why = None
         if answer.get("error"):
             why = f"{module} could not be imported ({answer['error']}):\n{answer.get('traceback', '').strip()}"
         server.imported[module] = why
         if why:
             raise StudentError(why)
+
+    def wait_for_node(self, probe, proc, name: str, seconds: float = 25.0) -> bool:
+        """Wait until a node `name` shows in `probe`'s graph; True when it does. The wait ends on
+        an event: the node appears, its process (`proc`, a NodeProcess) ends, the student's module
+        did not import in an earlier check, or the process has used NODE_START_CPU_SECONDS of
+        processor time without the node appearing (a loop before the node is created);
+        scaled(seconds) is only the backstop for a process that waits instead."""
+        def names():
+            return {node for node, _namespace in probe.node.get_node_names_and_namespaces()}
+
+        spent = ProcessorTime(proc, NODE_START_CPU_SECONDS, since_start=True)
+        self.waiting_on(f"node {name} was starting")
+        probe.spin_until(lambda: name in names() or not proc.running() or self.import_hung() or spent.used_up(),
+                         scaled(seconds))
+        return name in names()
 
     def endpoints(self, class_name: str, timeout: float = 20.0, module: str | None = None,
                   env: dict | None = None) -> dict:
@@ -277,12 +319,12 @@ class Context:
         if what in self.servers.hung:
             raise StudentError(f"{what} was not constructed: {self.servers.hung[what]}")
         server = self.servers.server(self._students, self.module_root if env is None else self.workdir, env)
-        limit = min(timeout, self.remaining())
+        limit = min(scaled(timeout), self.remaining())
         self.waiting_on(f"constructing {what} was running")
         with server.lock:
-            try:
+            try:  # its module may be imported first: both budgets
                 answer = self._request(server, what, {"kind": "endpoints", "module": module, "class": class_name},
-                                       None, limit)
+                                       None, limit, cpu_seconds=IMPORT_CPU_SECONDS + CALL_CPU_SECONDS)
             except ServerError as error:
                 raise StudentError(f"{what} could not be constructed: it {error}") from None
         if "endpoints" not in answer:

@@ -31,6 +31,8 @@ class ServerError(Exception):
     def __init__(self, message: str, timed_out: bool):
         super().__init__(message)
         self.timed_out = timed_out
+        #: How it failed, without the process's last output ("used 5 s of processor time ...").
+        self.reason = message.split(". Last output:", 1)[0]
 
 
 class StudentServer:
@@ -63,30 +65,44 @@ class StudentServer:
                                         name=f"student-calls-{id(self):x}", cwd=self.cwd, domain_id=domain_id,
                                         wall_seconds=self.wall_seconds, env=self.env)
 
-    def request(self, request: dict, arrays: dict | None, timeout: float, domain_id: int) -> dict:
-        """Send one request and wait at most `timeout` seconds for its answer ({"value", "pytype"} or
-        {"error"} or {"endpoints"}), starting the process first when none runs.
+    def request(self, request: dict, arrays: dict | None, timeout: float, domain_id: int,
+                cpu_seconds: float | None = None) -> dict:
+        """Send one request and wait for its answer ({"value", "pytype"} or {"error"} or
+        {"endpoints"}), starting the process first when none runs.
+
+        Args:
+            timeout: wall-clock seconds at most: the backstop for code that waits (sleep, spin,
+                input) rather than computes.
+            cpu_seconds: processor seconds the request may use (the process's whole tree; None:
+                no bound). What decides that computing code did not return: unlike wall time, it
+                does not grow when the machine is busy.
 
         Raises:
-            ServerError: no answer: the process ended (timed_out False) or the time ran out
-                (timed_out True; the process is then stopped).
+            ServerError: no answer: the process ended (timed_out False) or the processor time or
+                the wall-clock time ran out (timed_out True; the process is then stopped).
         """
         if self.proc is None or not self.proc.running():
             self.stop()
             self._start(domain_id)
         number, self._number = self._number, self._number + 1
         start_of_log = len(self.proc.log)
-        write_request(self._job / "in", number, request, arrays)
         outbox, proc = self._job / "out", self.proc
-        waiting.spin_until(lambda: (outbox / f"{number}.json").exists() or not proc.running(), timeout, poll=0.005)
+        spent = ProcessorTime(proc, cpu_seconds)
+        write_request(self._job / "in", number, request, arrays)
+        waiting.spin_until(lambda: (outbox / f"{number}.json").exists() or not proc.running() or spent.used_up(),
+                           timeout, poll=0.005)
         answer = read_answer(outbox, number)
         if answer is not None:
             return answer
         timed_out = proc.running()
         self.stop(grace=0.1)  # a hung call is not waited for
         output = last_lines(proc.log[start_of_log:] if len(proc.log) > start_of_log else proc.log, 4)
+        if spent.exceeded:
+            raise ServerError(f"used {cpu_seconds:g} s of processor time without returning (an endless loop?). "
+                              f"Last output:\n{output}", True)
         if timed_out:
-            raise ServerError(f"did not return within {timeout:.0f} s (an endless loop?). Last output:\n{output}", True)
+            raise ServerError(f"did not return within {timeout:.0f} s, waiting rather than computing (a sleep(), "
+                              f"spin() or input()?). Last output:\n{output}", True)
         raise ServerError(f"ended the process ({proc.describe_exit()}) before returning. Last output:\n{output}", False)
 
     def stop(self, grace: float = 1.0) -> None:
@@ -97,6 +113,27 @@ class StudentServer:
         if self._job is not None:
             shutil.rmtree(self._job, ignore_errors=True)
             self._job = None
+
+
+class ProcessorTime:
+    """Whether a process (a NodeProcess) has used `budget` processor seconds since this was made, or
+    since it started when `since_start` (read from /proc at most every CHECK_EVERY seconds; a
+    budget of None is never used up)."""
+
+    CHECK_EVERY = 0.05
+
+    def __init__(self, proc, budget: float | None, since_start: bool = False):
+        self.proc, self.budget = proc, budget
+        self.start = proc.cpu_seconds() if budget is not None and not since_start else 0.0
+        self.exceeded = False
+        self._next = time.monotonic()
+
+    def used_up(self) -> bool:
+        if self.budget is None or time.monotonic() < self._next:
+            return self.exceeded
+        self._next = time.monotonic() + self.CHECK_EVERY
+        self.exceeded = self.proc.cpu_seconds() - self.start >= self.budget
+        return self.exceeded
 
 
 class StudentServers:
