@@ -3,6 +3,8 @@
 #   make lab     set up, then start JupyterLab on the course (prints the URL; no browser needed)
 #   make test    set up, lint (ruff, notebooks too), then run the whole test suite (unit tests,
 #                notebooks, browser tests)
+#   make check   the inner loop (under 2 minutes): set up, lint as make test does, then run the tests
+#                that need no grading run, colcon build, browser, hub or notebook run
 #   make hub     set up, then run the course's JupyterHub for a class (root; course from
 #                `python -m coursehub create-course`, see README)
 
@@ -33,7 +35,7 @@ endif
 CHP_VERSION := 5.3.0
 HUB_DIR ?= /srv/ros2cv-hub
 
-.PHONY: setup lab test browser-deps hub-deps hub clean
+.PHONY: setup lab test check browser-deps hub-deps hub clean
 
 setup: $(VENV)/.setup-done
 
@@ -111,6 +113,14 @@ hub: setup hub-deps
 test: setup browser-deps hub-deps
 	$(PY) -m ruff check .
 	env -u PYTHONDONTWRITEBYTECODE $(PY) -m pytest -n $(TEST_WORKERS) --dist loadfile --no-loadscope-reorder $(PYTEST_ARGS); status=$$?; \
+	PATH="$(VENV)/bin:$$PATH" fastdds shm clean >/dev/null 2>&1; exit $$status
+
+# The tests marked slow (colcon builds, grading runs, lessons' commands), browser or hub are left
+# out, and -p no:nbmake leaves out the notebooks (conftest.py then accepts addopts' --nbmake).
+CHECK_MARKERS ?= not slow and not browser and not hub
+check: setup
+	$(PY) -m ruff check .
+	env -u PYTHONDONTWRITEBYTECODE $(PY) -m pytest -n $(TEST_WORKERS) --dist loadfile -p no:nbmake -m "$(CHECK_MARKERS)" $(PYTEST_ARGS); status=$$?; \
 	PATH="$(VENV)/bin:$$PATH" fastdds shm clean >/dev/null 2>&1; exit $$status
 
 clean:

@@ -48,6 +48,7 @@ def _download(course, folder, names: list[str]):
     return path
 
 
+@pytest.mark.slow
 def test_collect_puts_each_attempt_in_submitted_with_its_time(course, tmp_path):
     """alice's two attempts: the later one is kept with its time; carol's renamed notebook and
     dave (not in the roster) are reported with what to do."""
@@ -66,6 +67,7 @@ def test_collect_puts_each_attempt_in_submitted_with_its_time(course, tmp_path):
     assert "dave is not in the roster" in text
 
 
+@pytest.mark.slow
 def test_collect_without_a_release_or_matching_names_says_what_to_do(course, tmp_path):
     """An assignment not released, and a download whose names match nothing, give the fix."""
     with pytest.raises(ValueError, match="has not been released.*python -m autograder release"):

@@ -8,6 +8,7 @@ import time
 import urllib.request
 from pathlib import Path
 
+import pytest
 from browser_support import free_port
 
 from course_lib import process_tree
@@ -22,6 +23,7 @@ def test_make_setup_twice_changes_nothing():
     assert again.returncode == 0 and "Nothing to be done" in again.stdout + again.stderr, again.stdout
 
 
+@pytest.mark.slow
 def test_make_lab_serves_the_course_and_prints_its_url(tmp_path):
     port = free_port()
     log = tmp_path / "lab.log"

@@ -33,6 +33,7 @@ def _state(course):
             (course / "gradebook.db").read_bytes())
 
 
+@pytest.mark.slow
 def test_nbgrader_autograde_in_the_course_directory_refuses(course):
     """`nbgrader autograde pubsub --force` exits non-zero, names `python -m autograder grade`, and
     leaves the autograded notebook and the gradebook as they were."""
@@ -44,6 +45,7 @@ def test_nbgrader_autograde_in_the_course_directory_refuses(course):
     assert _state(course) == before
 
 
+@pytest.mark.slow
 def test_formgrader_autograde_button_refuses(course):
     """The formgrader's button (nbgrader's API in the server) fails with the command, changes nothing."""
     from nbgrader.apps.api import NbGraderAPI

@@ -189,6 +189,7 @@ def test_every_command_shown_is_checked():
     assert shown_commands("03_aruco_and_homography.ipynb") == []
 
 
+@pytest.mark.slow
 def test_create_and_build_commands(built):
     ws, env, outputs = built
     for command, output in outputs.items():
@@ -201,6 +202,7 @@ def start(command: str, env: dict) -> processes.NodeProcess:
     return processes.NodeProcess(["bash", "-c", f"exec {command}"], name="-".join(command.split()[1:4]), env=env).start()
 
 
+@pytest.mark.slow
 def test_ros2_run_with_remapping_and_topic_echo(built):
     """Lesson 02b's nodes, and lesson 02's brightness node on the same camera."""
     ws, env, _ = built
@@ -219,6 +221,7 @@ def test_ros2_run_with_remapping_and_topic_echo(built):
         processes.stop_together([camera, node, brightness])
 
 
+@pytest.mark.slow
 def test_launch_file_and_parameter_commands(built):
     ws, env, _ = built
     check("ros2 launch image_stats dark.launch.xml --show-args",
@@ -234,6 +237,7 @@ def test_launch_file_and_parameter_commands(built):
     assert "[dark_fraction-2]" in log and "now counting pixels darker than 100" in log, log
 
 
+@pytest.mark.slow
 def test_lesson_00_commands(tmp_path):
     """The lesson's package built as the lesson builds it, its node running: the ! lines print what it shows."""
     ws = tmp_path / "ros2_ws"
@@ -250,6 +254,7 @@ def test_lesson_00_commands(tmp_path):
         node.stop()
 
 
+@pytest.mark.slow
 def test_lesson_01_commands(tmp_path):
     """The lesson's talker (its own file, as a process) and a listener in this process, as in the
     notebook: the ! lines print what the lesson shows."""

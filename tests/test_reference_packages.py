@@ -197,6 +197,7 @@ def use_interfaces(ws):
         workspace.use_workspace(install.parent)
 
 
+@pytest.mark.slow
 def test_marker_reader_accepts_bgr_rgb_mono_and_skips_bad_images(built_ws, domain_id):
     """rgb8 gives the bgr8 crops, mono8 grey ones of the same pictures; bad images only count."""
     use_interfaces(built_ws)
@@ -264,6 +265,7 @@ def test_marker_reader_accepts_bgr_rgb_mono_and_skips_bad_images(built_ws, domai
             assert score >= marker_board.SAME_CROP_THRESHOLD, f"{name} from {encoding}: {score:.3f}"
 
 
+@pytest.mark.slow
 def test_an_unknown_dictionary_is_refused_with_the_choices(built_ws, domain_id):
     use_interfaces(built_ws)
     from readmarker.marker_reader import MarkerReader

@@ -397,6 +397,7 @@ def built_brightness(tmp_path_factory):
     return ws
 
 
+@pytest.mark.slow
 def test_brightness_package_check_wants_a_build_after_setup_py_changes(built_brightness):
     import os
     import time
@@ -419,6 +420,7 @@ def test_brightness_package_check_wants_a_build_after_setup_py_changes(built_bri
     assert not verdict and "the last build did not install it" in str(verdict), str(verdict)
 
 
+@pytest.mark.slow
 def test_brightness_package_check_finds_a_stale_copy_of_a_build_without_symlinks(built_brightness):
     import sys
 
@@ -441,6 +443,7 @@ def test_brightness_package_check_finds_a_stale_copy_of_a_build_without_symlinks
     ({"frame[height // 2, width // 2, 0]": "frame[width // 2, height // 2, 0]"}, "numpy indexes [row, column]"),
     ({"import UInt8": "import Float32", "UInt8": "Float32"}, "publishes std_msgs/msg/Float32 on /brightness"),
 ])
+@pytest.mark.slow
 def test_brightness_package_check_runs_the_node_as_ros2_run_would(built_brightness, change, expected):
     """With --symlink-install a changed node file runs without a build; the check sends it frames."""
     node = ANSWER_NODE

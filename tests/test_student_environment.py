@@ -135,6 +135,7 @@ def test_the_wheel_holds_the_student_package_only(wheel_files):
     assert "course_lib/checks/recorded/brightness.json" in wheel_files
 
 
+@pytest.mark.slow
 def test_no_reference_solution_in_the_wheel_or_the_release(wheel_files, release):
     """No reference solution, answer key or hidden test in anything a student can import or read."""
     files = dict(wheel_files)
