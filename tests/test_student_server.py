@@ -4,13 +4,15 @@ and not called again, answers kept across a crash."""
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 import pytest
 
 from course_lib.checks import context
 from course_lib.checks.context import Context, StudentError
 from course_lib.checks.registry import get_check
-from course_lib.checks.student_server import StudentServers
+from course_lib.checks.student_server import ProcessorTime, StudentServers
 
 MODULE = """
 import os, time
@@ -45,12 +47,12 @@ def test_calls_share_one_process_and_a_hung_function_is_named_and_not_called_aga
     ctx = _context(tmp_path, MODULE, servers)
     try:
         images = [np.zeros(3), np.zeros(4), np.zeros(7), np.zeros(3)]
-        first, second, hung, later = ctx.call("average_brightness", [((i,), {}) for i in images], timeout=1.5,
+        first, second, hung, later = ctx.call("average_brightness", [((i,), {}) for i in images], timeout=3,
                                               labels=["'one'", "'two'", "'the slow one'", "'four'"])
         assert first.ok and second.ok and first.value == second.value  # one process, imported once
-        assert "average_brightness on 'the slow one' did not return within 2 s, waiting rather than computing" \
+        assert "average_brightness on 'the slow one' did not return within 3 s, waiting rather than computing" \
             in hung.error
-        assert later.error.startswith("not run: average_brightness on 'the slow one' earlier did not return within 2 s")
+        assert later.error.startswith("not run: average_brightness on 'the slow one' earlier did not return within 3 s")
         again = _context(tmp_path / "next", MODULE, servers)  # a later check of the same grading
         assert again.call("average_brightness", [((images[0],), {})])[0].error.startswith("not run: ")
     finally:
@@ -79,8 +81,8 @@ def test_a_call_that_waits_is_not_stopped_by_the_processor_budget(tmp_path, monk
     monkeypatch.setattr(context, "CALL_CPU_SECONDS", 0.2)
     ctx = _context(tmp_path, MODULE)
     try:
-        (hung,) = ctx.call("average_brightness", [((np.zeros(7),), {})], timeout=1.5)
-        assert "did not return within 2 s, waiting rather than computing" in hung.error
+        (hung,) = ctx.call("average_brightness", [((np.zeros(7),), {})], timeout=3)
+        assert "did not return within 3 s, waiting rather than computing" in hung.error
     finally:
         ctx.close()
 
@@ -97,13 +99,12 @@ def test_after_a_crash_the_next_call_runs_in_a_fresh_process(tmp_path):
 
 @pytest.mark.parametrize("code, reason", [
     ("while True:\n    pass\n", "used 1 s of processor time without finishing"),
-    ("import time\ntime.sleep(100)\n", "did not finish within 2 s, waiting rather than computing")])
+    ("import time\ntime.sleep(100)\n", "did not finish within 3 s, waiting rather than computing")])
 def test_an_import_that_never_ends_is_marked_for_later_checks(tmp_path, monkeypatch, code, reason):
     """An import that computes forever ends at its processor budget, one that waits at the
     wall-clock backstop; either is marked, and later checks fail at once with the fix."""
     monkeypatch.setattr(context, "IMPORT_CPU_SECONDS", 1.0)
-    monkeypatch.setattr(context, "IMPORT_TIMEOUT", 2.0 if "sleep" in code else 120.0)
-    monkeypatch.setenv(context.LOAD_FACTOR_ENV, "1")  # the backstop as given, however busy the machine
+    monkeypatch.setattr(context, "IMPORT_TIMEOUT", 3.0 if "sleep" in code else 120.0)
     ctx = _context(tmp_path, code)
     try:
         try:
@@ -116,3 +117,23 @@ def test_an_import_that_never_ends_is_marked_for_later_checks(tmp_path, monkeypa
             ctx.require_module()
     finally:
         ctx.close()
+
+
+class _Using:
+    """A stand-in for a NodeProcess whose tree uses `share` of a core from now on."""
+
+    def __init__(self, share: float):
+        self.share, self.start = share, time.monotonic()
+
+    def cpu_seconds(self) -> float:
+        return self.share * (time.monotonic() - self.start)
+
+
+@pytest.mark.parametrize("share, waits", [(0.0, True), (0.01, True), (0.1, False), (1.0, False)])
+def test_a_process_waits_when_it_uses_next_to_no_processor_time(share, waits):
+    """A process that gets a tenth of a core (ten busy processes per core) still computes; an idle
+    rclpy node's hundredth of one is waiting. Nothing is said before a whole window was seen."""
+    spent = ProcessorTime(_Using(share), budget=None)
+    assert not spent.waiting()
+    time.sleep(ProcessorTime.WAITING_WINDOW + 0.2)
+    assert spent.waiting() == waits and not spent.used_up()

@@ -232,11 +232,12 @@ class Context:
                 self._import(server, self.module)
                 # Leaves the check a moment to report when the grading's time is nearly up.
                 limit = min(timeout or scaled(CALL_TIMEOUT), max(0.5, self.remaining() - 0.5))
+                waiting_after = timeout or CALL_TIMEOUT
                 self.waiting_on(f"{function} on {label} was running")
                 request, arrays = call_request(self.module, function, args, kwargs)
                 try:
                     answer = self._request(server, function, request, arrays, limit, f" on {label}",
-                                           cpu_seconds=CALL_CPU_SECONDS)
+                                           cpu_seconds=CALL_CPU_SECONDS, waiting_after=waiting_after)
                 except ServerError as error:
                     outcomes.append(Outcome(error=f"the call {function} on {label} {error}"))
                     continue
@@ -245,12 +246,13 @@ class Context:
         return outcomes
 
     def _request(self, server, what: str, request: dict, arrays, limit: float, on: str = "",
-                 cpu_seconds: float | None = None) -> dict:
+                 cpu_seconds: float | None = None, waiting_after: float | None = None) -> dict:
         """server.request(...) in this check's domain; a request that did not return (its processor
         time or its wall-clock `limit` ran out) marks `what` as hung for the rest of the grading
         (its later calls are not made, and say what the first one had)."""
         try:
-            return server.request(request, arrays, limit, self.domain_id, cpu_seconds=cpu_seconds)
+            return server.request(request, arrays, limit, self.domain_id, cpu_seconds=cpu_seconds,
+                                  waiting_after=waiting_after)
         except ServerError as error:
             if error.timed_out:
                 self.servers.hung[what] = f"{what}{on} earlier {error.reason}"
@@ -269,17 +271,20 @@ class Context:
         self.waiting_on(f"importing {module} was running")
         try:
             answer = server.request({"kind": "import", "module": module}, None, wait, self.domain_id,
-                                    cpu_seconds=IMPORT_CPU_SECONDS)
+                                    cpu_seconds=IMPORT_CPU_SECONDS, waiting_after=IMPORT_TIMEOUT)
         except ServerError as error:
             if not error.timed_out:
                 raise StudentError(f"{module} could not be imported: importing it {error}") from None
-            computing = error.reason.startswith("used")
-            if wait < allowed and not computing:
+            if error.reason.startswith("used"):
+                how = f"used {IMPORT_CPU_SECONDS:g} s of processor time without finishing"
+            elif "waiting rather than computing" in error.reason:
+                how = f"did not finish within {IMPORT_TIMEOUT:g} s, waiting rather than computing"
+            elif wait < allowed:
                 raise StudentError(f"importing {module} did not finish within the {wait:.0f} s this check had left "
                                    "(the machine may be busy; the import itself took long)") from None
+            else:
+                how = f"did not finish within {allowed:.0f} s"
             _mark(self.workdir / IMPORT_HANG_MARK)
-            how = (f"used {IMPORT_CPU_SECONDS:g} s of processor time without finishing" if computing else
-                   f"did not finish within {allowed:.0f} s, waiting rather than computing")
             raise StudentError(f"importing {module} {how}: remove code that runs forever at import (loops, "
                                "spin()) from the top level of the module; put it in main()") from None
         why = None
@@ -293,15 +298,21 @@ class Context:
         """Wait until a node `name` shows in `probe`'s graph; True when it does. The wait ends on
         an event: the node appears, its process (`proc`, a NodeProcess) ends, the student's module
         did not import in an earlier check, or the process has used NODE_START_CPU_SECONDS of
-        processor time without the node appearing (a loop before the node is created);
-        scaled(seconds) is only the backstop for a process that waits instead."""
+        processor time without the node appearing (a loop before the node is created), or after
+        `seconds` the process waits rather than computes (ProcessorTime.waiting; one still starting
+        on a busy machine is waited for up to scaled(seconds))."""
         def names():
             return {node for node, _namespace in probe.node.get_node_names_and_namespaces()}
 
         spent = ProcessorTime(proc, NODE_START_CPU_SECONDS, since_start=True)
         self.waiting_on(f"node {name} was starting")
-        probe.spin_until(lambda: name in names() or not proc.running() or self.import_hung() or spent.used_up(),
-                         scaled(seconds))
+        started = time.monotonic()
+
+        def waits() -> bool:  # a process still starting on a busy machine is waited for
+            return time.monotonic() - started >= seconds and spent.waiting()
+
+        probe.spin_until(lambda: name in names() or not proc.running() or self.import_hung() or spent.used_up()
+                         or waits(), scaled(seconds))
         return name in names()
 
     def endpoints(self, class_name: str, timeout: float = 20.0, module: str | None = None,

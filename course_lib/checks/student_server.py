@@ -14,6 +14,7 @@ all checks of a submission share them.
 
 from __future__ import annotations
 
+import collections
 import shutil
 import sys
 import tempfile
@@ -66,20 +67,22 @@ class StudentServer:
                                         wall_seconds=self.wall_seconds, env=self.env)
 
     def request(self, request: dict, arrays: dict | None, timeout: float, domain_id: int,
-                cpu_seconds: float | None = None) -> dict:
+                cpu_seconds: float | None = None, waiting_after: float | None = None) -> dict:
         """Send one request and wait for its answer ({"value", "pytype"} or {"error"} or
         {"endpoints"}), starting the process first when none runs.
 
         Args:
-            timeout: wall-clock seconds at most: the backstop for code that waits (sleep, spin,
-                input) rather than computes.
+            timeout: wall-clock seconds at most: the last backstop.
             cpu_seconds: processor seconds the request may use (the process's whole tree; None:
-                no bound). What decides that computing code did not return: unlike wall time, it
+                no bound). What decides that computing code does not return: unlike wall time, it
                 does not grow when the machine is busy.
+            waiting_after: after this many seconds (default `timeout`) a process that waits
+                (ProcessorTime.waiting: sleep, spin, input) rather than computes is not waited for
+                any longer; one that still computes, slowly on a busy machine, is.
 
         Raises:
-            ServerError: no answer: the process ended (timed_out False) or the processor time or
-                the wall-clock time ran out (timed_out True; the process is then stopped).
+            ServerError: no answer: the process ended (timed_out False) or its processor time,
+                its wait or the backstop ran out (timed_out True; the process is then stopped).
         """
         if self.proc is None or not self.proc.running():
             self.stop()
@@ -88,9 +91,15 @@ class StudentServer:
         start_of_log = len(self.proc.log)
         outbox, proc = self._job / "out", self.proc
         spent = ProcessorTime(proc, cpu_seconds)
+        waiting_after = timeout if waiting_after is None else min(waiting_after, timeout)
         write_request(self._job / "in", number, request, arrays)
-        waiting.spin_until(lambda: (outbox / f"{number}.json").exists() or not proc.running() or spent.used_up(),
-                           timeout, poll=0.005)
+        started = time.monotonic()
+
+        def waits() -> bool:
+            return time.monotonic() - started >= waiting_after and spent.waiting()
+
+        waiting.spin_until(lambda: (outbox / f"{number}.json").exists() or not proc.running() or spent.used_up()
+                           or waits(), timeout, poll=0.005)
         answer = read_answer(outbox, number)
         if answer is not None:
             return answer
@@ -101,8 +110,9 @@ class StudentServer:
             raise ServerError(f"used {cpu_seconds:g} s of processor time without returning (an endless loop?). "
                               f"Last output:\n{output}", True)
         if timed_out:
-            raise ServerError(f"did not return within {timeout:.0f} s, waiting rather than computing (a sleep(), "
-                              f"spin() or input()?). Last output:\n{output}", True)
+            how = ", waiting rather than computing (a sleep(), spin() or input()?)" if spent.waiting() else ""
+            raise ServerError(f"did not return within {time.monotonic() - started:.0f} s{how}. Last output:\n{output}",
+                              True)
         raise ServerError(f"ended the process ({proc.describe_exit()}) before returning. Last output:\n{output}", False)
 
     def stop(self, grace: float = 1.0) -> None:
@@ -116,24 +126,47 @@ class StudentServer:
 
 
 class ProcessorTime:
-    """Whether a process (a NodeProcess) has used `budget` processor seconds since this was made, or
-    since it started when `since_start` (read from /proc at most every CHECK_EVERY seconds; a
-    budget of None is never used up)."""
+    """The processor time a process (a NodeProcess: its whole tree) uses while something waits on
+    it: whether it has used up `budget` seconds since this was made (or since it started, with
+    `since_start`; None: never), and whether it is waiting (next to no processor time over the last
+    WAITING_WINDOW seconds: asleep, blocked in spin() or input()). Read from /proc at most every
+    CHECK_EVERY seconds."""
 
     CHECK_EVERY = 0.05
+    #: Below this share of a core over WAITING_WINDOW seconds a process waits rather than starves:
+    #: a runnable process still gets a tenth of a core on a machine loaded ten processes per core,
+    #: and an rclpy node that waits in spin() uses about a hundredth.
+    WAITING_SHARE = 0.03
+    WAITING_WINDOW = 2.0
 
-    def __init__(self, proc, budget: float | None, since_start: bool = False):
+    def __init__(self, proc, budget: float | None = None, since_start: bool = False):
         self.proc, self.budget = proc, budget
-        self.start = proc.cpu_seconds() if budget is not None and not since_start else 0.0
+        now, used = time.monotonic(), proc.cpu_seconds()
+        self.start = 0.0 if since_start else used
+        self.samples = collections.deque([(now, used)])
         self.exceeded = False
-        self._next = time.monotonic()
+        self._next = now + self.CHECK_EVERY
+
+    def _sample(self) -> None:
+        now = time.monotonic()
+        if now < self._next:
+            return
+        self._next = now + self.CHECK_EVERY
+        used = self.proc.cpu_seconds()
+        self.samples.append((now, used))
+        while len(self.samples) > 2 and self.samples[1][0] <= now - self.WAITING_WINDOW:
+            self.samples.popleft()
+        self.exceeded = self.budget is not None and used - self.start >= self.budget
 
     def used_up(self) -> bool:
-        if self.budget is None or time.monotonic() < self._next:
-            return self.exceeded
-        self._next = time.monotonic() + self.CHECK_EVERY
-        self.exceeded = self.proc.cpu_seconds() - self.start >= self.budget
+        self._sample()
         return self.exceeded
+
+    def waiting(self) -> bool:
+        self._sample()
+        (first, used_first), (last, used_last) = self.samples[0], self.samples[-1]
+        span = last - first
+        return span >= self.WAITING_WINDOW and used_last - used_first < self.WAITING_SHARE * span
 
 
 class StudentServers:
