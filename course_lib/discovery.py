@@ -124,11 +124,14 @@ def _participants_with_nodes(node) -> int:
 def _participants_here(domain_id: int) -> int:
     """How many DDS participants run on this machine in a domain.
 
-    Each binds the UDP port 7400 + 250 * domain + 10 + 2 * (its participant id) for discovery
-    traffic (the RTPS standard port mapping), so /proc/net/udp tells. 0 when it cannot.
+    Each binds two UDP ports (the RTPS standard port mapping): 7400 + 250 * domain + 10 +
+    2 * (its participant id) for discovery traffic and the next one for data, so /proc/net/udp
+    tells. Both must be bound, by one user: from domain 101 on, the range reaches the kernel's
+    ephemeral ports (32768 and up), which any program's socket may get, and such a lone socket
+    is no participant. 0 when it cannot.
     """
     first = 7410 + 250 * domain_id
-    ports = set()
+    owners: dict[int, set[str]] = {}  # port -> the uids of the sockets bound to it
     for table in ("/proc/net/udp", "/proc/net/udp6"):
         try:
             with open(table) as handle:
@@ -136,10 +139,11 @@ def _participants_here(domain_id: int) -> int:
         except OSError:
             continue
         for row in rows:
-            port = int(row.split()[1].rsplit(":", 1)[1], 16)
-            if first <= port < first + 240 and (port - first) % 2 == 0:
-                ports.add(port)
-    return len(ports)
+            fields = row.split()
+            port = int(fields[1].rsplit(":", 1)[1], 16)
+            if first <= port <= first + 240:
+                owners.setdefault(port, set()).add(fields[7])
+    return sum(1 for port in range(first, first + 240, 2) if owners.get(port, set()) & owners.get(port + 1, set()))
 
 
 def _snapshot(node):

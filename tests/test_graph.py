@@ -124,14 +124,36 @@ def test_discovery_counts_a_process_holding_three_nodes_as_one_participant(domai
         tool = session.tool_node()
         assert session.wait_for(lambda: {"one", "two", "three"} <= set(tool.get_node_names()), timeout=15)
         assert discovery._participants_here(domain_id) == 2  # this process and the other one
-        assert session.wait_for(lambda: discovery._participants_with_nodes(tool) == 2, timeout=5)
+        assert session.wait_for(lambda: discovery._participants_with_nodes(tool) == 2, timeout=30)
         session.add_node(Node("four"))
-        session.wait_for(lambda: "four" in tool.get_node_names(), timeout=5)
+        assert session.wait_for(lambda: "four" in tool.get_node_names(), timeout=30)
         assert discovery._participants_with_nodes(tool) == 2
     finally:
         process.kill()
         process.wait(timeout=10)
         process.stdout.close()
+
+
+def test_a_lone_socket_on_a_participants_port_is_no_participant(domain_id):
+    """A participant binds two ports, for discovery and for data. Domain 101's ports reach the
+    kernel's ephemeral ones, which any program's socket may get: counting single ports, a
+    listing in domain 101 waited for a process that was not there, and this module's test of a
+    three-node process counted 3 participants in a suite run."""
+    import socket
+
+    before = discovery._participants_here(domain_id)
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as lone, \
+            socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as data:
+        for participant in range(119, 60, -1):  # ids no process of this domain takes; skip ports in use
+            port = 7410 + 250 * domain_id + 2 * participant
+            try:
+                lone.bind(("127.0.0.1", port))
+            except OSError:
+                continue
+            break
+        assert discovery._participants_here(domain_id) == before
+        data.bind(("127.0.0.1", port + 1))
+        assert discovery._participants_here(domain_id) == before + 1
 
 
 def test_the_settling_wait_sees_a_subscription_arrive_on_a_topic_it_already_knows(local_session):
