@@ -103,22 +103,32 @@ def _every_process_shown(node, here: int) -> bool:
 
 #: Topics every node publishes on (unless told not to): their publishers show its participant.
 _EVERY_NODE_PUBLISHES = ("/rosout", "/parameter_events")
+#: The DDS topic of rmw's graph messages: every ROS process reads it from its start, before it
+#: makes any node, so its reader there is the first reader the process announces.
+_GRAPH_TOPIC = "ros_discovery_info"
 
 
 def _participants_with_nodes(node) -> int:
-    """How many participants (this process's included) have nodes the graph can name.
+    """How many participants (this process's included) the graph shows enough of to list: a node
+    of it named, and its readers announced.
 
-    An endpoint's gid begins with the 12-byte GUID prefix of its participant. A participant
-    counts once the graph knows the name of a node of it: rmw learns endpoints and node names
-    from two different messages, and a listing needs the names. Counting nodes instead would
-    not do: one process can hold several nodes.
+    An endpoint's gid begins with the 12-byte GUID prefix of its participant. rmw learns
+    endpoints and node names from two different messages, and a listing needs the names.
+    DDS discovery announces a participant's writers and its readers apart, each in the order
+    they were made: seen by the writers alone, a listener's process showed its node while its
+    subscriptions had not come, and `ros2 topic info` printed "Subscription count: 0". A
+    participant's first reader is rmw's own on the graph topic; once it shows, the readers the
+    process had when this one found it have been sent (with it, in one message as a rule).
+    Counting nodes instead would not do: one process can hold several nodes.
     """
-    prefixes = set()
+    readers = {bytes(info.endpoint_gid)[:12] for info in node.get_subscriptions_info_by_topic(_GRAPH_TOPIC,
+                                                                                             no_mangle=True)}
+    named = set()
     for topic in _EVERY_NODE_PUBLISHES:
         for info in node.get_publishers_info_by_topic(topic):
             if info.node_name != "_NODE_NAME_UNKNOWN_":
-                prefixes.add(bytes(info.endpoint_gid)[:12])
-    return len(prefixes)
+                named.add(bytes(info.endpoint_gid)[:12])
+    return len(named & readers)
 
 
 def _participants_here(domain_id: int) -> int:

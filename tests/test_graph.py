@@ -134,6 +134,30 @@ def test_discovery_counts_a_process_holding_three_nodes_as_one_participant(domai
         process.stdout.close()
 
 
+def test_a_process_counts_as_shown_once_its_readers_are_announced_too():
+    """DDS announces a process's writers and its readers apart: a process whose node is named
+    (by its /rosout writer) while none of its readers has come yet is not counted, or a listing
+    prints the topics it subscribes to with "Subscription count: 0"."""
+    import types
+
+    def endpoint(participant, node_name="talker"):
+        return types.SimpleNamespace(endpoint_gid=list(bytes([participant]) * 12 + bytes(4)), node_name=node_name)
+
+    class Graph:
+        readers = {"ros_discovery_info": [endpoint(1)]}  # process 2's readers have not come
+
+        def get_publishers_info_by_topic(self, topic):
+            return [endpoint(1), endpoint(2), endpoint(3, "_NODE_NAME_UNKNOWN_")] if topic == "/rosout" else []
+
+        def get_subscriptions_info_by_topic(self, topic, no_mangle=False):
+            return self.readers.get(topic, []) if no_mangle else []
+
+    graph_now = Graph()
+    assert discovery._participants_with_nodes(graph_now) == 1
+    graph_now.readers = {"ros_discovery_info": [endpoint(1), endpoint(2), endpoint(3)]}
+    assert discovery._participants_with_nodes(graph_now) == 2  # process 3's node has no name yet
+
+
 def test_a_lone_socket_on_a_participants_port_is_no_participant(domain_id):
     """A participant binds two ports, for discovery and for data. Domain 101's ports reach the
     kernel's ephemeral ones, which any program's socket may get: counting single ports, a
