@@ -113,11 +113,12 @@ def test_the_child_still_dies_with_its_supervisor(token):
     # under /root. The token is the shell's $0; its `sleep 1` children end within a second of it.
     command = run_as.command(NOBODY, ["sh", "-c", "while :; do sleep 1; done", token])
     process = NodeProcess(command, cwd="/").start()
-    # The child, as nobody: the wrapper (root until it switches) carries the token too, and found
-    # alone it let this test pass while the child could not even start.
-    assert wait_until(lambda: processes_with(token, uid=NOBODY), timeout=30), process.log
+    # The child, as nobody, once the wrapper has exec'd it: the wrapper carries the token too, as
+    # root until it switches and as nobody until it execs (before it arms the death signal).
+    assert wait_until(lambda: [p for p in processes_with(token, uid=NOBODY) if p.info["cmdline"][0] == "sh"],
+                      timeout=60), process.log
     os.kill(process._supervisor.pid, signal.SIGKILL)
-    assert wait_until(lambda: not processes_with(token), timeout=10)
+    assert wait_until(lambda: not processes_with(token), timeout=30), processes_with(token)
     process.stop()
 
 
