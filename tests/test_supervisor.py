@@ -4,7 +4,7 @@ when the caller dies; output relayed without blocking the child; the limits it s
 import signal
 import subprocess
 import sys
-import time
+import threading
 
 import pytest
 from process_support import processes_with, sleeper, sleeper_script, sleepers, wait_until
@@ -51,22 +51,29 @@ def test_on_output_gets_stdout_and_stderr_apart_as_they_arrive():
     assert "to out" in process.log and "to err" in process.log
 
 
-def test_a_slow_on_output_never_blocks_the_child():
+def test_a_slow_on_output_never_blocks_the_child(tmp_path):
     """A callback that stalls loses echoed output (and is told how much), not the child's time."""
     pieces = []
+    released = threading.Event()
 
-    def slow(stream, data):
+    def stalled(stream, data):
         if not pieces:
-            time.sleep(1.0)
+            released.wait(120)  # until the child has written everything
         pieces.append(data)
 
-    code = ("import sys, time\nstart = time.monotonic()\nfor _ in range(4096):\n"
-            "    sys.stdout.write('x' * 1023 + '\\n')\nprint(f'took {time.monotonic() - start:.3f}')\n")
-    process = NodeProcess([sys.executable, "-c", code], on_output=slow).start()
-    assert process.wait(timeout=20) == 0
-    took = float(process.log.rsplit("took ", 1)[1])
-    assert took < 0.9  # it wrote 4 MB without waiting for the stalled callback
-    assert wait_until(lambda: b"bytes of output not shown" in b"".join(pieces), timeout=5)
+    # 4 MB through a 64 KB pipe: a child that waited for the callback would never get to the end.
+    written, go = tmp_path / "written", tmp_path / "go"
+    code = (f"import os, sys, time\nfor _ in range(4096):\n    sys.stdout.write('x' * 1023 + '\\n')\n"
+            f"sys.stdout.flush()\nopen({str(written)!r}, 'w').close()\n"
+            f"while not os.path.exists({str(go)!r}):\n    time.sleep(0.01)\n")
+    process = NodeProcess([sys.executable, "-c", code], on_output=stalled).start()
+    try:
+        assert wait_until(written.exists, timeout=120), process.log_tail()
+    finally:
+        released.set()  # before the child ends, so that the supervisor can say what it dropped
+        go.touch()
+    assert process.wait(timeout=60) == 0
+    assert wait_until(lambda: b"bytes of output not shown" in b"".join(pieces), timeout=30)
 
 
 CALLER = """
