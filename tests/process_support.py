@@ -27,8 +27,10 @@ def processes_with(token: str, uid: int | None = None) -> list[psutil.Process]:
     return found
 
 
-def wait_until(condition, timeout: float = 10.0) -> bool:
-    """Poll `condition` until it holds or `timeout` passes; return its last value."""
+def wait_until(condition, timeout: float = 60.0) -> bool:
+    """Poll `condition` until it holds or `timeout` passes; return its last value. The timeout is
+    a backstop for a condition that never comes: a busy machine may take seconds for what an
+    idle one does at once (start a Python process, reap a killed one)."""
     deadline = time.monotonic() + timeout
     while not (result := condition()) and time.monotonic() < deadline:
         time.sleep(0.05)
