@@ -16,20 +16,27 @@ class Hello(Node):
     def __init__(self):
         super().__init__("hello")
         self.count = 0
+        self.until = 4  # lines to log: "hi 0" to "hi 3" (a later cell asks for more)
         self.create_timer(0.05, self.tick)
         self.get_logger().info("created")
 
     def tick(self):
-        self.get_logger().info(f"hi {self.count}")
-        self.count += 1
+        if self.count < self.until:
+            self.get_logger().info(f"hi {self.count}")
+            self.count += 1
 
-hello = session.add_node(Hello())
-session.spin_for(0.5)""",
-    "session.spin_for(0.5)\nprint('the next cell')",
+def shown(end):
+    \"\"\"Wait until the newest hello node's view holds a line ending with `end`.\"\"\"
+    return session.wait_for(lambda: any(line.endswith(end) for line in node_logs.text("hello").splitlines()),
+                            timeout=60)
+
+hello = session.add_node(Hello())""",
+    # The node logs while this cell runs: four more lines, each logged after the cell began.
+    "hello.until += 4\nassert shown(f'[hello]: hi {hello.until - 1}')\nprint('the next cell')",
     "print(node_logs.text('hello').splitlines()[0])",
-    # The first cell, re-run; then a moment for its lines to arrive before the kernel shuts down (in
-    # a live notebook they appear in the widget whenever they come).
-    "hello = session.add_node(Hello())\nsession.spin_for(0.5)",
+    # The first cell, re-run; the kernel shuts down once the new node's first line is shown (in a
+    # live notebook they appear in the widget whenever they come).
+    "hello = session.add_node(Hello())\nassert shown('[hello]: created')",
 ]
 
 
@@ -38,7 +45,7 @@ def test_log_lines_stay_with_the_cell_that_added_the_node(domain_id, monkeypatch
     and are said once what they are; node_logs.text() gives them back."""
     monkeypatch.setenv("ROS_DOMAIN_ID", str(domain_id))
     notebook = nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell(source) for source in CELLS])
-    NotebookClient(notebook, timeout=60, kernel_name="python3").execute()
+    NotebookClient(notebook, timeout=120, kernel_name="python3").execute()
     outputs = [cell.outputs for cell in notebook.cells]
     assert not any(output.get("name") == "stderr" for cell in outputs for output in cell), outputs
     assert outputs[1] == [nbformat.v4.new_output("stream", name="stdout", text="the next cell\n")]
