@@ -16,7 +16,6 @@ from course_lib.checks import registry, runner, validate  # noqa: E402
 
 ASSIGNMENTS = ["brightness", "pubsub", "catdog_warp"]
 REPO = Path(__file__).resolve().parent.parent
-pytestmark = pytest.mark.slow
 
 
 @pytest.mark.parametrize("assignment", ASSIGNMENTS)
@@ -87,6 +86,7 @@ def _brightness_mistakes():
     return {k: v for k, v in brightness_zoo.entries("").items() if v.get("level") == "check"}
 
 
+@pytest.mark.slow  # graded check runs and colcon builds
 @pytest.mark.parametrize("student", sorted(_brightness_mistakes()))
 def test_brightness_typical_mistake_gets_its_score_and_reason(tmp_path, monkeypatch, student):
     """Typical brightness mistakes, run through the checks directly: expected points and reason."""
@@ -136,6 +136,7 @@ FULL_RUN = {"catdog_warp": "mirrored", "pubsub": "wrong_topic"}
 CATDOG_CHECK = "easy"
 
 
+@pytest.mark.slow  # graded check runs and colcon builds
 @pytest.mark.parametrize("mistake", sorted(set(CATDOG_MISTAKES) - {FULL_RUN["catdog_warp"]}))
 def test_catdog_typical_mistake_loses_points_with_its_reason(tmp_path, mistake):
     """Typical warp mistakes score below full on easy scenes, and the verdict names the mistake."""
@@ -146,6 +147,7 @@ def test_catdog_typical_mistake_loses_points_with_its_reason(tmp_path, mistake):
     assert reason in "\n".join(result.verdict_lines())
 
 
+@pytest.mark.slow  # graded check runs and colcon builds
 def test_catdog_picture_reported_from_its_first_marker_loses_points_in_every_grading(tmp_path):
     """Each of a picture's four markers is hidden in turn in every grading, not left to a random
     draw: a crop_pictures that reports a picture whenever its first marker is seen always loses."""
@@ -181,6 +183,7 @@ PUBSUB_MISTAKES = {
 }
 
 
+@pytest.mark.slow  # graded check runs and colcon builds
 @pytest.mark.parametrize("mistake", sorted(set(PUBSUB_MISTAKES) - {FULL_RUN["pubsub"]}))
 def test_pubsub_typical_mistake_loses_points_with_its_reason(tmp_path, monkeypatch, mistake):
     """Typical publisher/subscriber mistakes score below full, and the verdict names the mistake."""
