@@ -185,7 +185,12 @@ def test_topic_echo(live):
 
 
 def test_topic_hz_prints_rates_until_ctrl_c(live):
-    """Average rate lines like ros2cli's every second; SIGINT ends it without a traceback."""
+    """Average rate lines like ros2cli's every second; SIGINT ends it without a traceback.
+
+    How regular the talker's messages come is the machine's doing, so the rates are not judged
+    against its 10 Hz; what follows from any arrivals is: each report's mean period lies between
+    its shortest and longest, and the periods of a report (window / rate) span at least a second
+    more than those of the report before (the first: at least a second)."""
     env = dict(live.env)
     env.pop("COURSE_LIB_UNDER_TEST")  # the live behaviour: run until Ctrl-C
     hz = subprocess.Popen([str(ROS2), "topic", "hz", "/cli_chatter"], env=env, stdout=subprocess.PIPE,
@@ -193,13 +198,21 @@ def test_topic_hz_prints_rates_until_ctrl_c(live):
     try:
         lines = [hz.stdout.readline() for _ in range(4)]
         hz.send_signal(signal.SIGINT)
-        code = hz.wait(timeout=15)
+        code = hz.wait(timeout=60)
     finally:
         hz.kill()
         hz.wait()
-    rates = [float(line.split()[-1]) for line in lines if line.startswith("average rate:")]
-    assert len(rates) == 2 and all(5 < rate < 15 for rate in rates), lines
-    assert re.fullmatch(r"\tmin: \d+\.\d{3}s max: \d+\.\d{3}s std dev: \d+\.\d{5}s window: \d+\n", lines[1])
+    reports = []
+    for average, spread in zip(lines[::2], lines[1::2]):
+        assert re.fullmatch(r"average rate: \d+\.\d{3}\n", average), lines
+        found = re.fullmatch(r"\tmin: (\d+\.\d{3})s max: (\d+\.\d{3})s std dev: \d+\.\d{5}s window: (\d+)\n", spread)
+        assert found, lines
+        reports.append((float(average.split()[-1]), float(found[1]), float(found[2]), int(found[3])))
+    rounding = 0.001  # min and max are printed in milliseconds
+    for rate, shortest, longest, _ in reports:
+        assert shortest - rounding <= 1 / rate <= longest + rounding, lines
+    spans = [window / rate for rate, _, _, window in reports]
+    assert spans[0] >= 1.0 - rounding and spans[1] >= spans[0] + 1.0 - rounding, (spans, lines)
     assert code == 2 and "Traceback" not in hz.stderr.read()
 
 
