@@ -24,6 +24,11 @@ from course_lib import rosenv, waiting
 
 SETUP_FIX = "run `make setup` in the course folder, then use the .venv/bin/python it creates"
 ECHO_SUFFIX = "/reply"
+#: What the round trip's second process prints once its node answers, and how long it may take
+#: to get there (Python and rclpy start in a second when idle, in many on a busy machine): the
+#: round trip's own timeout counts from then, so that a slow start is not taken for a blocked network.
+ECHO_READY = "course doctor echo: ready"
+ECHO_START_SECONDS = 60.0
 
 
 @dataclasses.dataclass
@@ -271,6 +276,11 @@ def _check_round_trip(timeout: float) -> Check:
                                  lambda msg: answers.append(time.monotonic() - sent.get(msg.data, started)), 10)
         publisher = node.create_publisher(String, topic, 10)
         echo = processes.python_node("course_lib.doctor:echo_main", topic, name="doctor-echo", domain_id=domain_id)
+        try:
+            echo.wait_for_output(ECHO_READY, timeout=ECHO_START_SECONDS)
+        except (RuntimeError, TimeoutError) as error:
+            return Check("pub/sub round trip", False, f"the second process did not start: {error}", SETUP_FIX)
+        started = time.monotonic()
         next_ping = [0.0]
 
         def ping() -> None:  # repeat: the first pings go out before discovery
@@ -314,6 +324,7 @@ def echo_main(args=None) -> None:
         node = Node("course_doctor_echo")
         reply = node.create_publisher(String, topic + ECHO_SUFFIX, 10)
         node.create_subscription(String, topic, reply.publish, 10)
+        print(ECHO_READY, flush=True)
         rclpy.spin(node)
     except KeyboardInterrupt:
         pass

@@ -15,7 +15,7 @@ def run_doctor(*args, **env_changes):
         else:
             env[name] = value
     return subprocess.run([sys.executable, "-m", "course_lib", "doctor", *args], capture_output=True,
-                          text=True, env=env, timeout=120)
+                          text=True, env=env, timeout=300)
 
 
 def test_doctor_passes_with_a_live_round_trip_between_two_processes():
