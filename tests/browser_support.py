@@ -669,7 +669,7 @@ def validate(page, timeout: float, screenshot: Path | None = None) -> Validation
         screenshot.parent.mkdir(parents=True, exist_ok=True)
         page.screenshot(path=str(screenshot))
     page.locator(_VALIDATE_DIALOG).locator(".jp-mod-accept").first.click()
-    page.locator(_VALIDATE_DIALOG).first.wait_for(state="detached", timeout=10_000)
+    page.locator(_VALIDATE_DIALOG).first.wait_for(state="detached", timeout=60_000)
     return Validation(title=said["title"].strip(), text=said["text"].strip(), outcome=said["outcome"],
                       error=said["error"], seconds=seconds)
 

@@ -185,7 +185,7 @@ def test_toolbar_buttons_are_clicked_by_their_label(browser, lab):
         before = page.locator(cells).count()
         click_toolbar_button(page, "Insert a cell below")
         page.wait_for_function("([selector, n]) => document.querySelectorAll(selector).length === n",
-                               arg=[cells, before + 1], timeout=10_000)
+                               arg=[cells, before + 1], timeout=60_000)
         with pytest.raises(LookupError, match="Insert a cell below"):
             click_toolbar_button(page, "No such button")
     finally:

@@ -133,7 +133,7 @@ def test_a_new_view_of_the_same_topic_replaces_the_old_one(ros):
 def test_views_stop_by_themselves_under_test(ros):
     assert rosenv.under_test()
     view = live.image_view("/image")
-    assert session.wait_for(lambda: view.stopped, timeout=live.LIMITED_SECONDS + 5)
+    assert session.wait_for(lambda: view.stopped, timeout=live.LIMITED_SECONDS + 60)
     assert view.updates <= live.LIMITED_UPDATES
 
 
