@@ -10,6 +10,9 @@ from course_lib.ros2cli.common import (NAMED_TIMEOUT, Verb, add_discovery_argume
 
 #: Verbs of ros2cli's ``ros2 topic`` that the course leaves out.
 LEFT_OUT = ("bw", "delay", "find", "type")
+#: Seconds ``ros2 topic pub`` waits at most, after its last message, for reliable subscriptions
+#: to acknowledge what it sent (it ends as soon as they have).
+ACK_SECONDS = 10.0
 
 
 def _positive_float(text: str) -> float:
@@ -229,6 +232,7 @@ def _pub_arguments(parser) -> None:
 
 def _pub(args) -> str | None:
     import yaml
+    from rclpy.duration import Duration
 
     from course_lib import message_yaml, session
 
@@ -282,7 +286,12 @@ def _pub(args) -> str | None:
             wait_until(lambda: times != 0 and count[0] >= times)
         finally:
             node.destroy_timer(timer)
-    time.sleep(args.keep_alive)  # let the last message reach the wire before the node goes
+    # Reliable subscriptions acknowledge what was sent before the node goes. A subscription that
+    # had not yet found this publisher when the message went out (the two ends discover each
+    # other apart, seconds apart on a busy machine) gets it again only from a publisher that
+    # still exists; ros2cli's keep-alive alone let `pub --once` end before that.
+    publisher.wait_for_all_acked(Duration(seconds=ACK_SECONDS))
+    time.sleep(args.keep_alive)
     node.destroy_publisher(publisher)
     return None
 
