@@ -86,6 +86,15 @@ def descendants_of(pid: int) -> list[int]:
     return found
 
 
+def command_line(pid: int) -> list[str]:
+    """The command line of process `pid` ([] when it has gone or has none)."""
+    try:
+        with open(f"/proc/{pid}/cmdline", "rb") as handle:
+            return [part.decode(errors="replace") for part in handle.read().split(b"\0") if part]
+    except OSError:
+        return []
+
+
 def cpu_seconds(pid: int, include_self: bool = True) -> float:
     """Processor time (user + system, all threads) that process `pid` and its descendants have
     used so far, children they have reaped included; 0.0 for a process that has gone.

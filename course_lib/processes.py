@@ -268,6 +268,18 @@ class NodeProcess:
 
         return cpu_seconds(self._supervisor.pid, include_self=False)
 
+    def member(self, executable: str) -> "TreeMember | None":
+        """The process of this child's tree (a launch's node, say) whose program is named
+        `executable`, as a TreeMember; None while there is none."""
+        if self._supervisor is None or not self.running():
+            return None
+        from course_lib.process_tree import command_line, descendants_of
+
+        for pid in descendants_of(self._supervisor.pid):
+            if any(Path(part).name == executable for part in command_line(pid)[:2]):
+                return TreeMember(pid)
+        return None
+
     @property
     def log(self) -> str:
         """Everything the child wrote to stdout and stderr so far, with the middle of a very
@@ -546,6 +558,23 @@ DUPLICATE_GRACE = 2.0
 #: Seconds start() waits at most for the session to see the nodes of every other ROS process on
 #: this machine (on a busy machine, discovery of a process started a moment ago takes seconds).
 EARLIER_NODES_WAIT = 2.0
+
+
+@dataclasses.dataclass(frozen=True)
+class TreeMember:
+    """One process of a NodeProcess's tree (NodeProcess.member), with the same questions."""
+
+    pid: int
+
+    def running(self) -> bool:
+        from course_lib.process_tree import command_line
+
+        return bool(command_line(self.pid))
+
+    def cpu_seconds(self) -> float:
+        from course_lib.process_tree import cpu_seconds
+
+        return cpu_seconds(self.pid)
 
 
 def _session_nodes(domain_id: int) -> dict[str, str]:

@@ -161,7 +161,9 @@ def _exchange(ctx, probe, node, publisher, replies: list, frames, encoding: str,
         # Resent every 0.3 s (best effort may drop a frame); WRONG_ANSWERS wrong answers end the
         # wait early. `earlier` collects the right answers of all frames sent before.
         wrong = lambda: _wrong(replies, earlier - {expected}) >= WRONG_ANSWERS  # noqa: E731
-        probe.resend_until(publisher, msg, lambda: expected in replies or not node.running() or wrong(), scaled(4.0))
+        gave_up = ctx.no_answer_coming(node, 4.0)
+        probe.resend_until(publisher, msg, lambda: expected in replies or not node.running() or wrong() or gave_up(),
+                           scaled(4.0))
         earlier.add(expected)
         if not node.running():
             return None
@@ -169,7 +171,7 @@ def _exchange(ctx, probe, node, publisher, replies: list, frames, encoding: str,
             if replies:
                 return ctx.item(False, f"{label}: for a frame of brightness {expected} the node published "
                                        f"{sorted(set(replies))[:5]}")
-            return ctx.item(False, f"{label}: no value on /brightness within {scaled(4):.0f} s of publishing a {encoding} frame "
+            return ctx.item(False, f"{label}: no value on /brightness after publishing a {encoding} frame "
                                    f"on /image, while the node runs; see the node's output below")
     return ctx.item(True, f"{label}: the right brightness for {len(frames)} {encoding} frames")
 
@@ -474,7 +476,9 @@ def _remapped(ctx, probe, remapped, image) -> None:
         return
     expected = ctx.expected("average_brightness", image)
     msg = images.image_to_msg(image, "bgr8")
-    probe.resend_until(publisher, msg, lambda: expected in replies or len(replies) >= WRONG_ANSWERS, scaled(4.0))
+    gave_up = ctx.no_answer_coming(remapped, 4.0)
+    probe.resend_until(publisher, msg, lambda: expected in replies or len(replies) >= WRONG_ANSWERS or gave_up(),
+                       scaled(4.0))
     if expected in replies:
         ctx.item(True, f"{label}: {REMAPPED_IMAGE} -> {REMAPPED_BRIGHTNESS} works")
         return

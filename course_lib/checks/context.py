@@ -225,10 +225,10 @@ class Context:
         server = self.servers.server(self._students, self.module_root, None)
         outcomes = []
         for (args, kwargs), label in zip(calls, labels):
-            if function in self.servers.hung:
-                outcomes.append(Outcome(error=f"not run: {self.servers.hung[function]}"))
-                continue
-            with server.lock:
+            with server.lock:  # the checks of a grading share the server: one may have seen a hang
+                if function in self.servers.hung:
+                    outcomes.append(Outcome(error=f"not run: {self.servers.hung[function]}"))
+                    continue
                 self._import(server, self.module)
                 # Leaves the check a moment to report when the grading's time is nearly up.
                 limit = min(timeout or scaled(CALL_TIMEOUT), max(0.5, self.remaining() - 0.5))
@@ -315,6 +315,15 @@ class Context:
                          or waits(), scaled(seconds))
         return name in names()
 
+    def no_answer_coming(self, proc, seconds: float):
+        """A condition for a wait on an answer of the student's node process `proc` (a NodeProcess),
+        true once it has used CALL_CPU_SECONDS of processor time from now on without the wait
+        ending (it computes and does not answer), or after `seconds` it waits rather than computes
+        (ProcessorTime.waiting). The wait's own timeout, scaled(seconds), is then only a backstop."""
+        spent = ProcessorTime(proc, CALL_CPU_SECONDS)
+        started = time.monotonic()
+        return lambda: spent.used_up() or (time.monotonic() - started >= seconds and spent.waiting())
+
     def endpoints(self, class_name: str, timeout: float = 20.0, module: str | None = None,
                   env: dict | None = None) -> dict:
         """Construct the student's node class (not spun) in a student process and return the QoS of
@@ -333,6 +342,8 @@ class Context:
         limit = min(scaled(timeout), self.remaining())
         self.waiting_on(f"constructing {what} was running")
         with server.lock:
+            if what in self.servers.hung:  # another check's construction hung meanwhile
+                raise StudentError(f"{what} was not constructed: {self.servers.hung[what]}")
             try:  # its module may be imported first: both budgets
                 answer = self._request(server, what, {"kind": "endpoints", "module": module, "class": class_name},
                                        None, limit, cpu_seconds=IMPORT_CPU_SECONDS + CALL_CPU_SECONDS)
