@@ -234,11 +234,11 @@ def test_publisher_reaches_subscriber_across_two_processes(built_ws, domain_id):
                                domain_id=domain_id, name="test_topic_subscriber")
     publisher = None
     try:
-        subscriber.wait_for_node("topic_subscriber", timeout=20)
+        subscriber.wait_for_node("topic_subscriber", timeout=60)
         publisher = workspace.run(built_ws, "tutorial_nodes", "topic_publisher", domain_id=domain_id,
                                   remap={"topic": "tutorial_topic"}, params={"start": 100},
                                   name="test_topic_publisher")
-        received = wait_for_log(subscriber, r"Received: stamp=(\d+)\.(\d{9}) data=(\d+)", count=5, timeout=30)
+        received = wait_for_log(subscriber, r"Received: stamp=(\d+)\.(\d{9}) data=(\d+)", count=5, timeout=60)
     finally:
         if publisher is not None:
             publisher.stop()
