@@ -40,11 +40,12 @@ def _wait_until(condition, timeout: float) -> bool:
     return session.wait_for(condition, timeout=timeout, poll=0.05)
 
 
-def _unsubscribe(node, subscription, topic: str, timeout: float = 1.0) -> None:
+def _unsubscribe(node, subscription, topic: str, timeout: float = 10.0) -> None:
     """Destroy a tool-node subscription and wait until the graph no longer shows it.
 
     The executor may hold the subscription in its current wait set, which defers the
-    destruction for a moment; waiting keeps a following topic_info() from showing it.
+    destruction until the session's thread next runs (a moment, or seconds on a busy machine);
+    waiting keeps a following topic_info() from showing it. The timeout is only a backstop.
     """
     node.destroy_subscription(subscription)
     _wait_until(lambda: not any(info.node_name == node.get_name()
