@@ -63,7 +63,7 @@ def graded_round(course: Path, names: list[str], workers: int) -> dict:
     """Grade everything again: name -> (score, max score, seconds), and the load averages around it."""
     load_before = os.getloadavg()[0]
     results = grading.grade(course, workers=workers, force=True, progress=False)
-    rows = {r.student: (r.score, r.max_score, r.seconds) for r in results if r.student in names}
+    rows = {r.student: (r.score, r.max_score, r.seconds, r.steps) for r in results if r.student in names}
     return {"rows": rows, "load": (load_before, os.getloadavg()[0])}
 
 
@@ -137,7 +137,9 @@ def report(args, argv: list[str], names: list[str], rounds: dict, hog_count: int
     print(f"| 1-min load average, start → end |{loads}")
     for load in ("idle", "loaded"):
         worst = max((r["rows"][name][2], name) for r in rounds[load] for name in names)
-        print(f"\nworst case {load}: {worst[0]:.1f} s ({worst[1]})", end="")
+        steps = next(r["rows"][worst[1]][3] for r in rounds[load] if r["rows"][worst[1]][2] == worst[0])
+        shown = ", ".join(f"{step} {seconds:.1f}" for step, seconds in steps.items() if seconds >= 0.5)
+        print(f"\nworst case {load}: {worst[0]:.1f} s ({worst[1]}; steps in s: {shown})", end="")
     print(f"\n\nevery score identical across all rounds and both loads: {'yes' if all_same else 'NO'}")
     return 0 if all_same else 1
 
