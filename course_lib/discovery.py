@@ -151,7 +151,7 @@ def _participants_here(domain_id: int) -> int:
         for row in rows:
             fields = row.split()
             port = int(fields[1].rsplit(":", 1)[1], 16)
-            if first <= port <= first + 240:
+            if first <= port < first + 240:
                 owners.setdefault(port, set()).add(fields[7])
     return sum(1 for port in range(first, first + 240, 2) if owners.get(port, set()) & owners.get(port + 1, set()))
 
