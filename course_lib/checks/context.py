@@ -306,13 +306,8 @@ class Context:
 
         spent = ProcessorTime(proc, NODE_START_CPU_SECONDS, since_start=True)
         self.waiting_on(f"node {name} was starting")
-        started = time.monotonic()
-
-        def waits() -> bool:  # a process still starting on a busy machine is waited for
-            return time.monotonic() - started >= seconds and spent.waiting()
-
-        probe.spin_until(lambda: name in names() or not proc.running() or self.import_hung() or spent.used_up()
-                         or waits(), scaled(seconds))
+        probe.spin_until(lambda: name in names() or not proc.running() or self.import_hung()
+                         or spent.gives_up(seconds), scaled(seconds))
         return name in names()
 
     def no_answer_coming(self, proc, seconds: float):
@@ -321,8 +316,7 @@ class Context:
         ending (it computes and does not answer), or after `seconds` it waits rather than computes
         (ProcessorTime.waiting). The wait's own timeout, scaled(seconds), is then only a backstop."""
         spent = ProcessorTime(proc, CALL_CPU_SECONDS)
-        started = time.monotonic()
-        return lambda: spent.used_up() or (time.monotonic() - started >= seconds and spent.waiting())
+        return lambda: spent.gives_up(seconds)
 
     def endpoints(self, class_name: str, timeout: float = 20.0, module: str | None = None,
                   env: dict | None = None) -> dict:

@@ -94,12 +94,8 @@ class StudentServer:
         waiting_after = timeout if waiting_after is None else min(waiting_after, timeout)
         write_request(self._job / "in", number, request, arrays)
         started = time.monotonic()
-
-        def waits() -> bool:
-            return time.monotonic() - started >= waiting_after and spent.waiting()
-
-        waiting.spin_until(lambda: (outbox / f"{number}.json").exists() or not proc.running() or spent.used_up()
-                           or waits(), timeout, poll=0.005)
+        waiting.spin_until(lambda: (outbox / f"{number}.json").exists() or not proc.running()
+                           or spent.gives_up(waiting_after), timeout, poll=0.005)
         answer = read_answer(outbox, number)
         if answer is not None:
             return answer
@@ -142,6 +138,7 @@ class ProcessorTime:
     def __init__(self, proc, budget: float | None = None, since_start: bool = False):
         self.proc, self.budget = proc, budget
         now, used = time.monotonic(), proc.cpu_seconds()
+        self.created = now
         self.start = 0.0 if since_start else used
         self.samples = collections.deque([(now, used)])
         self.exceeded = False
@@ -167,6 +164,14 @@ class ProcessorTime:
         (first, used_first), (last, used_last) = self.samples[0], self.samples[-1]
         span = last - first
         return span >= self.WAITING_WINDOW and used_last - used_first < self.WAITING_SHARE * span
+
+    def waits_after(self, seconds: float) -> bool:
+        """True once `seconds` have passed since this was made and the process is waiting."""
+        return time.monotonic() - self.created >= seconds and self.waiting()
+
+    def gives_up(self, seconds: float) -> bool:
+        """True once the budget is used up, or the process waits after `seconds` (waits_after)."""
+        return self.used_up() or self.waits_after(seconds)
 
 
 class StudentServers:
