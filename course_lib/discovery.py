@@ -7,6 +7,7 @@ first query of :mod:`course_lib.graph` on the session's tool node waits here; ``
 
 from __future__ import annotations
 
+import os
 import time
 
 from course_lib import rosenv, session, waiting
@@ -68,7 +69,7 @@ def wait_for_discovery(minimum: float | None = None, quiet: float = _SETTLE_QUIE
     busy = rosenv.load_factor(MAX_LOAD_FACTOR)
     complete_within = (COMPLETE_SECONDS if complete_within is None else complete_within) * busy
     quiet *= busy  # on a busy machine the announcements of one process come further apart
-    here = _participants_here(node.context.get_domain_id()) if complete_within else 0
+    here = _participants_here(node.context.get_domain_id()) if complete_within else []
     seen = {"graph": _snapshot(node), "since": time.monotonic(), "checks": 0, "complete": not here}
 
     def settled():
@@ -97,8 +98,18 @@ def wait_for_every_process(timeout: float) -> bool:
     return waiting.spin_until(lambda: _every_process_shown(node, here), timeout, poll=_SETTLE_POLL)
 
 
-def _every_process_shown(node, here: int) -> bool:
-    return _participants_with_nodes(node) >= here
+def _every_process_shown(node, here: list[int | None]) -> bool:
+    """True once every participant of `here` (a process id each, None: not known) whose process
+    still runs is among those the graph shows.
+
+    Participants are matched by their process, not counted: a listing started beside other
+    `ros2` commands counted the quick ones that appeared after it looked, and answered before the
+    slow process it was waiting for had shown its subscriptions ("Subscription count: 0").
+    """
+    shown = _processes_shown(node)
+    known = {pid & 0xFFFF for pid in here if pid is not None and os.path.exists(f"/proc/{pid}")}
+    unknown = sum(1 for pid in here if pid is None)  # another user's process: its sockets cannot be traced
+    return known <= shown and len(shown - known) >= unknown
 
 
 #: Topics every node publishes on (unless told not to): their publishers show its participant.
@@ -108,40 +119,47 @@ _EVERY_NODE_PUBLISHES = ("/rosout", "/parameter_events")
 _GRAPH_TOPIC = "ros_discovery_info"
 
 
-def _participants_with_nodes(node) -> int:
-    """How many participants (this process's included) the graph shows enough of to list: a node
-    of it named, and its readers announced.
+def _process_of(gid) -> int:
+    """The process an endpoint belongs to, as Fast DDS writes it into the GUID prefix of its
+    participant: bytes 4 and 5 hold the low 16 bits of the process id."""
+    return int.from_bytes(bytes(gid)[4:6], "little")
 
-    An endpoint's gid begins with the 12-byte GUID prefix of its participant. rmw learns
-    endpoints and node names from two different messages, and a listing needs the names.
-    DDS discovery announces a participant's writers and its readers apart, each in the order
-    they were made: seen by the writers alone, a listener's process showed its node while its
-    subscriptions had not come, and `ros2 topic info` printed "Subscription count: 0". A
+
+def _processes_shown(node) -> set[int]:
+    """The processes (their ids' low 16 bits; this one's included) whose participant the graph
+    shows enough of to list: a node of it named, and its readers announced.
+
+    rmw learns endpoints and node names from two different messages, and a listing needs the
+    names. DDS discovery announces a participant's writers and its readers apart, each in the
+    order they were made: seen by the writers alone, a listener's process showed its node while
+    its subscriptions had not come, and `ros2 topic info` printed "Subscription count: 0". A
     participant's first reader is rmw's own on the graph topic; once it shows, the readers the
-    process had when this one found it have been sent (with it, in one message as a rule).
-    Counting nodes instead would not do: one process can hold several nodes.
+    process had when this one found it have been sent. Counting nodes instead would not do: one
+    process can hold several nodes.
     """
-    readers = {bytes(info.endpoint_gid)[:12] for info in node.get_subscriptions_info_by_topic(_GRAPH_TOPIC,
-                                                                                             no_mangle=True)}
+    readers = {_process_of(info.endpoint_gid)
+               for info in node.get_subscriptions_info_by_topic(_GRAPH_TOPIC, no_mangle=True)}
     named = set()
     for topic in _EVERY_NODE_PUBLISHES:
         for info in node.get_publishers_info_by_topic(topic):
             if info.node_name != "_NODE_NAME_UNKNOWN_":
-                named.add(bytes(info.endpoint_gid)[:12])
-    return len(named & readers)
+                named.add(_process_of(info.endpoint_gid))
+    return named & readers
 
 
-def _participants_here(domain_id: int) -> int:
-    """How many DDS participants run on this machine in a domain.
+def _participants_here(domain_id: int) -> list[int | None]:
+    """The DDS participants that run on this machine in a domain: for each, its process's id, or
+    None where the process cannot be told (another user's).
 
     Each binds two UDP ports (the RTPS standard port mapping): 7400 + 250 * domain + 10 +
     2 * (its participant id) for discovery traffic and the next one for data, so /proc/net/udp
     tells. Both must be bound, by one user: from domain 101 on, the range reaches the kernel's
     ephemeral ports (32768 and up), which any program's socket may get, and such a lone socket
-    is no participant. 0 when it cannot.
+    is no participant. Empty when it cannot tell.
     """
     first = 7410 + 250 * domain_id
     owners: dict[int, set[str]] = {}  # port -> the uids of the sockets bound to it
+    inodes: dict[int, str] = {}  # discovery port -> the inode of a socket bound to it
     for table in ("/proc/net/udp", "/proc/net/udp6"):
         try:
             with open(table) as handle:
@@ -153,7 +171,35 @@ def _participants_here(domain_id: int) -> int:
             port = int(fields[1].rsplit(":", 1)[1], 16)
             if first <= port < first + 240:
                 owners.setdefault(port, set()).add(fields[7])
-    return sum(1 for port in range(first, first + 240, 2) if owners.get(port, set()) & owners.get(port + 1, set()))
+                inodes.setdefault(port, fields[9])
+    ports = [port for port in range(first, first + 240, 2) if owners.get(port, set()) & owners.get(port + 1, set())]
+    processes = _socket_processes({inodes[port] for port in ports})
+    return [processes.get(inodes[port]) for port in ports]
+
+
+def _socket_processes(inodes: set[str]) -> dict[str, int]:
+    """The id of the process that holds each of these sockets, where /proc shows it."""
+    found: dict[str, int] = {}
+    if not inodes:
+        return found
+    for entry in os.scandir("/proc"):
+        if not entry.name.isdigit():
+            continue
+        try:
+            descriptors = os.scandir(f"/proc/{entry.name}/fd")
+        except OSError:
+            continue  # gone, or another user's
+        with descriptors:
+            for descriptor in descriptors:
+                try:
+                    target = os.readlink(descriptor.path)
+                except OSError:
+                    continue
+                if target.startswith("socket:[") and target[8:-1] in inodes:
+                    found[target[8:-1]] = int(entry.name)
+        if len(found) == len(inodes):
+            break
+    return found
 
 
 def _snapshot(node):

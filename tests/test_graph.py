@@ -1,6 +1,7 @@
 """Tests for course_lib.graph: the ros2 CLI's node/topic introspection, from a notebook."""
 
 import math
+import os
 import select
 import signal
 import subprocess
@@ -124,39 +125,73 @@ def test_discovery_counts_a_process_holding_three_nodes_as_one_participant(domai
         session.start(domain_id=domain_id)
         tool = session.tool_node()
         assert session.wait_for(lambda: {"one", "two", "three"} <= set(tool.get_node_names()), timeout=15)
-        assert discovery._participants_here(domain_id) == 2  # this process and the other one
-        assert session.wait_for(lambda: discovery._participants_with_nodes(tool) == 2, timeout=30)
+        here = discovery._participants_here(domain_id)
+        assert sorted(here) == sorted([os.getpid(), process.pid])  # this process and the other one
+        assert session.wait_for(lambda: discovery._every_process_shown(tool, here), timeout=30)
+        assert discovery._processes_shown(tool) == {os.getpid() & 0xFFFF, process.pid & 0xFFFF}
         session.add_node(Node("four"))
         assert session.wait_for(lambda: "four" in tool.get_node_names(), timeout=30)
-        assert discovery._participants_with_nodes(tool) == 2
+        assert len(discovery._processes_shown(tool)) == 2
     finally:
         process.kill()
         process.wait(timeout=10)
         process.stdout.close()
 
 
+class _Graph:
+    """What a tool node's graph shows, for the rule that tells when a process has shown its nodes:
+    each endpoint belongs to the participant of one process (its id in the GUID prefix)."""
+
+    def __init__(self, named, unnamed=(), readers=()):
+        self.named, self.unnamed, self.readers = named, unnamed, readers
+
+    @staticmethod
+    def endpoint(pid, node_name="talker"):
+        import types
+
+        prefix = bytes(4) + (pid & 0xFFFF).to_bytes(2, "little") + bytes(6)
+        return types.SimpleNamespace(endpoint_gid=list(prefix + bytes(4)), node_name=node_name)
+
+    def get_publishers_info_by_topic(self, topic):
+        if topic != "/rosout":
+            return []
+        return [self.endpoint(pid) for pid in self.named] + [self.endpoint(pid, "_NODE_NAME_UNKNOWN_")
+                                                             for pid in self.unnamed]
+
+    def get_subscriptions_info_by_topic(self, topic, no_mangle=False):
+        return [self.endpoint(pid) for pid in self.readers] if no_mangle and topic == "ros_discovery_info" else []
+
+
 def test_a_process_counts_as_shown_once_its_readers_are_announced_too():
     """DDS announces a process's writers and its readers apart: a process whose node is named
     (by its /rosout writer) while none of its readers has come yet is not counted, or a listing
     prints the topics it subscribes to with "Subscription count: 0"."""
-    import types
+    assert discovery._processes_shown(_Graph(named=[101, 102], unnamed=[103], readers=[101])) == {101}
+    # process 103's node has no name yet
+    assert discovery._processes_shown(_Graph(named=[101, 102], unnamed=[103], readers=[101, 102, 103])) == {101, 102}
 
-    def endpoint(participant, node_name="talker"):
-        return types.SimpleNamespace(endpoint_gid=list(bytes([participant]) * 12 + bytes(4)), node_name=node_name)
 
-    class Graph:
-        readers = {"ros_discovery_info": [endpoint(1)]}  # process 2's readers have not come
+def test_a_listing_waits_for_the_processes_it_found_not_for_as_many():
+    """A listing started beside other `ros2` commands found this process, the talker's and its own;
+    a quick `ros2` process that came after it looked and showed at once must not stand in for this
+    slow process, whose subscriptions had not come ("Subscription count: 0" in a suite run)."""
+    me, talker, newcomer = os.getpid(), os.getppid(), 1
+    here = [me, talker]
+    graph_now = _Graph(named=[talker, newcomer], readers=[talker, newcomer])
+    assert not discovery._every_process_shown(graph_now, here)
+    graph_now.named, graph_now.readers = [me, talker, newcomer], [me, talker, newcomer]
+    assert discovery._every_process_shown(graph_now, here)
+    # a process of another user (None: its sockets cannot be traced) needs one more shown
+    assert not discovery._every_process_shown(_Graph(named=[me, talker], readers=[me, talker]), here + [None])
+    assert discovery._every_process_shown(graph_now, here + [None])
 
-        def get_publishers_info_by_topic(self, topic):
-            return [endpoint(1), endpoint(2), endpoint(3, "_NODE_NAME_UNKNOWN_")] if topic == "/rosout" else []
 
-        def get_subscriptions_info_by_topic(self, topic, no_mangle=False):
-            return self.readers.get(topic, []) if no_mangle else []
-
-    graph_now = Graph()
-    assert discovery._participants_with_nodes(graph_now) == 1
-    graph_now.readers = {"ros_discovery_info": [endpoint(1), endpoint(2), endpoint(3)]}
-    assert discovery._participants_with_nodes(graph_now) == 2  # process 3's node has no name yet
+def test_a_listing_stops_waiting_for_a_process_that_has_ended():
+    """A `ros2` command beside it that ended before showing itself does not keep a listing waiting."""
+    ended = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True,
+                           text=True, check=True)
+    assert discovery._every_process_shown(_Graph(named=[os.getpid()], readers=[os.getpid()]),
+                                          [os.getpid(), int(ended.stdout)])
 
 
 def test_a_lone_socket_on_a_participants_port_is_no_participant(domain_id):
@@ -166,7 +201,7 @@ def test_a_lone_socket_on_a_participants_port_is_no_participant(domain_id):
     three-node process counted 3 participants in a suite run."""
     import socket
 
-    before = discovery._participants_here(domain_id)
+    before = len(discovery._participants_here(domain_id))
     with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as lone, \
             socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as data:
         for participant in range(119, 60, -1):  # ids no process of this domain takes; skip ports in use
@@ -176,9 +211,9 @@ def test_a_lone_socket_on_a_participants_port_is_no_participant(domain_id):
             except OSError:
                 continue
             break
-        assert discovery._participants_here(domain_id) == before
+        assert len(discovery._participants_here(domain_id)) == before
         data.bind(("127.0.0.1", port + 1))
-        assert discovery._participants_here(domain_id) == before + 1
+        assert len(discovery._participants_here(domain_id)) == before + 1
 
 
 def test_the_settling_wait_sees_a_subscription_arrive_on_a_topic_it_already_knows(local_session):
