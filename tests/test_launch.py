@@ -14,6 +14,7 @@ import subprocess
 import sys
 import textwrap
 import time
+import types
 from pathlib import Path
 
 import psutil
@@ -202,6 +203,12 @@ def test_processes_that_end_are_reported_and_then_the_launch_ends(prefix, ros_do
     assert (f"[ERROR] [{name}]: process has died [pid {pid}, exit code 1, "
             f"cmd '{prefix}/lib/course_demo/crasher --ros-args'].") in lines
     assert any("[quitter-" in line and "process has finished cleanly" in line for line in lines)
+    # The catdog check's launch item stops waiting on these lines (a marker_reader that died at start
+    # kept it waiting for its whole backstop while the launch's camera went on).
+    from course_lib.checks.catdog_warp import _ended
+
+    finished = types.SimpleNamespace(log=output)
+    assert _ended(finished, "crasher") and _ended(finished, "quitter") and not _ended(finished, "endings")
     shown_all = ros2_launch("-a", "course_demo", "endings.launch.xml", domain_id=ros_domain)
     output, _ = shown_all.communicate(timeout=30)
     assert any(line.startswith("[crasher-") and line.endswith("] to stdout") for line in output.splitlines())

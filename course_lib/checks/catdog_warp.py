@@ -26,6 +26,7 @@ marker_board.crop_similarity, passing at marker_board.SAME_CROP_THRESHOLD; colou
 
 from __future__ import annotations
 
+import re
 import time
 
 import numpy as np
@@ -280,6 +281,13 @@ def _single_node_items(ctx: Context, proc, message_type) -> bool:
 LAUNCH = ("readmarker", "catdog_warp.launch.xml")
 
 
+def _ended(launch, node: str) -> bool:
+    """True once the launch has said that its process `node` ended, as ros2 launch says it
+    ("[marker_reader-2]: process has died [...]" or "... has finished cleanly"): the launch goes on
+    with its other processes, and no crop can come any more."""
+    return re.search(rf"\[{node}-\d+\]: process has (died|finished cleanly)", launch.log) is not None
+
+
 def _launch_item(ctx: Context, message_type) -> tuple[bool, str]:
     """One item, (ok, message): ``ros2 launch readmarker catdog_warp.launch.xml`` starts
     image_publisher and marker_reader, and crops of the camera's board arrive on cropped_img (the
@@ -311,7 +319,8 @@ def _launch_item(ctx: Context, message_type) -> tuple[bool, str]:
                 return "gave_up" in reader and reader["gave_up"]()
 
             started = time.monotonic()
-            probe.spin_until(lambda: bool(crops) or not launch.running() or reader_gave_up(), backstop)
+            probe.spin_until(lambda: bool(crops) or not launch.running() or _ended(launch, "marker_reader")
+                             or reader_gave_up(), backstop)
             waited = time.monotonic() - started
             nodes = {n for n, _ in probe.node.get_node_names_and_namespaces()}
     finally:
