@@ -178,8 +178,9 @@ PUBSUB_MISTAKES = {
                     "publisher queue depth 5"),
     "one_hertz": ([("create_timer(0.1,", "create_timer(1.0,")], "publisher", "rate 1.00 Hz from the stamps of 3"),
     "counter_stuck": ([("        self.count += 1\n", "")], "publisher", "add one per message"),
-    # Package-level mistakes (a missing <depend>, a wrong entry point, a wrong message field, a
-    # build error) go through the whole pipeline in the zoo (tests/zoo/pubsub.py), with these phrases.
+    # Package-level mistakes (a missing <depend>, a wrong entry point, a build error) go through the
+    # whole pipeline in the zoo (tests/zoo/pubsub.py), with these phrases; a wrong message field is
+    # judged from the .msg file in tests/test_check_packages.py.
 }
 
 
