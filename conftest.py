@@ -8,13 +8,13 @@ import os
 
 import pytest
 
-from course_lib import rosenv
+from course_lib import contract, rosenv
 
 _reservation = rosenv.reserve_domain_id()
 os.environ["ROS_DOMAIN_ID"] = str(_reservation.domain_id)
 os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
 os.environ.pop("ROS_LOCALHOST_ONLY", None)
-os.environ["COURSE_LIB_UNDER_TEST"] = "1"
+os.environ[contract.UNDER_TEST_ENV] = "1"
 
 
 def pytest_addoption(parser, pluginmanager):

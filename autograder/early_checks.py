@@ -23,8 +23,9 @@ import threading
 import time
 from pathlib import Path
 
-from autograder import hidden_checks, kernel, notebook_writes, run_as, student_uid
+from autograder import hidden_checks, kernel, notebook_writes, run_as
 from autograder.sandbox import run_sandboxed
+from course_lib import contract
 
 #: The folder in the grader's work folder that the early build and checks run in.
 FOLDER = "early"
@@ -81,7 +82,7 @@ class EarlyRun:
                 return
             env = {**g.env, **self.built}
             if g.early_uid is not None:
-                env[student_uid.STUDENT_UID_ENV] = str(g.early_uid)
+                env[contract.STUDENT_UID_ENV] = str(g.early_uid)
             self.verdicts = hidden_checks.run_checks(
                 g.sub, self.names, g.work / f"{FOLDER}-checks", self.folder, g.domain_id, env,
                 g.hide, g.seconds_left(), run=self._sandboxed)

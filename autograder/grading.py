@@ -48,9 +48,8 @@ def grade(course_dir, assignment: str | None = None, workers: int = 1, force: bo
     recorded scores go into the gradebook again with the late penalty of today's due dates.
     Returns the results of the submissions found, in (student, assignment) order.
     """
-    from course_lib import rosenv
-
     from autograder import export, late, report
+    from course_lib import rosenv
 
     course = prepare_course(course_dir)
     course_config = config.load(course)

@@ -19,7 +19,7 @@ import os
 
 from nbconvert.exporters import NotebookExporter
 
-from course_lib.checks.runner import OUTSIDE_ENV
+from course_lib import contract
 
 
 def grade_command(course: str, assignment: str, student: str) -> str:
@@ -37,7 +37,7 @@ class GraderOnlyExporter(NotebookExporter):
     the command to use (logged by nbgrader and shown by the formgrader)."""
 
     def __init__(self, *args, **kwargs):
-        if os.environ.get(OUTSIDE_ENV) != "1":
+        if os.environ.get(contract.CHECKS_OUTSIDE_ENV) != "1":
             from nbgrader.converters.base import NbGraderException
 
             parent = kwargs.get("parent")

@@ -7,13 +7,12 @@ import os
 import sys
 from pathlib import Path
 
-from autograder import hidden_checks_process
 from autograder.result import GradeResult
 from autograder.sandbox import run_sandboxed
 from autograder.submissions import Submission
-from course_lib.checks import registry, runner
+from course_lib import contract
+from course_lib.checks import registry
 from course_lib.checks.result import Result, images_html, verdict_text
-
 
 #: Seconds between the checks' own budget and the wall limit of their process.
 CHECKS_MARGIN = 3.0
@@ -29,7 +28,7 @@ def grade_outside(sub: Submission, result: GradeResult, work: Path, autograded: 
     The check runs as root in a fresh sandbox (network and mount namespaces); the student's
     processes it starts run as the worker's uid, so they cannot touch the check or its results.
     With `seconds`, the checks together get that much wall time: the process is told
-    (hidden_checks_process.BUDGET_ENV, a little less, so that it can still write its verdicts) and stopped after it.
+    (contract.CHECKS_SECONDS_ENV, a little less, so that it can still write its verdicts) and stopped after it.
     """
     names = graded_checks(sub, result)
     if names:
@@ -61,10 +60,10 @@ def run_checks(sub: Submission, names: list[str], out: Path, workdir: Path, doma
     command = [sys.executable, "-m", "autograder.hidden_checks_process", sub.assignment, *names,
                "--workdir", str(workdir), "--out", str(out)]
     wall = sum(checks[name].timeout + 30 for name in names)
-    env = {**env, runner.SEED_ENV: None, "AUTOGRADER_SEED": os.environ.get("AUTOGRADER_SEED")}
+    env = {**env, contract.CHECK_SEED_ENV: None, contract.SEED_ENV: os.environ.get(contract.SEED_ENV)}
     if seconds is not None:
         wall = min(wall, seconds)
-        env[hidden_checks_process.BUDGET_ENV] = f"{max(1.0, wall - CHECKS_MARGIN):.1f}"
+        env[contract.CHECKS_SECONDS_ENV] = f"{max(1.0, wall - CHECKS_MARGIN):.1f}"
     proc = run(command, hide, f"checks {sub.key} {out.name}", domain_id, env, out,
                processes.Limits(wall_seconds=wall, grace_seconds=5.0))
     verdicts = {}

@@ -21,8 +21,8 @@ import time
 from pathlib import Path
 
 from autograder.student_uid import StudentUid
-from course_lib.checks import answers
-from course_lib.checks.check_process import write_json, run_in_this_process
+from course_lib import contract
+from course_lib.checks.check_process import run_in_this_process, write_json
 from course_lib.checks.context import number_from_environment
 from course_lib.checks.registry import get_check
 from course_lib.checks.result import Result
@@ -30,7 +30,6 @@ from course_lib.checks.runner import embed_images, fresh_seed
 from course_lib.checks.student_server import StudentServers
 
 #: Set by the grader: the wall time, in seconds, that all checks of the submission together may use.
-BUDGET_ENV = "AUTOGRADER_CHECKS_SECONDS"
 
 #: Seconds of that time kept for writing the verdicts of checks cut short and stopping processes.
 MARGIN = 1.0
@@ -38,7 +37,7 @@ MARGIN = 1.0
 
 def budget_from_environment() -> float | None:
     """AUTOGRADER_CHECKS_SECONDS as a number of seconds, or None (no bound but the checks' own)."""
-    return number_from_environment(BUDGET_ENV)
+    return number_from_environment(contract.CHECKS_SECONDS_ENV)
 
 
 def own_domains() -> int | None:
@@ -68,7 +67,7 @@ def run_outside(assignment: str, names: list[str], workdir, out: Path, budget: f
     Args:
         budget: seconds for all checks together (default AUTOGRADER_CHECKS_SECONDS; None: no bound).
     """
-    os.environ[answers.MODE_ENV] = "graded"
+    os.environ[contract.ANSWERS_ENV] = "graded"
     budget = budget if budget is not None else budget_from_environment()
     started = time.monotonic()
     deadline = None if budget is None else started + max(1.0, budget - MARGIN)

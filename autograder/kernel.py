@@ -27,6 +27,7 @@ import sys
 import tempfile
 
 from autograder import run_as
+from course_lib import contract
 
 #: The kernel's working directory, inside the notebook's folder (see the module docstring).
 WORK_SUBDIR = ".autograder-cwd"
@@ -48,10 +49,10 @@ KERNEL_CODE = ("import os, sys\n"
 def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     connection = argv[0]
-    uid = os.environ.get("AUTOGRADER_KERNEL_UID")
+    uid = os.environ.get(contract.KERNEL_UID_ENV)
     if uid and os.geteuid() == 0:
         uid = int(uid)
-        private = tempfile.mkdtemp(prefix="autograder-kernel-", dir=os.environ.get("AUTOGRADER_KERNEL_TMP"))
+        private = tempfile.mkdtemp(prefix="autograder-kernel-", dir=os.environ.get(contract.KERNEL_TMP_ENV))
         copy = os.path.join(private, "connection.json")
         shutil.copyfile(connection, copy)
         for name in ("home", "tmp"):
@@ -72,7 +73,7 @@ def main(argv=None) -> int:
                           IPYTHONDIR=os.path.join(private, "home", ".ipython"),
                           MPLCONFIGDIR=os.path.join(private, "home", ".matplotlib"))
         os.environ.pop("ROS_LOG_DIR", None)
-        run_as.become(uid, uid, int(os.environ.get("AUTOGRADER_KERNEL_NPROC", "512")))
+        run_as.become(uid, uid, int(os.environ.get(contract.KERNEL_NPROC_ENV, str(contract.MAX_PROCESSES))))
         connection = copy
     os.execv(sys.executable, [sys.executable, "-c", KERNEL_CODE, "-f", connection])
     return 1  # not reached

@@ -41,7 +41,7 @@ import time
 import xml.etree.ElementTree as ElementTree
 from pathlib import Path
 
-from course_lib import colcon, package_files, workspace
+from course_lib import colcon, contract, package_files, workspace
 
 #: The workspace folder beside the notebook.
 WORKSPACE = "ros2_ws"
@@ -184,7 +184,6 @@ def _store_atomically(entry: Path, fill) -> None:
 
 
 #: Set to 0 to build every workspace with colcon even when an identical one was built before.
-REUSE_BUILDS_ENV = "AUTOGRADER_REUSE_BUILDS"
 #: What colcon and setuptools make of a workspace depends on their versions too.
 _BUILD_TOOLS = ("colcon-core", "colcon-ros", "colcon-python-setup-py", "setuptools")
 
@@ -403,7 +402,7 @@ def build_workspace(ws: Path, cache: InterfaceCache, scratch: Path, run, give=No
         underlays.append(underlay)
     skip = ["--packages-ignore", *interfaces] if interfaces else []
     key = None
-    if builds is not None and os.environ.get(REUSE_BUILDS_ENV, "1") != "0" \
+    if builds is not None and os.environ.get(contract.REUSE_BUILDS_ENV, "1") != "0" \
             and not (ws / "build").exists() and not (ws / "install").exists():
         key = workspace_key(ws / "src", list(keys.values()))
         if builds.restore(key, ws, scratch):
@@ -466,16 +465,9 @@ def _in_dependency_order(interfaces: dict[str, Path]) -> list[str]:
 # ---- in the grader -----------------------------------------------------------------------------
 
 #: The checks find the build report here (course_lib.checks.packages reads it).
-REPORT_ENV = "AUTOGRADER_BUILD_REPORT"
-
-#: Memory (address space, MB) of the build: CMake, the compiler and rosidl's generators.
-BUILD_MEMORY_MB = 4096
-
-#: Processes and threads of the student's uid during the build (make -j and colcon's workers).
-BUILD_PROCESSES = 384
 
 #: The sandbox variables of the grader's environment that a build needs too (autograder.grading).
-_SANDBOX_VARIABLES = ("AUTOGRADER_EXPOSE", "AUTOGRADER_BLOCKED", "AUTOGRADER_STAGE")
+_SANDBOX_VARIABLES = (contract.EXPOSE_ENV, contract.BLOCKED_ENV, contract.STAGE_ENV)
 
 
 def cache_of(course: Path) -> InterfaceCache:
@@ -494,7 +486,7 @@ def build_for_checks(assignment: str, course: Path, work: Path, workdir: Path, u
     """Build the submission's workspace (``workdir/ros2_ws``) in the sandbox as the student's uid
     (autograder.run_as),
     write the report into the grader's `work` folder, and return the variables that tell the
-    checks where it is ({REPORT_ENV: path}) and the seconds spent building interface packages the
+    checks where it is ({contract.BUILD_REPORT_ENV: path}) and the seconds spent building interface packages the
     cache did not have.
 
     Args:
@@ -533,12 +525,12 @@ def build_for_checks(assignment: str, course: Path, work: Path, workdir: Path, u
             wall_seconds = max(1.0, min(wall_seconds, deadline + interface_seconds - started))
         run.seconds_given = round(wall_seconds, 1)
         if uid is not None:
-            command = run_as.command(uid, command, max_processes=BUILD_PROCESSES)
+            command = run_as.command(uid, command, max_processes=contract.MAX_PROCESSES)
             # The sandbox hides the repository's autograder/: the wrapper runs from the grader's
             # staged copy (autograder.staging), as the checks' do.
             staged = work / "grader" / "autograder" / "run_as.py"
             command = [str(staged) if part == os.path.abspath(run_as.__file__) else part for part in command]
-        limits = processes.Limits(wall_seconds=wall_seconds, memory_mb=BUILD_MEMORY_MB, file_size_mb=256,
+        limits = processes.Limits(wall_seconds=wall_seconds, memory_mb=contract.MEMORY_MB, file_size_mb=256,
                                   grace_seconds=3.0)
         # A name of its own: a process started under the name of a running one replaces it (stops
         # it), and another worker builds its own ros2_ws at the same time.
@@ -555,7 +547,7 @@ def build_for_checks(assignment: str, course: Path, work: Path, workdir: Path, u
     except RuntimeError as error:  # the course's fault: the checks that need messages say so
         report.log += f"\n{error}"
     path = report.write(work / f"{prefix}build-report.json")
-    return {REPORT_ENV: str(path)}, interface_seconds
+    return {contract.BUILD_REPORT_ENV: str(path)}, interface_seconds
 
 
 def needed(assignment: str, workdir: Path) -> bool:
@@ -621,7 +613,7 @@ def local_cache() -> InterfaceCache:
 def build_here(assignment: str, workdir: Path, cache: InterfaceCache | None = None) -> BuildReport:
     """Build workdir/ros2_ws as the grader does, without a sandbox (reference solutions, tests,
     benchmarks), a build of an identical workspace reused (kept beside `cache`). The report goes
-    to workdir/.colcon/build-report.json; checks run with REPORT_ENV set to it use this build
+    to workdir/.colcon/build-report.json; checks run with contract.BUILD_REPORT_ENV set to it use this build
     (see course_lib.checks.packages)."""
     scratch = Path(workdir) / ".colcon"
     scratch.mkdir(exist_ok=True)
@@ -641,7 +633,7 @@ def report_path(workdir: Path) -> Path:
 def read_report(variables: dict) -> BuildReport | None:
     """The report of the build whose variables (build_for_checks) name it; None when unreadable."""
     try:
-        return BuildReport.read(Path(variables[REPORT_ENV]))
+        return BuildReport.read(Path(variables[contract.BUILD_REPORT_ENV]))
     except (KeyError, OSError, ValueError, TypeError):
         return None
 

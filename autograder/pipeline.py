@@ -42,17 +42,16 @@ import tempfile
 import time
 from pathlib import Path
 
-from autograder import config, early_checks, gradebook, intake, kernel, packages, student_uid
+from autograder import config, early_checks, gradebook, intake, kernel, packages
+from autograder.hidden_checks import apply_verdicts, grade_outside, graded_checks
 from autograder.nbgrader_cli import env_for_tools
 from autograder.outputs import keep_autograded, keep_log, scrub_paths
-from autograder.hidden_checks import apply_verdicts, grade_outside, graded_checks
 from autograder.result import GradeResult
 from autograder.sandbox import HIDDEN_FROM_STUDENTS, interpreter_exposure, isolation, run_sandboxed
 from autograder.staging import private_copy, stage_grader
 from autograder.submissions import Submission, submission_digest
-from course_lib import rosenv
-from course_lib.checks import context, runner
-
+from course_lib import contract, rosenv
+from course_lib.checks import context
 
 #: Seconds one submission's grading may take on an idle machine, every step included (issue #14:
 #: a hostile submission must not stall the class). Each step gets at most what is left of it.
@@ -69,13 +68,8 @@ NOTEBOOK_TIMEOUT = 420.0
 KEPT_FOR_CHECKS = 20.0
 #: Set to 0 to build and check only after the notebook ran (autograder.early_checks), e.g. on a
 #: one-core machine, where overlapping them gains nothing.
-EARLY_CHECKS_ENV = "AUTOGRADER_EARLY_CHECKS"
-#: Address space of each process of a submission (MB). Fast DDS + numpy + OpenCV need ~1 GB.
-MEMORY_MB = 4096
 #: Largest file a submission may write (MB).
 FILE_MB = 256
-#: Processes and threads of one worker's uid (root only). A kernel, a check and a node need ~100.
-NPROC = 384
 #: Base of the per-worker uids (root only): uid = KERNEL_UID_BASE + reserved ROS domain id.
 KERNEL_UID_BASE = 61000
 #: The early build and checks run as the worker's uid + EARLY_UID_OFFSET: the kernel, which runs
@@ -179,26 +173,26 @@ def choose_environment(g: Grading) -> None:
     work = g.work
     grader = stage_grader(work)
     g.env = {"COURSE_LIB_GRADING": "1", "COURSE_LIB_UNDER_TEST": None, "AUTOGRADER_SEED": None,
-             runner.OUTSIDE_ENV: "1",
+             contract.CHECKS_OUTSIDE_ENV: "1",
              "JUPYTER_PATH": str(work / "jupyter"), "JUPYTER_RUNTIME_DIR": str(work / "runtime"),
-             "JUPYTER_CONFIG_DIR": str(work / "jupyter-config"), "AUTOGRADER_KERNEL_TMP": str(work / "kernel-tmp"),
+             "JUPYTER_CONFIG_DIR": str(work / "jupyter-config"), contract.KERNEL_TMP_ENV: str(work / "kernel-tmp"),
              "PYTHONPATH": os.pathsep.join([str(grader), env_for_tools()["PYTHONPATH"]]), "HOME": str(work),
-             context.LOAD_FACTOR_ENV: f"{g.budget / GRADING_SECONDS:.2f}"}
+             contract.LOAD_FACTOR_ENV: f"{g.budget / GRADING_SECONDS:.2f}"}
     if g.result.isolation == "root":
         g.result.kernel_uid = KERNEL_UID_BASE + g.domain_id
-        g.env.update(AUTOGRADER_KERNEL_UID=str(g.result.kernel_uid), AUTOGRADER_KERNEL_NPROC=str(NPROC))
-        g.env.update({student_uid.STUDENT_UID_ENV: str(g.result.kernel_uid), student_uid.STUDENT_NPROC_ENV: str(NPROC)})
+        g.env.update({contract.KERNEL_UID_ENV: str(g.result.kernel_uid), contract.KERNEL_NPROC_ENV: str(contract.MAX_PROCESSES)})
+        g.env.update({contract.STUDENT_UID_ENV: str(g.result.kernel_uid), contract.STUDENT_NPROC_ENV: str(contract.MAX_PROCESSES)})
         exposure = interpreter_exposure()
         if exposure:
             (work / "stage").mkdir()
-            g.env.update(exposure, AUTOGRADER_STAGE=str(work / "stage"))
+            g.env.update(exposure, **{contract.STAGE_ENV: str(work / "stage")})
 
 
 def start_early_checks(g: Grading) -> None:
     """Build and check the files the notebook is predicted to write while it runs
     (autograder.early_checks); build_workspace decides afterwards whether they count."""
     names = graded_checks(g.sub)
-    if os.environ.get(EARLY_CHECKS_ENV, "1") != "0" and names and packages.needed(g.sub.assignment, g.submitted):
+    if os.environ.get(contract.EARLY_CHECKS_ENV, "1") != "0" and names and packages.needed(g.sub.assignment, g.submitted):
         g.early = early_checks.EarlyRun(g, names, build_for_checks).start()
 
 
@@ -209,7 +203,7 @@ def run_notebook(g: Grading) -> None:
     command = [sys.executable, "-m", "nbgrader", "autograde", g.sub.assignment, "--student", g.sub.student,
                "--force", f"--CourseDirectory.root={g.root}"]
     g.notebook_seconds = round(min(NOTEBOOK_TIMEOUT, g.seconds_left(keep=KEPT_FOR_CHECKS)), 1)
-    limits = processes.Limits(wall_seconds=g.notebook_seconds, memory_mb=MEMORY_MB, file_size_mb=FILE_MB,
+    limits = processes.Limits(wall_seconds=g.notebook_seconds, memory_mb=contract.MEMORY_MB, file_size_mb=FILE_MB,
                               grace_seconds=2.0)
     g.notebook_run = run_sandboxed(command, g.hide, f"autograde {g.sub.key}", g.domain_id, g.env, g.root, limits)
 

@@ -14,6 +14,7 @@ import tempfile
 from pathlib import Path
 
 from autograder import packages, reference
+from course_lib import contract
 from course_lib.checks import answers, registry, runner
 
 ANSWER_KEYS = Path(__file__).resolve().parent / "answers"
@@ -33,8 +34,8 @@ def record_answers(assignments: list[str] | None = None) -> list[Path]:
     with tempfile.TemporaryDirectory(prefix="autograder-record-") as tmp:
         lines = Path(tmp) / "answers.jsonl"
         lines.touch()
-        previous = os.environ.get(answers.RECORD_ENV)
-        os.environ[answers.RECORD_ENV] = str(lines)
+        previous = os.environ.get(contract.RECORD_ANSWERS_ENV)
+        os.environ[contract.RECORD_ANSWERS_ENV] = str(lines)
         try:
             for assignment in assignments or assignments_with_keys():
                 workdir = Path(tmp) / assignment
@@ -43,16 +44,16 @@ def record_answers(assignments: list[str] | None = None) -> list[Path]:
                 report = packages.build_here(assignment, workdir)
                 if not report.ok:
                     raise RuntimeError(f"the {assignment} reference packages do not build: {report.reason}")
-                os.environ[packages.REPORT_ENV] = str(packages.report_path(workdir))
+                os.environ[contract.BUILD_REPORT_ENV] = str(packages.report_path(workdir))
                 for name in registry.checks_of(assignment):
                     result = runner.execute(assignment, name, runner.SELFCHECK_SEED, workdir=workdir, mode="record")
                     if result.points < result.max_points:
                         raise RuntimeError(f"the reference solution got {result.points:g} of {result.max_points:g} "
                                            f"points in {assignment}/{name}:\n" + "\n".join(result.verdict_lines()))
         finally:
-            os.environ.pop(packages.REPORT_ENV, None)
+            os.environ.pop(contract.BUILD_REPORT_ENV, None)
             if previous is None:
-                os.environ.pop(answers.RECORD_ENV, None)
+                os.environ.pop(contract.RECORD_ANSWERS_ENV, None)
             else:
-                os.environ[answers.RECORD_ENV] = previous
+                os.environ[contract.RECORD_ANSWERS_ENV] = previous
         return answers.merge_recording(lines)

@@ -24,6 +24,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+from course_lib import contract
+
 REPO = Path(__file__).resolve().parent.parent
 #: The script that runs first inside the namespaces (see sandbox_command).
 ENTRY = Path(__file__).resolve().parent / "sandbox_entry.py"
@@ -67,7 +69,7 @@ def interpreter_exposure() -> dict:
     prefix = Path(sys.base_prefix).resolve()
     for ancestor in reversed(prefix.parents):
         if ancestor != Path("/") and not os.stat(ancestor).st_mode & 0o001:
-            return {"AUTOGRADER_EXPOSE": str(prefix), "AUTOGRADER_BLOCKED": str(ancestor)}
+            return {contract.EXPOSE_ENV: str(prefix), contract.BLOCKED_ENV: str(ancestor)}
     return {}
 
 

@@ -1,7 +1,7 @@
 """The grader's student uid: the checks' student processes run as the worker's uid, not as root.
 
 The grader runs a submission's hidden checks as root (autograder.hidden_checks_process) and sets
-STUDENT_UID_ENV (and STUDENT_NPROC_ENV) for them. :class:`StudentUid` is then what the checks
+contract.STUDENT_UID_ENV (and STUDENT_NPROC_ENV) for them. :class:`StudentUid` is then what the checks
 (course_lib.checks.context.Context) start the student's code with: the same limits as a
 self-check, plus the uid (autograder.run_as) and a fresh HOME it owns. The student's code can
 then neither read nor signal nor trace the check, nor write its results.
@@ -13,37 +13,30 @@ import os
 from pathlib import Path
 
 from autograder import run_as
+from course_lib import contract
 from course_lib.checks.student_processes import StudentProcesses
-
-#: Set by the grader (as root) for the checks it runs: the uid (and its RLIMIT_NPROC) that the
-#: student's processes run as, while the check itself stays root.
-STUDENT_UID_ENV = "AUTOGRADER_STUDENT_UID"
-STUDENT_NPROC_ENV = "AUTOGRADER_STUDENT_NPROC"
-
-#: RLIMIT_NPROC of the student's uid when STUDENT_NPROC_ENV is not set.
-DEFAULT_NPROC = 384
 
 
 class StudentUid(StudentProcesses):
     """Starts the student's processes as `uid`, with at most `max_processes` processes and threads."""
 
-    def __init__(self, uid: int, max_processes: int | None = DEFAULT_NPROC):
+    def __init__(self, uid: int, max_processes: int | None = contract.MAX_PROCESSES):
         self.uid = uid
         self.max_processes = max_processes
 
     @classmethod
     def from_environment(cls) -> StudentProcesses:
-        """StudentUid when the grader asked for one (STUDENT_UID_ENV) and this process is root, else
+        """StudentUid when the grader asked for one (contract.STUDENT_UID_ENV) and this process is root, else
         the self-check's StudentProcesses (same user)."""
-        uid = os.environ.get(STUDENT_UID_ENV)
+        uid = os.environ.get(contract.STUDENT_UID_ENV)
         if not uid or os.geteuid() != 0:
             return StudentProcesses()
-        return cls(int(uid), int(os.environ.get(STUDENT_NPROC_ENV, str(DEFAULT_NPROC))))
+        return cls(int(uid), int(os.environ.get(contract.STUDENT_NPROC_ENV, str(contract.MAX_PROCESSES))))
 
     def confine(self, command: list[str], env: dict) -> tuple[list[str], dict, list[Path]]:
         home = run_as.home_for(self.uid)
         env = {**env, "HOME": home, "ROS_HOME": home, "ROS_LOG_DIR": None,
-               STUDENT_UID_ENV: None, STUDENT_NPROC_ENV: None}
+               contract.STUDENT_UID_ENV: None, contract.STUDENT_NPROC_ENV: None}
         return run_as.command(self.uid, command, self.max_processes), env, [Path(home)]
 
     def give(self, path: Path) -> None:

@@ -40,6 +40,7 @@ sys.path[:0] = [str(ROOT), str(ROOT / "tests")]  # the grader runs from the repo
 
 import zoo  # noqa: E402 (tests/zoo builds submissions from the reference solutions)
 from autograder import grading, packages, pipeline, release, sandbox  # noqa: E402
+from course_lib import contract  # noqa: E402
 
 ASSIGNMENTS = ["brightness", "pubsub", "catdog_warp"]
 #: The steps shown on their own (autograder.pipeline.STEPS); the others are summed as "other".
@@ -47,8 +48,8 @@ SHOWN_STEPS = ["run_notebook", "early_build_and_checks", "build_workspace", "run
 
 
 def timed_grade(course: Path, workers: int, early: bool = True, reuse: bool = True) -> tuple[float, list]:
-    os.environ[pipeline.EARLY_CHECKS_ENV] = "1" if early else "0"
-    os.environ[packages.REUSE_BUILDS_ENV] = "1" if reuse else "0"
+    os.environ[contract.EARLY_CHECKS_ENV] = "1" if early else "0"
+    os.environ[contract.REUSE_BUILDS_ENV] = "1" if reuse else "0"
     started = time.monotonic()
     results = grading.grade(course, workers=workers, force=True, progress=False)
     return time.monotonic() - started, results
@@ -89,7 +90,7 @@ def main(argv=None) -> int:
     print(f"\nthe early build and checks counted for {early_used} of {len(runs['early'][1])} submissions")
     reused = {run: sum(r.build_reused for r in runs[run][1]) for run in ("built", "early")}
     print(f"workspace builds copied from an identical one: {reused['built']} of {len(runs['built'][1])} in the "
-          f"built run ({packages.REUSE_BUILDS_ENV}=0), {reused['early']} of {len(runs['early'][1])} in the early run")
+          f"built run ({contract.REUSE_BUILDS_ENV}=0), {reused['early']} of {len(runs['early'][1])} in the early run")
     print(f"\nseconds per step, mean of the cached runs with 1 worker (budget {pipeline.GRADING_SECONDS:g} s idle, "
           f"per submission):")
     print(f"{'assignment':<14}{'run':<12}" + "".join(f"{name:>23}" for name in [*SHOWN_STEPS, "other"]))

@@ -26,6 +26,8 @@ import sys
 import tempfile
 from pathlib import Path
 
+from course_lib import contract
+
 DISTRO = "jazzy"
 SYSTEM_PREFIX = Path("/opt/ros") / DISTRO
 
@@ -320,9 +322,9 @@ def reserve_domain_id(candidates=RESERVABLE_DOMAIN_IDS) -> DomainReservation:
 
 def under_test() -> bool:
     """True under the test suite or CI notebook runs: bound loops that would run forever live."""
-    return os.environ.get("COURSE_LIB_UNDER_TEST", "") not in ("", "0")
+    return os.environ.get(contract.UNDER_TEST_ENV, "") not in ("", "0")
 
 
 def under_grading() -> bool:
     """True while the autograder runs a submission (a separate flag from under_test on purpose)."""
-    return os.environ.get("COURSE_LIB_GRADING", "") not in ("", "0")
+    return os.environ.get(contract.GRADING_ENV, "") not in ("", "0")

@@ -13,6 +13,8 @@ import pwd
 import sys
 from pathlib import Path
 
+from course_lib import contract
+
 REPO = Path(__file__).resolve().parent.parent
 
 
@@ -47,5 +49,5 @@ def user_environment(course, user: str, base: dict) -> dict:
     exposure = sandbox.interpreter_exposure()
     if exposure:  # the interpreter lives below /root: the sandbox puts it back for the user
         (course.run_dir / "stage").mkdir(mode=0o700, parents=True, exist_ok=True)
-        env.update(exposure, AUTOGRADER_STAGE=str(course.run_dir / "stage"))
+        env.update(exposure, **{contract.STAGE_ENV: str(course.run_dir / "stage")})
     return env

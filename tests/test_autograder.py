@@ -12,6 +12,7 @@ import pytest
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from autograder import packages, reference, sandbox  # noqa: E402
+from course_lib import contract
 from course_lib.checks import registry, runner, validate  # noqa: E402
 
 ASSIGNMENTS = ["brightness", "pubsub", "catdog_warp"]
@@ -76,7 +77,7 @@ def _module_dir(tmp_path: Path, assignment: str, edits=(), monkeypatch=None) -> 
     reference.write_reference_workspace(assignment, tmp_path, edits)
     if monkeypatch is not None:
         packages.build_here(assignment, tmp_path)
-        monkeypatch.setenv(packages.REPORT_ENV, str(packages.report_path(tmp_path)))
+        monkeypatch.setenv(contract.BUILD_REPORT_ENV, str(packages.report_path(tmp_path)))
     return tmp_path
 
 

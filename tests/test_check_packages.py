@@ -7,6 +7,7 @@ from pathlib import Path
 
 import pytest
 
+from course_lib import contract
 from course_lib.checks import packages
 from course_lib.checks.context import StudentError
 
@@ -92,7 +93,7 @@ def test_a_message_with_other_fields_costs_an_item(tmp_path, definition, ok):
 
 
 def test_an_unbuilt_workspace_says_to_run_the_build_cell(tmp_path, monkeypatch):
-    monkeypatch.delenv(packages.REPORT_ENV, raising=False)
+    monkeypatch.delenv(contract.BUILD_REPORT_ENV, raising=False)
     with pytest.raises(StudentError, match="run the notebook's build cell"):
         packages.require_build(Recorder(tmp_path))
 
@@ -101,6 +102,6 @@ def test_a_failed_grader_build_is_the_reason_of_every_check_that_needs_it(tmp_pa
     report = tmp_path / "build.json"
     report.write_text('{"ok": false, "reason": "colcon build failed in package \'pubsub\':\\nSyntaxError: x", '
                       '"workspace": "/nowhere"}')
-    monkeypatch.setenv(packages.REPORT_ENV, str(report))
+    monkeypatch.setenv(contract.BUILD_REPORT_ENV, str(report))
     with pytest.raises(StudentError, match="(?s)did not build.*SyntaxError: x"):
         packages.require_build(Recorder(tmp_path))

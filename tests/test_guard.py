@@ -7,11 +7,11 @@ import shutil
 import subprocess
 import sys
 
+import course_support
 import pytest
 
-import course_support
 from autograder import config, guard
-from course_lib.checks import runner
+from course_lib import contract
 
 
 @pytest.fixture(scope="module")
@@ -59,8 +59,8 @@ def test_formgrader_autograde_button_refuses(course):
 
 def test_exporter_works_under_the_graders_flag(monkeypatch):
     """With the flag the grader sets for its sandboxed run, nbgrader gets a working exporter."""
-    monkeypatch.setenv(runner.OUTSIDE_ENV, "1")
+    monkeypatch.setenv(contract.CHECKS_OUTSIDE_ENV, "1")
     assert guard.GraderOnlyExporter().file_extension == ".ipynb"
-    monkeypatch.delenv(runner.OUTSIDE_ENV)
+    monkeypatch.delenv(contract.CHECKS_OUTSIDE_ENV)
     with pytest.raises(Exception, match="python -m autograder grade"):
         guard.GraderOnlyExporter()

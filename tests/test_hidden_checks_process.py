@@ -11,7 +11,8 @@ import sys
 import time
 
 from autograder import hidden_checks_process
-from autograder.hidden_checks_process import BUDGET_ENV, _Run
+from autograder.hidden_checks_process import _Run
+from course_lib import contract
 from course_lib.checks.runner import child_pythonpath
 from course_lib.checks.student_server import StudentServers
 
@@ -25,7 +26,7 @@ def test_a_hung_call_costs_at_most_the_checks_time_and_is_named(tmp_path):
     module.write_text(HANGS)
     out = tmp_path / "out"
     out.mkdir()
-    env = {**os.environ, BUDGET_ENV: "8", "PYTHONPATH": child_pythonpath()}
+    env = {**os.environ, contract.CHECKS_SECONDS_ENV: "8", "PYTHONPATH": child_pythonpath()}
     subprocess.run([sys.executable, "-m", "autograder.hidden_checks_process", "brightness", "values",
                     "--workdir", str(tmp_path), "--out", str(out)], env=env, cwd=out, timeout=60, check=True)
     result = json.loads((out / "values.json").read_text())
@@ -60,9 +61,9 @@ def test_checks_cut_short_by_the_time_say_what_was_running_and_earn_nothing(tmp_
 
 
 def test_the_budget_comes_from_the_environment(monkeypatch):
-    monkeypatch.setenv(BUDGET_ENV, "12.5")
+    monkeypatch.setenv(contract.CHECKS_SECONDS_ENV, "12.5")
     assert hidden_checks_process.budget_from_environment() == 12.5
-    monkeypatch.delenv(BUDGET_ENV)
+    monkeypatch.delenv(contract.CHECKS_SECONDS_ENV)
     assert hidden_checks_process.budget_from_environment() is None
 
 

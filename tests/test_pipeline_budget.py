@@ -8,7 +8,7 @@ import time
 
 from autograder import pipeline, report
 from autograder.result import GradeResult
-from course_lib import processes
+from course_lib import contract, processes
 
 
 def test_each_step_gets_what_is_left_of_the_budget_less_what_it_keeps_for_later():
@@ -52,26 +52,25 @@ def test_the_checks_limits_grow_with_the_load_factor_the_grader_passes_on(monkey
     from course_lib.checks import context
 
     cores = os.cpu_count() or 1
-    monkeypatch.delenv(context.LOAD_FACTOR_ENV, raising=False)
+    monkeypatch.delenv(contract.LOAD_FACTOR_ENV, raising=False)
     monkeypatch.setattr(os, "getloadavg", lambda: (0.1, 0.1, 0.1))
     assert context.scaled(context.CALL_TIMEOUT) == context.CALL_TIMEOUT
     monkeypatch.setattr(os, "getloadavg", lambda: (2.0 * cores, 0.1, 0.1))
     assert context.scaled(context.CALL_TIMEOUT) == 2.0 * context.CALL_TIMEOUT
-    monkeypatch.setenv(context.LOAD_FACTOR_ENV, "3.5")
+    monkeypatch.setenv(contract.LOAD_FACTOR_ENV, "3.5")
     assert context.scaled(context.CALL_TIMEOUT) == 3.5 * context.CALL_TIMEOUT
-    monkeypatch.setenv(context.LOAD_FACTOR_ENV, "0.2")
+    monkeypatch.setenv(contract.LOAD_FACTOR_ENV, "0.2")
     assert context.scaled(context.IMPORT_TIMEOUT) == context.IMPORT_TIMEOUT
-    monkeypatch.setenv(context.LOAD_FACTOR_ENV, "100")
+    monkeypatch.setenv(contract.LOAD_FACTOR_ENV, "100")
     assert context.scaled(context.IMPORT_TIMEOUT) == context.MAX_LOAD_FACTOR * context.IMPORT_TIMEOUT
-    monkeypatch.setenv(context.LOAD_FACTOR_ENV, "busy")
+    monkeypatch.setenv(contract.LOAD_FACTOR_ENV, "busy")
     assert context.scaled(context.IMPORT_TIMEOUT) == 2.0 * context.IMPORT_TIMEOUT
 
 
 def test_the_grader_tells_the_checks_its_load_factor(tmp_path):
     from autograder.submissions import Submission
-    from course_lib.checks import context
 
     sub = Submission("s", "brightness", tmp_path)
     g = pipeline.Grading(sub, tmp_path, 0, GradeResult("s", "brightness", ""), tmp_path, budget=150.0)
     pipeline.choose_environment(g)
-    assert g.env[context.LOAD_FACTOR_ENV] == "2.50"
+    assert g.env[contract.LOAD_FACTOR_ENV] == "2.50"

@@ -16,11 +16,12 @@ import sys
 import zipfile
 from pathlib import Path
 
+import course_support
 import nbformat
 import pytest
 
-import course_support
 from autograder import reference
+from course_lib import contract
 from course_lib.checks import registry, runner
 
 REPO = Path(__file__).resolve().parent.parent
@@ -172,7 +173,7 @@ def test_untouched_release_earns_nothing(release, tmp_path, monkeypatch, assignm
     nb = nbformat.read(release / assignment / f"{assignment}.ipynb", as_version=4)
     reference.write_files(nb, tmp_path)
     packages.build_here(assignment, tmp_path)
-    monkeypatch.setenv(packages.REPORT_ENV, str(packages.report_path(tmp_path)))
+    monkeypatch.setenv(contract.BUILD_REPORT_ENV, str(packages.report_path(tmp_path)))
     verdicts = []
     for name in registry.checks_of(assignment):
         result = runner.execute(assignment, name, 7, workdir=tmp_path, mode="graded")

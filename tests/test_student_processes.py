@@ -3,7 +3,8 @@ student's code: bounded in time, memory and file size, without the grader's vari
 
 import sys
 
-from course_lib.checks.student_processes import STUDENT_FILE_MB, STUDENT_MEMORY_MB, StudentProcesses
+from course_lib import contract
+from course_lib.checks.student_processes import STUDENT_FILE_MB, StudentProcesses
 
 REPORT = ("import os, resource; print(resource.getrlimit(resource.RLIMIT_AS)[0] // 2**20, "
           "resource.getrlimit(resource.RLIMIT_FSIZE)[0] // 2**20, os.environ.get('AUTOGRADER_CHECK_SEED'), "
@@ -16,7 +17,7 @@ def test_a_students_process_gets_the_memory_and_file_limits_and_no_seed(tmp_path
     process = StudentProcesses().start([sys.executable, "-S", "-c", REPORT], name="student-limits", cwd=tmp_path,
                                        domain_id=0, wall_seconds=30)
     assert process.wait(timeout=30) == 0, process.log
-    assert process.log.split() == [str(STUDENT_MEMORY_MB), str(STUDENT_FILE_MB), "None", "None", "True"]
+    assert process.log.split() == [str(contract.STUDENT_MEMORY_MB), str(STUDENT_FILE_MB), "None", "None", "True"]
 
 
 def test_a_students_process_is_stopped_at_its_wall_time(tmp_path):

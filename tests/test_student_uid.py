@@ -7,7 +7,8 @@ import pytest
 
 from autograder import student_uid
 from autograder.student_uid import StudentUid
-from course_lib.checks.student_processes import STUDENT_MEMORY_MB, StudentProcesses
+from course_lib import contract
+from course_lib.checks.student_processes import StudentProcesses
 
 needs_root = pytest.mark.skipif(os.geteuid() != 0, reason="running as the student's uid needs root")
 
@@ -23,11 +24,11 @@ REPORT = ("id -u; id -g; test \"$HOME\" = \"$ROS_HOME\" && echo True; stat -c %u
 
 @needs_root
 def test_the_students_process_runs_as_the_uid_with_a_home_it_owns(tmp_path, monkeypatch):
-    monkeypatch.setenv(student_uid.STUDENT_UID_ENV, str(UID))
+    monkeypatch.setenv(contract.STUDENT_UID_ENV, str(UID))
     process = StudentUid(UID, max_processes=64).start(["sh", "-c", REPORT], name="student-test", cwd="/",
                                                       domain_id=0, wall_seconds=30)
     process.wait(timeout=30)
-    assert process.log.split() == [str(UID), str(UID), "True", str(UID), "64", str(STUDENT_MEMORY_MB), "None"], process.log
+    assert process.log.split() == [str(UID), str(UID), "True", str(UID), "64", str(contract.STUDENT_MEMORY_MB), "None"], process.log
 
 
 @needs_root
@@ -46,14 +47,14 @@ def test_give_hands_a_job_folder_to_the_uid(tmp_path):
 
 
 def test_without_the_graders_uid_the_student_runs_as_the_check(monkeypatch):
-    monkeypatch.delenv(student_uid.STUDENT_UID_ENV, raising=False)
+    monkeypatch.delenv(contract.STUDENT_UID_ENV, raising=False)
     assert type(StudentUid.from_environment()) is StudentProcesses
 
 
 @needs_root
 def test_the_graders_uid_and_process_limit_come_from_the_environment(monkeypatch):
-    monkeypatch.setenv(student_uid.STUDENT_UID_ENV, str(UID))
-    monkeypatch.setenv(student_uid.STUDENT_NPROC_ENV, "99")
+    monkeypatch.setenv(contract.STUDENT_UID_ENV, str(UID))
+    monkeypatch.setenv(contract.STUDENT_NPROC_ENV, "99")
     students = StudentUid.from_environment()
     assert isinstance(students, StudentUid) and (students.uid, students.max_processes) == (UID, 99)
 

@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 from autograder import packages
-from course_lib import workspace
+from course_lib import contract, workspace
 
 pytestmark = pytest.mark.slow
 
@@ -127,7 +127,7 @@ def test_a_failed_build_is_not_kept_and_reuse_can_be_switched_off(tmp_path, monk
         report = build(tmp_path / student, builds, colcon)
         assert not report.ok and "colcon build failed in package 'greeter'" in report.reason
     assert colcon.runs == 2 and not any(builds.root.glob("*"))
-    monkeypatch.setenv(packages.REUSE_BUILDS_ENV, "0")
+    monkeypatch.setenv(contract.REUSE_BUILDS_ENV, "0")
     for student in ("frank", "grace"):
         write_workspace(tmp_path / student, student)
         assert build(tmp_path / student, builds, colcon).ok

@@ -1,7 +1,7 @@
 """The answers a check compares a student's results with: the grader's, or recorded from the grader's.
 
 A check asks ``ctx.expected("average_brightness", image)``. Where the answer comes from depends on
-how the check runs (MODE_ENV, set by runner.execute):
+how the check runs (contract.ANSWERS_ENV, set by runner.execute):
 
 - ``graded`` (the grader, fresh seeds): the grader's answer key, the function of that name in
   ``autograder.answers.<assignment>``. It lives only on the instructor's side: students'
@@ -10,7 +10,7 @@ how the check runs (MODE_ENV, set by runner.execute):
   exactly those inputs, recorded as data in ``course_lib/checks/recorded/<assignment>.json``.
   A self-check and a graded run of the same input therefore compare with the same number.
 - ``record`` (``python -m autograder record-answers``): graded, and every answer is also written
-  to the file named by RECORD_ENV, from which the recorded answers are made.
+  to the file named by contract.RECORD_ANSWERS_ENV, from which the recorded answers are made.
 
 Inputs are keyed by their content (dtype, shape and bytes of each argument), so the order in
 which a check asks does not matter.
@@ -24,8 +24,8 @@ import json
 import os
 from pathlib import Path
 
-MODE_ENV = "AUTOGRADER_ANSWERS"
-RECORD_ENV = "AUTOGRADER_RECORD_TO"
+from course_lib import contract
+
 MODES = ("selfcheck", "graded", "record")
 RECORDED = Path(__file__).resolve().parent / "recorded"
 
@@ -55,9 +55,9 @@ class AnswerKey:
 
     def __init__(self, assignment: str, mode: str | None = None):
         self.assignment = assignment
-        self.mode = mode or os.environ.get(MODE_ENV, "selfcheck")
+        self.mode = mode or os.environ.get(contract.ANSWERS_ENV, "selfcheck")
         if self.mode not in MODES:
-            raise ValueError(f"{MODE_ENV}={self.mode!r}: expected one of {', '.join(MODES)}")
+            raise ValueError(f"{contract.ANSWERS_ENV}={self.mode!r}: expected one of {', '.join(MODES)}")
         self._oracle = None
         self._recorded: dict | None = None
 
@@ -67,7 +67,7 @@ class AnswerKey:
             return self._lookup(question, input_key(*args))
         answer = getattr(self._key_module(), question)(*args)
         if self.mode == "record":
-            with open(os.environ[RECORD_ENV], "a") as handle:
+            with open(os.environ[contract.RECORD_ANSWERS_ENV], "a") as handle:
                 handle.write(json.dumps({"assignment": self.assignment, "question": question,
                                          "key": input_key(*args), "answer": answer}) + "\n")
         return answer

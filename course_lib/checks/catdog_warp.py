@@ -226,9 +226,10 @@ def node(ctx: Context) -> None:
 def _single_node_items(ctx: Context, proc, message_type) -> bool:
     """The items of ``ros2 run readmarker marker_reader`` (`proc`), fed a drawn frame: a cat and
     a dog crop arrive on cropped_img, each the expected picture. False when the node did not run."""
-    from course_lib import images, scenes
     from rclpy.qos import QoSProfile, ReliabilityPolicy
     from sensor_msgs.msg import Image
+
+    from course_lib import images, scenes
 
     try:
         with ctx.probe() as probe:

@@ -11,11 +11,11 @@ import sys
 import traceback
 from pathlib import Path
 
-from course_lib import processes
+from course_lib import contract, processes
 from course_lib.checks.context import Context, StudentError
 from course_lib.checks.registry import get_check
 from course_lib.checks.result import Result
-from course_lib.checks.runner import SEED_ENV, SELFCHECK_SEED
+from course_lib.checks.runner import SELFCHECK_SEED
 from course_lib.checks.student_processes import StudentProcesses
 
 
@@ -52,12 +52,12 @@ def main(argv=None) -> int:
     run = sub.add_parser("run")
     run.add_argument("assignment")
     run.add_argument("check")
-    run.add_argument("--seed", type=int, default=None, help=f"default: ${SEED_ENV}, else {SELFCHECK_SEED}")
+    run.add_argument("--seed", type=int, default=None, help=f"default: ${contract.CHECK_SEED_ENV}, else {SELFCHECK_SEED}")
     run.add_argument("--workdir", default=".")
     run.add_argument("--out", required=True)
     args = parser.parse_args(argv)
     out = Path(args.out)
-    seed = args.seed if args.seed is not None else int(os.environ.get(SEED_ENV, SELFCHECK_SEED))
+    seed = args.seed if args.seed is not None else int(os.environ.get(contract.CHECK_SEED_ENV, SELFCHECK_SEED))
     try:
         result = run_in_this_process(args.assignment, args.check, seed, Path(args.workdir).resolve(), out)
     finally:

@@ -7,6 +7,7 @@ import os
 import time
 from pathlib import Path
 
+from course_lib import contract
 from course_lib.checks import answers
 from course_lib.checks.probe import RosProbe
 from course_lib.checks.registry import Check
@@ -34,7 +35,6 @@ NODE_START_CPU_SECONDS = 10.0
 #: Set by the grader: how many times the idle machine's time limits a grading gets on this
 #: machine now (its load per core, autograder.pipeline.grading_budget). The wall-clock backstops
 #: above grow with it: a busy machine gives each process a fraction of a core.
-LOAD_FACTOR_ENV = "AUTOGRADER_LOAD_FACTOR"
 
 
 def number_from_environment(name: str) -> float | None:
@@ -51,10 +51,10 @@ MAX_LOAD_FACTOR = 6.0
 
 def scaled(seconds: float) -> float:
     """A wall-clock backstop of `seconds` on an idle machine, times the grader's load factor
-    (LOAD_FACTOR_ENV), or in a self-check this machine's load per core now (between 1 and
+    (contract.LOAD_FACTOR_ENV), or in a self-check this machine's load per core now (between 1 and
     MAX_LOAD_FACTOR): a legitimate answer that needs a little processor time comes later on a busy
     machine, and a backstop must never be what decides against it."""
-    factor = number_from_environment(LOAD_FACTOR_ENV)
+    factor = number_from_environment(contract.LOAD_FACTOR_ENV)
     if factor is None:
         from course_lib import rosenv
 

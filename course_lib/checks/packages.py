@@ -12,7 +12,7 @@ written by the notebook's ``%%writefile`` cells). The checks
 
 Who builds: in a self-check, the student, with the notebook's build cell (the check says so when
 ``install/`` is missing); at grading, the grader (autograder.packages, in its sandbox), which hands
-the checks its report through AUTOGRADER_BUILD_REPORT. When that build failed, every check that
+the checks its report through contract.BUILD_REPORT_ENV. When that build failed, every check that
 needs it fails with the build's own error lines.
 """
 
@@ -23,15 +23,12 @@ import os
 import xml.etree.ElementTree as ElementTree
 from pathlib import Path
 
-from course_lib import package_files
+from course_lib import contract, package_files
 from course_lib.checks.context import StudentError
 from course_lib.checks.student_processes import student_env as _student_env
 
 #: The workspace folder beside the notebook.
 WORKSPACE = "ros2_ws"
-
-#: Set by the grader: the JSON report of its build (autograder.packages.BuildReport).
-REPORT_ENV = "AUTOGRADER_BUILD_REPORT"
 
 #: The packages of each assignment and their executables (what ``ros2 run`` offers).
 PACKAGES = {
@@ -62,7 +59,7 @@ def package_dir(ctx, package: str) -> Path:
 def require_build(ctx) -> Path:
     """The built workspace; raises StudentError with the reason when it is not built."""
     ws = workspace_dir(ctx)
-    report = os.environ.get(REPORT_ENV)
+    report = os.environ.get(contract.BUILD_REPORT_ENV)
     if report:
         data = json.loads(Path(report).read_text())
         if not data["ok"]:
@@ -88,7 +85,7 @@ def student_env(ctx, ws: Path) -> dict:
     paths = [p for p in env.get("PYTHONPATH", "").split(os.pathsep) if p]
     env.update(_student_env())
     env["PYTHONPATH"] = os.pathsep.join(paths + [env["PYTHONPATH"]])
-    env[REPORT_ENV] = None
+    env[contract.BUILD_REPORT_ENV] = None
     return env
 
 
@@ -166,7 +163,7 @@ def use_interfaces(ctx) -> None:
     as the grader), in a self-check the student's own workspace."""
     from course_lib import workspace
 
-    report = os.environ.get(REPORT_ENV)
+    report = os.environ.get(contract.BUILD_REPORT_ENV)
     try:
         if report:
             for install in json.loads(Path(report).read_text()).get("reference_underlays", []):

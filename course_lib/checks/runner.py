@@ -43,7 +43,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from course_lib.checks import answers
+from course_lib import contract
 from course_lib.checks.registry import get_check
 from course_lib.checks.result import Result, images_html, points_text, verdict_text
 
@@ -76,7 +76,6 @@ def selfcheck(assignment: str, name: str) -> None:
 #: run in the student's kernel, where the student's code could fake their result; the grader
 #: runs them afterwards in processes of its own (see :func:`grade_outside`) and writes the
 #: verdicts into the graded notebook.
-OUTSIDE_ENV = "AUTOGRADER_CHECKS_OUTSIDE"
 
 
 def grade(assignment: str, name: str) -> float:
@@ -86,7 +85,7 @@ def grade(assignment: str, name: str) -> float:
     Under the course's grader (AUTOGRADER_CHECKS_OUTSIDE=1) it only says so and returns 0: the
     grader runs the check itself and replaces this cell's output and score.
     """
-    if os.environ.get(OUTSIDE_ENV) == "1":
+    if os.environ.get(contract.CHECKS_OUTSIDE_ENV) == "1":
         print(f"[graded] {get_check(assignment, name).description}\n"
               "  The autograder runs this check outside the notebook; its verdict replaces this text.")
         return 0.0
@@ -95,7 +94,7 @@ def grade(assignment: str, name: str) -> float:
 
 def fresh_seed() -> int:
     """A seed drawn now, or AUTOGRADER_SEED when set (to reproduce a grade)."""
-    seed = os.environ.get("AUTOGRADER_SEED")
+    seed = os.environ.get(contract.SEED_ENV)
     return int(seed) if seed else secrets.randbelow(2**31)
 
 
@@ -127,7 +126,7 @@ def execute(assignment: str, name: str, seed: int, workdir=None, mode: str = "se
                "--workdir", str(workdir), "--out", str(out)]
     limits = processes.Limits(wall_seconds=spec.timeout + 10, grace_seconds=2.0)
     proc = processes.NodeProcess(command, name=f"autograder-check-{name}", cwd=out, limits=limits,
-                                 env={"PYTHONPATH": child_pythonpath(), SEED_ENV: str(seed), answers.MODE_ENV: mode})
+                                 env={"PYTHONPATH": child_pythonpath(), contract.CHECK_SEED_ENV: str(seed), contract.ANSWERS_ENV: mode})
     try:
         proc.start()
         try:
@@ -184,4 +183,3 @@ def _display_images(result: Result) -> None:
 
 
 #: How execute() hands the seed to the check process.
-SEED_ENV = "AUTOGRADER_CHECK_SEED"

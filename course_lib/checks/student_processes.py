@@ -11,11 +11,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from course_lib.checks import answers
-from course_lib.checks.runner import SEED_ENV, child_pythonpath
-
-#: Memory (address space, MB) of a student's process. rclpy with Fast DDS maps a few hundred MB.
-STUDENT_MEMORY_MB = 2048
+from course_lib import contract
+from course_lib.checks.runner import child_pythonpath
 
 #: Largest file a student's process may write, MB.
 STUDENT_FILE_MB = 128
@@ -25,8 +22,8 @@ def student_env() -> dict:
     """The variables of a student process: course_lib importable, none of the grader's seeds or answers."""
     # Fast DDS's set-up for camera frames comes, as for every course process, from
     # course_lib.rosenv.ros_environment (its shared-memory segments need RLIMIT_FSIZE above 32 MB).
-    return {"PYTHONPATH": child_pythonpath(), "AUTOGRADER_SEED": None, SEED_ENV: None,
-            answers.MODE_ENV: None, answers.RECORD_ENV: None, "PYTHONDONTWRITEBYTECODE": "1", **MALLOC_ENV}
+    return {"PYTHONPATH": child_pythonpath(), contract.SEED_ENV: None, contract.CHECK_SEED_ENV: None,
+            contract.ANSWERS_ENV: None, contract.RECORD_ANSWERS_ENV: None, "PYTHONDONTWRITEBYTECODE": "1", **MALLOC_ENV}
 
 
 #: glibc's allocator, fixed: blocks below 32 MB come from the heap, which keeps 128 MB before it
@@ -54,7 +51,7 @@ class StudentProcesses:
         """Bounds of a student process: time, memory, file size."""
         from course_lib import processes
 
-        return processes.Limits(wall_seconds=wall_seconds, memory_mb=STUDENT_MEMORY_MB,
+        return processes.Limits(wall_seconds=wall_seconds, memory_mb=contract.STUDENT_MEMORY_MB,
                                 file_size_mb=STUDENT_FILE_MB, grace_seconds=1.0)
 
     def confine(self, command: list[str], env: dict) -> tuple[list[str], dict, list[Path]]:

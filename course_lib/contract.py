@@ -1,0 +1,70 @@
+"""What the grader (autograder/) and the checks (course_lib/checks/) agree on, each defined once:
+the environment variables one sets for the other, the seeds, and the limits of the student's code.
+
+The grader sets these variables for the processes it starts (the notebook's kernel, the hidden
+checks, the student's nodes); the checks and course_lib read them. Nothing here is secret: the
+student's package holds this module, and the answer keys stay on the instructor's side
+(``autograder.answers``).
+"""
+
+from __future__ import annotations
+
+# --- who runs: grading, the test suite ---------------------------------------------------------
+
+#: "1" in every process of a grading run (course_lib.rosenv.under_grading).
+GRADING_ENV = "COURSE_LIB_GRADING"
+#: "1" under the test suite and CI's notebook runs: loops that would run for ever live are bounded.
+UNDER_TEST_ENV = "COURSE_LIB_UNDER_TEST"
+
+# --- seeds --------------------------------------------------------------------------------------
+
+#: Set by the instructor to grade again with the seed a feedback page shows (reproduce a grade).
+SEED_ENV = "AUTOGRADER_SEED"
+#: The seed of one check's process, set by the runner that starts it.
+CHECK_SEED_ENV = "AUTOGRADER_CHECK_SEED"
+
+# --- the checks in a grading run ---------------------------------------------------------------
+
+#: "1": the notebook's hidden test cells only say that the grader runs their checks outside.
+CHECKS_OUTSIDE_ENV = "AUTOGRADER_CHECKS_OUTSIDE"
+#: Seconds that all hidden checks of a submission may take together.
+CHECKS_SECONDS_ENV = "AUTOGRADER_CHECKS_SECONDS"
+#: How much longer than on an idle machine the wall-clock backstops may be (the grader's load).
+LOAD_FACTOR_ENV = "AUTOGRADER_LOAD_FACTOR"
+#: Where a check's expected answers come from: "selfcheck", "graded" or "record" (checks.answers).
+ANSWERS_ENV = "AUTOGRADER_ANSWERS"
+#: The file the answers are written to while recording them (``python -m autograder record-answers``).
+RECORD_ANSWERS_ENV = "AUTOGRADER_RECORD_TO"
+#: The JSON report of the grader's build of the submission's workspace (autograder.packages).
+BUILD_REPORT_ENV = "AUTOGRADER_BUILD_REPORT"
+#: "0" turns off the checks that start while the notebook still runs (autograder.pipeline).
+EARLY_CHECKS_ENV = "AUTOGRADER_EARLY_CHECKS"
+#: "0" builds every submission's packages, even where an identical build could be reused.
+REUSE_BUILDS_ENV = "AUTOGRADER_REUSE_BUILDS"
+
+# --- the student's uid, kernel and sandbox ------------------------------------------------------
+
+#: The uid the student's processes run as (when the grader runs as root), and its process limit.
+STUDENT_UID_ENV = "AUTOGRADER_STUDENT_UID"
+STUDENT_NPROC_ENV = "AUTOGRADER_STUDENT_NPROC"
+#: The same for the grading kernel (autograder.kernel), and the folder of its private /tmp.
+KERNEL_UID_ENV = "AUTOGRADER_KERNEL_UID"
+KERNEL_NPROC_ENV = "AUTOGRADER_KERNEL_NPROC"
+KERNEL_TMP_ENV = "AUTOGRADER_KERNEL_TMP"
+#: The sandbox's view of the interpreter (autograder.sandbox). autograder/sandbox_entry.py runs
+#: with ``python -I -S`` and imports nothing of the course: it spells these three itself.
+EXPOSE_ENV = "AUTOGRADER_EXPOSE"
+BLOCKED_ENV = "AUTOGRADER_BLOCKED"
+STAGE_ENV = "AUTOGRADER_STAGE"
+
+# --- limits of the student's code ---------------------------------------------------------------
+
+#: Address space (MB) of each process of a submission's notebook run and of its build (CMake, the
+#: compiler, rosidl's generators). Fast DDS + numpy + OpenCV need about 1 GB.
+MEMORY_MB = 4096
+#: Address space (MB) of each process the checks start for the student. rclpy with Fast DDS maps a
+#: few hundred MB.
+STUDENT_MEMORY_MB = 2048
+#: Processes and threads of the student's uid (RLIMIT_NPROC, root only) in the notebook run, the
+#: build and the checks. A kernel, a check and a node need about 100.
+MAX_PROCESSES = 384
