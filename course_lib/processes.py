@@ -428,10 +428,19 @@ class NodeProcess:
             self._poll(wait=True)
             return self._returncode
 
+    def send_signal(self, number: int) -> None:
+        """Send one signal to the child's process group (and what left it) now, as one step of
+        a stop the caller paces itself (``ros2 launch``: SIGINT, SIGTERM, SIGKILL); nothing once
+        the child has ended. Its exit_reason becomes "stopped"."""
+        self._tell_supervisor(f"signal {int(number)}")
+
     def _request_stop(self, timeout: float) -> None:
+        self._tell_supervisor(f"stop {float(timeout)}")
+
+    def _tell_supervisor(self, command: str) -> None:
         if self._control is not None and self._returncode is None:
             try:
-                os.write(self._control, f"stop {float(timeout)}\n".encode())
+                os.write(self._control, f"{command}\n".encode())
             except OSError:  # the supervisor has gone; _poll() will find out how
                 pass
 

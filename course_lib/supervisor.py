@@ -141,6 +141,12 @@ def _supervisor_main(argv: list[str] | None = None) -> int:
         deadline = time.monotonic() + max(0.0, grace)
         kill_at = deadline if kill_at is None else min(kill_at, deadline)
 
+    def send(number: int) -> None:
+        """A signal the caller sends as a step of its own stop (ros2 launch's escalation)."""
+        nonlocal reason
+        reason = reason or "stopped"
+        process_tree.signal_tree(child.pid, number)
+
     echo_dropped = {b"o": 0, b"e": 0}
 
     def echo(stream: bytes, data: bytes) -> None:
@@ -198,6 +204,8 @@ def _supervisor_main(argv: list[str] | None = None) -> int:
                 for line in command.decode(errors="replace").splitlines():
                     if line.startswith("stop"):
                         begin_stop("stopped", float(line.split()[1]))
+                    elif line.startswith("signal"):
+                        send(int(line.split()[1]))
         if signalled:
             signalled.clear()
             begin_stop("stopped", PARENT_GONE_GRACE)

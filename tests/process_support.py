@@ -1,6 +1,8 @@
 """Helpers of the process tests: find a test's own processes by a unique marker in their command
 line (psutil), so that a test only sees the processes it started itself."""
 
+import shlex
+import subprocess
 import sys
 import time
 import uuid
@@ -35,6 +37,16 @@ def wait_until(condition, timeout: float = 60.0) -> bool:
     while not (result := condition()) and time.monotonic() < deadline:
         time.sleep(0.05)
     return result
+
+
+def in_background_of_a_script(command: list[str], output, env: dict) -> tuple[subprocess.Popen, int]:
+    """``COMMAND > OUTPUT 2>&1 &`` in a non-interactive sh, which then waits for it: (the shell,
+    the command's pid). Such a command inherits SIGINT (and SIGQUIT) ignored (POSIX)."""
+    output.touch()  # the background job opens it a moment after sh has said its pid
+    script = f"{shlex.join(command)} > {shlex.quote(str(output))} 2>&1 &\necho $!\nwait $!\n"
+    shell = subprocess.Popen(["sh", "-c", script], stdout=subprocess.PIPE, text=True,
+                             env=env)
+    return shell, int(shell.stdout.readline())
 
 
 def sleeper(token: str, seconds: int = 100) -> list[str]:

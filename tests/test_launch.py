@@ -9,6 +9,7 @@ line of every process a launch starts (nodes and their supervisors).
 """
 
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -22,6 +23,7 @@ import pytest
 
 from course_lib import colcon, graph, launch, pkg_create, rosenv, rqt_graph, session, workspace
 from launch_demo import CHATTER_NODE, CHATTER_SOURCE, make_prefix
+from process_support import in_background_of_a_script
 
 EVERY_TAG = """\
 <launch>
@@ -75,6 +77,13 @@ SLEEPERS = """\
 </launch>
 """
 
+STUBBORN = """\
+<launch>
+  <node pkg="course_demo" exec="deaf_to_int" output="screen"/>
+  <node pkg="course_demo" exec="deaf_to_int_and_term" output="screen"/>
+</launch>
+"""
+
 
 @pytest.fixture(scope="module")
 def prefix(tmp_path_factory):
@@ -85,11 +94,14 @@ def prefix(tmp_path_factory):
         "crasher": "#!/bin/sh\necho to stdout\necho to stderr >&2\nexit 1\n",
         "quitter": "#!/bin/sh\nsleep 0.5\nexit 0\n",
         "sleeper": "#!/bin/sh\ntrap 'echo bye; exit 0' INT\necho sleeping\nwhile :; do sleep 0.1; done\n",
+        "deaf_to_int": "#!/bin/sh\ntrap '' INT\necho deaf\nwhile :; do sleep 0.1; done\n",
+        "deaf_to_int_and_term": "#!/bin/sh\ntrap '' INT TERM\necho deaf\nwhile :; do sleep 0.1; done\n",
     }, {
         "launch/every_tag.launch.xml": EVERY_TAG,
         "launch/listener.launch.yaml": LISTENER,
         "launch/endings.launch.xml": ENDINGS,
         "launch/sleepers.launch.xml": SLEEPERS,
+        "launch/stubborn.launch.xml": STUBBORN,
         "config/params.yaml": "/**:\n  ros__parameters:\n    gain: 2\n    rate: 1\n",
     })
     saved = os.environ.get("AMENT_PREFIX_PATH", "")
@@ -223,6 +235,81 @@ def test_a_launch_file_error_is_reported_like_ros2_launch_and_starts_nothing(tmp
     assert process.returncode == 1
     assert (f"[ERROR] [launch]: Caught exception in launch (see debug for traceback): {path}:3: No executable "
             "'nope' found in package 'course_demo'") in output
+    assert "process started" not in output
+
+
+def test_a_script_s_background_command_inherits_sigint_ignored(tmp_path, ros_domain):
+    """What the next test relies on: sh gives `command &` SIGINT ignored."""
+    code = "import signal; print(signal.getsignal(signal.SIGINT) is signal.SIG_IGN)"
+    shell, _ = in_background_of_a_script([sys.executable, "-c", code], tmp_path / "out", rosenv.ros_environment(domain_id=ros_domain))
+    assert shell.wait(timeout=60) == 0
+    assert (tmp_path / "out").read_text() == "True\n"
+
+
+def test_kill_int_stops_a_launch_started_with_ampersand_by_a_script(tmp_path, prefix, ros_domain):
+    """launch installs its own SIGINT handler, as ros2/launch's LaunchService does, so an
+    inherited SIG_IGN does not leave the launch and its nodes running for good."""
+    output = tmp_path / "launch.out"
+    shell, pid = in_background_of_a_script([sys.executable, "-m", "course_lib.launch", "-a", "course_demo",
+                                            "sleepers.launch.xml"], output,  # -a: both say "sleeping"
+                                           rosenv.ros_environment(domain_id=ros_domain))
+    try:
+        assert wait_until(lambda: output.read_text().count("sleeping") == 2), output.read_text()
+        os.kill(pid, signal.SIGINT)
+        assert shell.wait(timeout=60) == 0  # `wait $!` ends when the launch has: its exit code
+    finally:
+        shell.kill()
+        shell.wait()
+    lines = output.read_text().splitlines()
+    assert "[WARNING] [launch]: user interrupted with ctrl-c (SIGINT)" in lines
+    # Like a Ctrl-C in ros2 launch's terminal: no "sending signal 'SIGINT'" line (interactive).
+    assert not any("sending signal" in line for line in lines), lines
+    assert sum("process has finished cleanly" in line for line in lines) == 2, lines
+    assert wait_until(lambda: not processes_below(prefix), timeout=30), "processes outlived ros2 launch"
+
+
+def test_sigterm_escalates_like_ros2_launch(tmp_path, prefix, ros_domain):
+    """ros2/launch's ExecuteLocal: SIGINT, SIGTERM after sigterm_timeout, SIGKILL after
+    sigkill_timeout more, each with its log lines (launch/actions/execute_local.py: "process[{}]
+    failed to terminate '{}' seconds after receiving '{}', escalating to '{}'", "sending signal
+    '{}' to process[{}]"); launch_service.py's three lines for SIGTERM; exit code 1."""
+    output = tmp_path / "launch.out"
+    shell, pid = in_background_of_a_script([sys.executable, "-m", "course_lib.launch", "course_demo",
+                                            "stubborn.launch.xml", "sigterm_timeout:=1", "sigkill_timeout:=1"],
+                                           output, rosenv.ros_environment(domain_id=ros_domain))
+    try:
+        assert wait_until(lambda: output.read_text().count("] deaf") == 2), output.read_text()
+        os.kill(pid, signal.SIGTERM)
+        assert shell.wait(timeout=60) == 1
+    finally:
+        shell.kill()
+        shell.wait()
+    text = output.read_text()
+    first, second = (re.search(rf"\[INFO\] \[({name}-\d+)\]: process started with pid \[(\d+)\]", text).groups()
+                     for name in ("deaf_to_int", "deaf_to_int_and_term"))
+    expected = ["[ERROR] [launch]: user interrupted with ctrl-\\ (SIGTERM), terminating...",
+                "[ERROR] [launch]: using SIGTERM can result in orphaned processes",
+                "[ERROR] [launch]: make sure no processes launched are still running"]
+    expected += [f"[INFO] [{name}]: sending signal 'SIGINT' to process[{name}]" for name, _ in (first, second)]
+    for name, _ in (first, second):
+        expected += [f"[ERROR] [{name}]: process[{name}] failed to terminate '1' seconds after receiving 'SIGINT', "
+                     "escalating to 'SIGTERM'", f"[INFO] [{name}]: sending signal 'SIGTERM' to process[{name}]"]
+    name = second[0]
+    expected += [f"[ERROR] [{name}]: process[{name}] failed to terminate '2.0' seconds after receiving 'SIGTERM', "
+                 "escalating to 'SIGKILL'", f"[INFO] [{name}]: sending signal 'SIGKILL' to process[{name}]"]
+    lines = text.splitlines()
+    assert [line for line in lines if line in expected] == expected, text
+    for (name, process_id), code in ((first, -signal.SIGTERM), (second, -signal.SIGKILL)):
+        assert any(line.startswith(f"[ERROR] [{name}]: process has died [pid {process_id}, exit code {code}, ")
+                   for line in lines), text
+    assert wait_until(lambda: not processes_below(prefix), timeout=30), "processes outlived ros2 launch"
+
+
+def test_a_stop_timeout_that_is_not_a_number_is_a_launch_file_error(prefix, ros_domain):
+    process = ros2_launch("course_demo", "sleepers.launch.xml", "sigterm_timeout:=soon", domain_id=ros_domain)
+    output, _ = process.communicate(timeout=60)
+    assert process.returncode == 1
+    assert "sigterm_timeout is 'soon': give it in seconds, e.g. sigterm_timeout:=5" in output
     assert "process started" not in output
 
 

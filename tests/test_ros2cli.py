@@ -1,6 +1,7 @@
 """The course's ``ros2`` command (course_lib.ros2cli), run as the installed ``.venv/bin/ros2``
 against live nodes in other processes: one test per verb, each reading what the verb prints."""
 
+import os
 import re
 import signal
 import subprocess
@@ -10,6 +11,7 @@ from pathlib import Path
 
 import pytest
 import yaml
+from process_support import in_background_of_a_script, wait_until
 
 from course_lib import colcon, processes, rosenv, workspace
 
@@ -217,6 +219,29 @@ def test_topic_hz_prints_rates_until_ctrl_c(live):
     spans = [window / rate for rate, _, _, window in reports]
     assert spans[0] >= 1.0 - rounding and spans[1] >= spans[0] + 1.0 - rounding, (spans, lines)
     assert code == 2 and "Traceback" not in hz.stderr.read()
+
+
+@pytest.mark.parametrize("args, ready, number, code", [
+    (["topic", "echo", "/cli_chatter"], "---", signal.SIGINT, 2),
+    (["topic", "hz", "/cli_chatter"], "average rate:", signal.SIGTERM, 15),
+    (["topic", "pub", "/cli_numbers", "std_msgs/msg/Int32", "{data: 1}"], "publishing #1", signal.SIGINT, 2),
+])
+def test_a_verb_started_with_ampersand_by_a_script_ends_on_a_signal(live, tmp_path, args, ready, number, code):
+    """A script's `ros2 topic ... &` inherits SIGINT ignored; like ros2cli (whose rclpy installs
+    its handlers), it still ends on SIGINT (exit code 2) and SIGTERM (15, ros2cli/cli.py's
+    ExternalShutdownException), without a traceback."""
+    env = dict(live.env)
+    env.pop("COURSE_LIB_UNDER_TEST")  # the live behaviour: run until a signal
+    output = tmp_path / "out"
+    shell, pid = in_background_of_a_script([str(ROS2), *args], output, env)
+    try:
+        assert wait_until(lambda: ready in output.read_text()), output.read_text()
+        os.kill(pid, number)
+        assert shell.wait(timeout=60) == code, output.read_text()
+    finally:
+        shell.kill()
+        shell.wait()
+    assert "Traceback" not in output.read_text()
 
 
 def test_topic_info(live):

@@ -21,6 +21,20 @@ def test_child_that_ignores_sigint_is_killed_after_the_timeout(token):
     assert processes_with(token) == []
 
 
+def test_send_signal_passes_one_signal_on_and_the_exit_counts_as_stopped(token):
+    """A caller that paces its own stop (ros2 launch) signals through the supervisor: SIGINT is
+    ignored here, SIGTERM ends the child, and the supervisor kills nothing on its own."""
+    code = "import signal, time; signal.signal(signal.SIGINT, signal.SIG_IGN); print('ready', flush=True); time.sleep(100)"
+    process = NodeProcess([sys.executable, "-c", code, token]).start()
+    assert wait_until(lambda: "ready" in process.log), process.log
+    process.send_signal(signal.SIGINT)
+    process.send_signal(signal.SIGTERM)
+    assert process.wait(timeout=30) == -signal.SIGTERM
+    assert process.exit_reason == "stopped"
+    process.send_signal(signal.SIGKILL)  # after the end: nothing, no error
+    assert processes_with(token) == []
+
+
 def test_grandchildren_are_killed_by_stop_even_if_they_left_the_group(token):
     """sh's background children, one in its process group and one in a new session, die with it."""
     run = sleeper_script(token)

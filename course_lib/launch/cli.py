@@ -103,25 +103,28 @@ def main(argv: list[str] | None = None) -> int:
     except (LookupError, FileNotFoundError, ValueError, LaunchFileError) as error:
         print(f"ros2 launch: {error}", file=sys.stderr)
         return 1
-    return run(path, arguments, force_output="both" if options.show_all_subprocesses_output else None)
+    return run(path, arguments, force_output="both" if options.show_all_subprocesses_output else None,
+               noninteractive=options.noninteractive)
 
 
-class _Terminated(Exception):
-    """SIGTERM (or SIGQUIT) reached ros2 launch."""
+def run(path, arguments: dict, force_output: str | None = None, noninteractive: bool = False) -> int:
+    """Run a launch file in the foreground until its processes end or a signal stops it; the
+    exit code (0, or 1 after a launch file error or SIGTERM/SIGQUIT, as ros2 launch).
 
+    Like ros2 launch, it handles SIGINT, SIGTERM and SIGQUIT itself, whatever it inherited: a
+    program started with ``&`` from a script inherits SIGINT ignored, and Python then gives it
+    no KeyboardInterrupt. SIGINT stops the processes (launch.Launch.stop: SIGINT, SIGTERM,
+    SIGKILL, each in its time); a second one is logged and ignored.
+    """
+    received: list[int] = []
+    launch = Launch(path, arguments, screen=lambda line: print(line, flush=True), force_output=force_output)
 
-def run(path, arguments: dict, force_output: str | None = None) -> int:
-    """Run a launch file in the foreground until its processes end or Ctrl-C; the exit code."""
+    def on_signal(number, _frame):
+        _log_signal(launch, number, again=number == signal.SIGINT and signal.SIGINT in received)
+        received.append(number)
 
-    def terminated(number, _frame):
-        raise _Terminated(signal.Signals(number).name)
-
-    def print_line(line: str) -> None:
-        print(line, flush=True)
-
-    previous = {number: signal.signal(number, terminated) for number in (signal.SIGTERM, signal.SIGQUIT)}
-    previous[signal.SIGINT] = signal.getsignal(signal.SIGINT)
-    launch = Launch(path, arguments, screen=print_line, force_output=force_output)
+    handled = (signal.SIGINT, signal.SIGTERM, signal.SIGQUIT)
+    previous = {number: signal.signal(number, on_signal) for number in handled}
     try:
         try:
             launch.prepare()
@@ -130,18 +133,21 @@ def run(path, arguments: dict, force_output: str | None = None) -> int:
             launch.stop()
             return 1
         launch.start()
-        while not launch.wait(0.1):
+        while not received and not launch.wait(0.1):
             pass
-    except KeyboardInterrupt:
-        launch.warning("launch", "user interrupted with ctrl-c (SIGINT)")
-    except _Terminated as signal_name:
-        launch.error("launch", f"user interrupted with ctrl-\\ ({signal_name}), terminating...")
+        launch.stop(announce_sigint=noninteractive or received[:1] != [signal.SIGINT])
     finally:
-        signal.signal(signal.SIGINT, lambda *_: launch.warning(
-            "launch", "user interrupted with ctrl-c (SIGINT) again, ignoring..."))
-        try:
-            launch.stop()
-        finally:
-            for number, handler in previous.items():
-                signal.signal(number, handler)
-    return 0
+        for number, handler in previous.items():
+            signal.signal(number, handler)
+    return 1 if received and received[0] != signal.SIGINT else 0
+
+
+def _log_signal(launch: Launch, number: int, again: bool) -> None:
+    """ros2 launch's log lines for a signal it received."""
+    if number == signal.SIGINT:
+        launch.warning("launch", "user interrupted with ctrl-c (SIGINT)" + (" again, ignoring..." if again else ""))
+        return
+    name = signal.Signals(number).name
+    launch.error("launch", f"user interrupted with ctrl-\\ ({name}), terminating...")
+    launch.error("launch", f"using {name} can result in orphaned processes")
+    launch.error("launch", "make sure no processes launched are still running")

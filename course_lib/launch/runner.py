@@ -33,9 +33,16 @@ from typing import Callable
 
 from course_lib import processes
 from course_lib.launch.actions import LaunchContext, NodeToStart, run_launch_file
+from course_lib.launch.entities import LaunchFileError
 
-#: Seconds between SIGINT and SIGKILL when a launch stops (the real tool's sigterm_timeout).
-STOP_TIMEOUT = 5.0
+#: How a launch stops a process that still runs, as ros2/launch's ExecuteLocal does: SIGINT, then
+#: SIGTERM after ``sigterm_timeout`` seconds, then SIGKILL after ``sigkill_timeout`` seconds more.
+#: Both are launch configurations (``ros2 launch FILE sigterm_timeout:=2``); these are their
+#: defaults, as text, the way the real tool prints them.
+STOP_TIMEOUTS = {"sigterm_timeout": "5", "sigkill_timeout": "5"}
+
+#: Seconds stop() waits at most, after SIGKILL, for the reports of the processes' ends.
+_REPORT_BACKSTOP = 30.0
 
 #: Lines of screen output a Launch keeps for ``.log`` (the oldest are dropped beyond it).
 KEPT_LINES = 20000
@@ -108,6 +115,7 @@ class Launch:
         self._context: LaunchContext | None = None
         self._done = threading.Event()
         self._monitor: threading.Thread | None = None
+        self._stopping = False
         self.log_dir = _new_log_dir()
         self._log_file = open(self.log_dir / "launch.log", "a", buffering=1)
         self.info("launch", f"All log files can be found below {self.log_dir}")
@@ -172,6 +180,11 @@ class Launch:
         """
         context = run_launch_file(self.path, self.arguments)
         self._context, self._nodes = context, context.nodes
+        try:
+            self.stop_timeouts()  # a bad one shows now, not when the launch stops
+        except LaunchFileError:
+            context.remove_files()
+            raise
         for logger, message in context.warnings:
             self.warning(logger, message)
         return self._nodes
@@ -221,9 +234,6 @@ class Launch:
         name, code = self.names[index], process.returncode
         if process.pid is None:
             return  # it never started; that was reported already
-        if process.exit_reason == "stopped" and code == -signal.SIGKILL:
-            self.error(name, f"process[{name}] failed to terminate '{STOP_TIMEOUT}' seconds after receiving "
-                             "'SIGINT', escalating to 'SIGKILL'")
         if code == 0:
             self.info(name, f"process has finished cleanly [pid {process.pid}]")
         else:
@@ -259,17 +269,66 @@ class Launch:
                 process.wait_for_node(node.node_name, timeout=max(0.1, deadline - time.monotonic()),
                                       namespace=node.namespace)
 
-    def stop(self, timeout: float = STOP_TIMEOUT) -> None:
-        """Stop every process (SIGINT, then SIGKILL after `timeout` s) and wait for their reports.
-        Calling it again does nothing."""
-        processes.stop_together(self.processes, timeout)
+    def stop_timeouts(self) -> tuple[str, str]:
+        """(sigterm_timeout, sigkill_timeout) of this launch, as text: its launch configurations
+        (arguments such as ``sigterm_timeout:=2``), else STOP_TIMEOUTS.
+
+        Raises:
+            LaunchFileError: one is not a number of seconds.
+        """
+        configured = self._context.configurations if self._context is not None else {}
+        texts = []
+        for name, default in STOP_TIMEOUTS.items():
+            text = configured.get(name, default)
+            try:
+                if not float(text) >= 0:
+                    raise ValueError(text)
+            except ValueError:
+                raise LaunchFileError(f"{name} is {text!r}: give it in seconds, e.g. {name}:={default}",
+                                      self.path) from None
+            texts.append(text)
+        return texts[0], texts[1]
+
+    def stop(self, *, announce_sigint: bool = True) -> None:
+        """Stop every process that still runs, as ros2 launch does, each step in its log lines:
+        SIGINT; SIGTERM to those still running after sigterm_timeout seconds; SIGKILL to those
+        still running sigkill_timeout seconds later. Then wait for every process's report.
+        Calling it again does nothing.
+
+        Args:
+            announce_sigint: log "sending signal 'SIGINT'"; ros2 launch does not after Ctrl-C in
+                its terminal, where the terminal itself sent SIGINT to every process.
+        """
+        with self._lock:
+            stopping, self._stopping = self._stopping, True
+        if not stopping and self._monitor is not None:
+            self._escalate(announce_sigint)
+        processes.stop_together(self.processes, 0)  # a backstop: they have all ended by now
         if self._monitor is None:
             self._finish()
         else:
-            self._done.wait(timeout + 10)
+            self._done.wait(_REPORT_BACKSTOP)
         with _LAUNCHES_LOCK:
             if _LAUNCHES.get(self.path) is self:
                 del _LAUNCHES[self.path]
+
+    def _escalate(self, announce_sigint: bool) -> None:
+        term_text, kill_text = self.stop_timeouts()
+        kill_text = str(float(term_text) + float(kill_text))  # launch prints the sum, as a float
+        steps = [("SIGINT", None, None), ("SIGTERM", "SIGINT", term_text), ("SIGKILL", "SIGTERM", kill_text)]
+        started = time.monotonic()
+        for sent, before, after_text in steps:
+            if after_text is not None and self._done.wait(max(0.0, started + float(after_text) - time.monotonic())):
+                return
+            for name, process in zip(self.names, self.processes):
+                if not process.running():
+                    continue
+                if before is not None:
+                    self.error(name, f"process[{name}] failed to terminate '{after_text}' seconds after receiving "
+                                     f"'{before}', escalating to '{sent}'")
+                if before is not None or announce_sigint:
+                    self.info(name, f"sending signal '{sent}' to process[{name}]")
+                process.send_signal(getattr(signal, sent))
 
     def __enter__(self) -> "Launch":
         return self

@@ -6,6 +6,7 @@ import importlib
 import os
 import signal
 import sys
+import threading
 
 from course_lib.ros2cli.common import FULL_INSTALL, Unsupported, unsupported
 
@@ -52,6 +53,7 @@ def main(argv: list[str] | None = None) -> int:
         sys.stdout.reconfigure(line_buffering=True)  # ros2cli prints line by line, also into pipes
     except AttributeError:  # stdout replaced by something without reconfigure (a notebook)
         pass
+    previous = _handle_signals()
     try:
         outcome = _dispatch(argv)
     except Unsupported as error:
@@ -59,6 +61,8 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     except KeyboardInterrupt:
         return int(signal.SIGINT)
+    except Terminated:
+        return int(signal.SIGTERM)
     except SystemExit as end:  # argparse's --help and usage errors
         return end.code if isinstance(end.code, int) else (0 if end.code is None else 1)
     except BrokenPipeError:  # `ros2 topic echo /t | head -3`: the reader has gone
@@ -66,10 +70,32 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     except (RuntimeError, LookupError, ValueError, TimeoutError, FileNotFoundError) as error:
         outcome = str(error)
+    finally:
+        for number, handler in previous.items():
+            signal.signal(number, handler)
     if isinstance(outcome, str):
         print(outcome, file=sys.stderr)
         return 1
     return outcome or 0
+
+
+class Terminated(Exception):
+    """SIGTERM reached the command (ros2cli ends with exit code 15 then, like rclpy's shutdown)."""
+
+
+def _terminated(_number, _frame):
+    raise Terminated
+
+
+def _handle_signals() -> dict:
+    """Make SIGINT raise KeyboardInterrupt and SIGTERM Terminated, whatever this process
+    inherited: started with ``&`` from a script, it inherits SIGINT ignored, and Python then
+    gives it no KeyboardInterrupt (ros2cli's rclpy installs its handlers the same way). The
+    previous handlers, to put back; none where signals cannot be handled (not the main thread)."""
+    if threading.current_thread() is not threading.main_thread():
+        return {}
+    return {signal.SIGINT: signal.signal(signal.SIGINT, signal.default_int_handler),
+            signal.SIGTERM: signal.signal(signal.SIGTERM, _terminated)}
 
 
 def _dispatch(argv: list[str]) -> int | str | None:

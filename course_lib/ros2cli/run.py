@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import signal
 import sys
 
 from course_lib.ros2cli.common import VerbParser
@@ -25,4 +26,8 @@ def main(argv: list[str]) -> int | str:
     path = ament.executable(args.package_name, args.executable_name)  # LookupError names the fix
     sys.stdout.flush()
     sys.stderr.flush()
+    # exec keeps an ignored signal ignored: started with `&` from a script, ros2 inherited SIGINT
+    # ignored, and the node would never see Ctrl-C or `kill -INT`. It starts with the defaults.
+    for number in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(number, signal.SIG_DFL)
     os.execv(path, [str(path), *args.argv])
