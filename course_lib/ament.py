@@ -24,12 +24,14 @@ def prefix(package: str) -> Path:
     Raises:
         LookupError: the package is not installed; the message says how to make it visible.
     """
+    from course_lib.node_logs import kernel_hint
+
     try:
         return Path(get_package_prefix(package))
     except (PackageNotFoundError, ValueError):
-        raise LookupError(f"Package '{package}' not found: build it with colcon and `source install/setup.bash` "
-                          "in this terminal (in a notebook: workspace.use_workspace(WS)), or check its name "
-                          "with `ros2 pkg list`") from None
+        raise LookupError(f"Package '{package}' not found: build it with colcon and `source install/setup.bash`, "
+                          "or check its name with `ros2 pkg list`"
+                          + kernel_hint("workspace.use_workspace(WS)")) from None
 
 
 def share(package: str) -> Path:
@@ -60,5 +62,9 @@ def executable(package: str, name: str) -> Path:
     if path.is_file() and os.access(path, os.X_OK):
         return path
     available = executables(package)
-    raise LookupError(f"No executable '{name}' found in package '{package}'; it has: "
-                      f"{', '.join(available) or 'none'} (add it to entry_points in setup.py and build again)")
+    raise NoExecutable(f"No executable '{name}' found in package '{package}'; it has: "
+                       f"{', '.join(available) or 'none'} (add it to entry_points in setup.py and build again)")
+
+
+class NoExecutable(LookupError):
+    """The package is there, the executable is not (``ros2 run``: "No executable found")."""

@@ -41,13 +41,48 @@ def _graph_node():
     return node
 
 
+class Settling:
+    """The rule that ends a wait for discovery, apart from the clock and the graph (so that a test
+    can make both up): discovery has shown the graph once
+
+    - at least ``minimum`` seconds have passed since the tool node's creation,
+    - the graph has not changed for ``quiet`` seconds (things found late bring more with them),
+    - and every other ROS process on this machine has shown its nodes, or ``complete_within``
+      seconds have passed since the tool node's creation (a process that has called
+      rclpy.init() but made no node yet would keep the wait going).
+
+    No fixed sleep: a wait ends as soon as the graph has stopped changing.
+    """
+
+    def __init__(self, created_at: float, now: float, graph, minimum: float, quiet: float, complete_within: float):
+        self.created_at, self.minimum, self.quiet, self.complete_within = created_at, minimum, quiet, complete_within
+        self.graph, self.since = graph, now
+        self.complete = False
+        self.changes = 0  # how often the graph changed while waiting
+
+    def settled(self, now: float, graph, every_process_shown) -> bool:
+        """Whether discovery has settled by ``now``, the graph looking like ``graph`` then.
+
+        Args:
+            every_process_shown: a function of no arguments, called only while it matters.
+        """
+        if graph != self.graph:  # a change restarts the quiet time
+            self.graph, self.since = graph, now
+            self.changes += 1
+        age = now - self.created_at
+        if not self.complete:  # once every process has shown its nodes, no need to count again
+            self.complete = age >= self.complete_within or every_process_shown()
+        return age >= self.minimum and now - self.since >= self.quiet and self.complete
+
+
 def wait_for_discovery(minimum: float | None = None, quiet: float = _SETTLE_QUIET,
-                       complete_within: float | None = None) -> None:
-    """Wait until discovery has shown the graph to the tool node; later queries do not wait.
+                       complete_within: float | None = None, until=None) -> bool:
+    """Wait until discovery has shown the graph to the tool node (the Settling rule); later
+    queries do not wait.
 
     The functions of this module call it on the tool node's first use, with the defaults;
-    the ``ros2`` command calls it first with its own (--spin-time, or no wait at all for a
-    verb that waits for the name it is given).
+    the ``ros2`` command calls it first with its own (--spin-time; and for a verb that names a
+    node or topic, ``until`` that name shows).
 
     Args:
         minimum: seconds after the tool node's creation to wait at least (default
@@ -57,36 +92,30 @@ def wait_for_discovery(minimum: float | None = None, quiet: float = _SETTLE_QUIE
             until every other DDS participant on this machine in this domain (each ROS process
             has one, holding its nodes) has announced its nodes (default COMPLETE_SECONDS; 0:
             not at all). On a busy machine some of them take seconds to be discovered.
+        until: a function of no arguments that ends the wait early when it returns true.
 
-    The wait never lasts longer than 5 s after the tool node's creation. On a machine loaded
-    above one process per core, complete_within, quiet and that limit grow with the load per core
-    (at most MAX_LOAD_FACTOR times); the wait still ends as soon as every process has shown its
-    nodes and the graph has stayed the same for the quiet time.
+    Returns:
+        True when ``until`` or the rule ended the wait, False when the backstop did: 5 s after
+        the tool node's creation (or ``minimum``, if later). On a machine loaded above one
+        process per core, complete_within, quiet and the backstop grow with the load per core
+        (at most MAX_LOAD_FACTOR times).
     """
     global _settled_node
     node = session.tool_node()
+    _settled_node = node  # graph queries made by ``until`` must not start a wait of their own
     minimum = SETTLE_SECONDS if minimum is None else minimum
     busy = rosenv.load_factor(MAX_LOAD_FACTOR)
     complete_within = (COMPLETE_SECONDS if complete_within is None else complete_within) * busy
-    quiet *= busy  # on a busy machine the announcements of one process come further apart
     here = _participants_here(node.context.get_domain_id()) if complete_within else []
-    seen = {"graph": _snapshot(node), "since": time.monotonic(), "checks": 0, "complete": not here}
+    rule = Settling(node.created_at, time.monotonic(), _snapshot(node), minimum, quiet * busy,
+                    complete_within if here else 0.0)
 
-    def settled():
-        if seen["checks"]:  # after each wait, look again; a change restarts the quiet time
-            current = _snapshot(node)
-            if current != seen["graph"]:
-                seen["graph"], seen["since"] = current, time.monotonic()
-        seen["checks"] += 1
-        now = time.monotonic()
-        age = now - node.created_at
-        if not seen["complete"]:  # once every process has shown its nodes, no need to count again
-            seen["complete"] = age >= complete_within or _every_process_shown(node, here)
-        return age >= minimum and now - seen["since"] >= quiet and seen["complete"]
+    def done():
+        return (until is not None and until()) or rule.settled(
+            time.monotonic(), _snapshot(node), lambda: _every_process_shown(node, here))
 
-    waiting.spin_until(settled, max(0.0, _SETTLE_MAX * busy - (time.monotonic() - node.created_at)),
-                       poll=_SETTLE_POLL)
-    _settled_node = node
+    backstop = max(_SETTLE_MAX * busy, minimum) - (time.monotonic() - node.created_at)
+    return waiting.spin_until(done, max(0.0, backstop), poll=_SETTLE_POLL)
 
 
 def wait_for_every_process(timeout: float) -> bool:

@@ -479,7 +479,8 @@ def node_info(name: str, include_hidden: bool = False, timeout: float = 2.0) -> 
 
     Args:
         name: the node's full name, e.g. "/talker" ("talker" is read as "/talker").
-        include_hidden: also list hidden names (a part starting with "_").
+        include_hidden: also find a hidden node, and list hidden names (a part starting with
+            "_"), like ``ros2 node info --include-hidden``.
         timeout: seconds to wait for the node to appear in the graph.
 
     Raises:
@@ -489,7 +490,7 @@ def node_info(name: str, include_hidden: bool = False, timeout: float = 2.0) -> 
                               get_action_server_names_and_types_by_node)
 
     full = name if name.startswith("/") else "/" + name
-    nodes = node_list(all=True, wait_for=[full], timeout=timeout)
+    nodes = node_list(all=include_hidden, wait_for=[full], timeout=timeout)
     if full not in nodes:
         raise ValueError(f"Unable to find node '{full}'; the nodes are {node_list()}")
     namespace, _, base = full.rpartition("/")

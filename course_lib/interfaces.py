@@ -32,16 +32,19 @@ def definition_path(name: str) -> Path:
     Raises:
         LookupError: the package or the interface is not installed, with what is available.
     """
+    from course_lib.node_logs import kernel_hint
+
     package, kind, type_name = _split(name)
     try:
         share = Path(get_package_share_directory(package))
-    except PackageNotFoundError:
-        raise LookupError(f"package {package!r} is not installed (or its workspace is not sourced); "
-                          "installed interface packages can be listed with interfaces.packages()") from None
+    except PackageNotFoundError:  # rosidl_runtime_py's words, as `ros2 interface show` prints them
+        raise LookupError(f"Unknown package '{package}'"
+                          + kernel_hint("interfaces.packages() lists the installed interface packages")) from None
     path = share / kind / f"{type_name}.{kind}"
     if not path.is_file():
         available = ", ".join(package_interfaces(package, kind)) or "none"
-        raise LookupError(f"{package} has no {kind} {type_name!r}; it has: {available}")
+        raise LookupError(f"Could not find the interface '{share / kind / type_name}.idl'"
+                          + kernel_hint(f"{package} has the {kind} types {available}"))
     return path
 
 

@@ -62,6 +62,13 @@ def in_kernel() -> bool:
     return shell is not None and getattr(shell, "kernel", None) is not None
 
 
+def kernel_hint(text: str) -> str:
+    """`` (in a notebook: TEXT)`` inside a Jupyter kernel, else "": a hint that names a notebook
+    helper follows an error only where that helper can be called (a terminal shows the real
+    tool's words alone)."""
+    return f" (in a notebook: {text})" if in_kernel() else ""
+
+
 def init_arguments() -> list[str]:
     """Extra rclpy.init() arguments for the session: console logging off inside a kernel."""
     return ["--ros-args", "--disable-stdout-logs"] if in_kernel() else []

@@ -28,13 +28,26 @@ def test_packages_and_package_listing():
 
 
 @pytest.mark.parametrize("name, message", [
-    ("std_msgs/msg/Nope", "std_msgs has no msg 'Nope'; it has: Bool"),
-    ("no_such_msgs/msg/X", "package 'no_such_msgs' is not installed"),
+    # rosidl_runtime_py's get_interface_path, as ros2interface's test_cli.py expects them
+    # (test_show_not_an_interface, test_show_not_a_package).
+    ("std_msgs/msg/Nope", r"^Could not find the interface '/.+/share/std_msgs/msg/Nope\.idl'$"),
+    ("no_such_msgs/msg/X", r"^Unknown package 'no_such_msgs'$"),
     ("Twist", "package/msg/Type"),
 ])
-def test_bad_names_say_what_exists(name, message):
-    with pytest.raises((LookupError, ValueError), match=message.replace("(", r"\(")):
+def test_bad_names_get_ros2_interface_shows_words(name, message):
+    with pytest.raises((LookupError, ValueError), match=message):
         interfaces.show(name)
+
+
+def test_inside_a_kernel_a_notebook_hint_follows(monkeypatch):
+    """Only where interfaces.packages() can be called is it named."""
+    from course_lib import node_logs
+
+    monkeypatch.setattr(node_logs, "in_kernel", lambda: True)
+    with pytest.raises(LookupError, match=r"^Unknown package 'no_such_msgs' \(in a notebook: interfaces\.packages"):
+        interfaces.show("no_such_msgs/msg/X")
+    with pytest.raises(LookupError, match=r"Nope\.idl' \(in a notebook: std_msgs has the msg types Bool, "):
+        interfaces.show("std_msgs/msg/Nope")
 
 
 def test_comments_like_ros2_interface_show():

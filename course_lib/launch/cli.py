@@ -13,6 +13,9 @@ import signal
 import sys
 from pathlib import Path
 
+from ament_index_python import get_search_paths
+
+from course_lib import ament
 from course_lib.launch import actions, parser, substitutions
 from course_lib.launch.entities import LaunchFileError
 from course_lib.launch.runner import Launch, find_in_package
@@ -41,6 +44,14 @@ def _argument_parser() -> argparse.ArgumentParser:
     arguments.add_argument("launch_arguments", nargs="*",
                            help="Arguments to the launch file; '<name>:=<value>' (for duplicates, last one wins)")
     return arguments
+
+
+class PackageNotFound(LookupError):
+    """``ros2 launch PKG FILE`` names a package that is not installed."""
+
+    def __init__(self, package: str):
+        super().__init__(package)
+        self.package = package
 
 
 def parse_launch_arguments(texts: list[str]) -> dict[str, str]:
@@ -91,17 +102,25 @@ def main(argv: list[str] | None = None) -> int:
             if options.launch_file_name is not None:
                 texts.insert(0, options.launch_file_name)
         elif options.launch_file_name is None:
+            if options.package_name not in ament.packages():
+                raise PackageNotFound(options.package_name)
             print(f"ros2 launch: no launch file '{options.package_name}' here; give a launch file's path, or a "
                   "package name and the name of a launch file in it", file=sys.stderr)
             return 1
         else:
+            if options.package_name not in ament.packages():
+                raise PackageNotFound(options.package_name)
             path = find_in_package(options.package_name, options.launch_file_name)
         arguments = parse_launch_arguments(texts)
         if options.show_args:
             print_arguments(path)
             return 0
+    except PackageNotFound as error:  # ros2launch's words, with ament_index_python's
+        print(f"Package '{error.package}' not found: package '{error.package}' not found, searching: "
+              f"{get_search_paths()}", file=sys.stderr)
+        return 1
     except (LookupError, FileNotFoundError, ValueError, LaunchFileError) as error:
-        print(f"ros2 launch: {error}", file=sys.stderr)
+        print(error, file=sys.stderr)
         return 1
     return run(path, arguments, force_output="both" if options.show_all_subprocesses_output else None,
                noninteractive=options.noninteractive)

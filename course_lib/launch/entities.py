@@ -136,13 +136,32 @@ class Entity:
         line = self._attribute_lines.get("children", self.line)
         return [_yaml_child(item, self.file, line) for item in items]
 
-    def check_all_read(self, supported: str) -> None:
+    def check_all_read(self, supported: str, known=frozenset()) -> None:
         """Raise for any attribute or nested tag the parser did not read.
+
+        One that the full ROS 2 launch does not know either gets its words (launch_xml's and
+        launch_yaml's entity.py): ``Unexpected attribute(s) found in `arg`: {'whats_this'}``,
+        ``Unexpected nested tag(s) found in `arg`: {'whats_this'}`` (XML), ``Unexpected key(s)
+        found in `arg`: {'whats_this'}`` (YAML). One that it knows and this one does not run is
+        said to be not supported here, with what is.
 
         Args:
             supported: what this tag supports, for the message (e.g. "pkg, exec, name").
+            known: the attributes and nested tags the full ROS 2 launch reads on this tag.
         """
         unread = [name for name in self._attributes if name not in self._read]
+        if not self.typed:
+            children = [child for child in self._nested or []
+                        if f"<{child.kind}>" not in self._read and child.kind not in known]
+            if children:
+                strange = {child.kind for child in children}
+                raise children[0].error(f"Unexpected nested tag(s) found in `{self.kind}`: {strange}"
+                                        f"{did_you_mean(children[0].kind, known)}")
+        strange = [name for name in unread if name not in known]
+        if strange:
+            words = "key(s)" if self.typed else "attribute(s)"
+            raise self.error(f"Unexpected {words} found in `{self.kind}`: {set(strange)}"
+                             f"{did_you_mean(strange[0], known)}", strange[0])
         if unread:
             name = unread[0]
             raise self.error(f"<{self.kind}> attribute '{name}' is not supported here"

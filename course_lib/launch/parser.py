@@ -23,6 +23,27 @@ NOT_SUPPORTED = ("executable", "timer", "log", "shutdown", "append_env", "unset_
 
 _CONDITION = "if, unless"
 
+#: The attributes and nested tags the full ROS 2 launch (Jazzy's launch and launch_ros parse
+#: methods) reads on each tag this one runs: one outside these is "Unexpected" there too.
+_ACTION = {"if", "unless"}
+_EXECUTE = {"cmd", "cwd", "name", "launch-prefix", "output", "sigterm_timeout", "sigkill_timeout", "respawn",
+            "respawn_delay", "respawn_max_retries", "shell", "emulate_tty", "on_exit", "env"}
+KNOWN = {
+    "launch": {"version"},
+    "arg": _ACTION | {"name", "default", "description", "choice"},
+    "let": _ACTION | {"name", "value"},
+    "set_env": _ACTION | {"name", "value"},
+    "push_ros_namespace": _ACTION | {"namespace"},
+    "push-ros-namespace": _ACTION | {"namespace"},
+    "group": _ACTION | {"scoped", "forwarding", "keep"},
+    "include": _ACTION | {"file", "arg"},
+    "node": _ACTION | _EXECUTE | {"pkg", "exec", "namespace", "exec_name", "args", "ros_args", "param", "remap"},
+    "param": {"name", "value", "from", "allow_substs", "value-sep", "type", "param"},
+    "remap": {"from", "to"},
+    "env": {"name", "value"},
+    "include/arg": {"name", "value"},
+}
+
 
 def load_description(path) -> list:
     """The actions of a launch file (XML or YAML).
@@ -34,20 +55,20 @@ def load_description(path) -> list:
     if root.kind != "launch":
         raise root.error(f"the root tag must be <launch>, not <{root.kind}>")
     actions = [parse_action(child) for child in root.children()]
-    root.check_all_read("its tags as children")
+    root.check_all_read("its tags as children", KNOWN["launch"])
     return actions
 
 
 def parse_action(entity: Entity):
     """The action of one tag (``<node>``, ``<arg>``, ...)."""
     parse = _ACTIONS.get(entity.kind)
+    if parse is None and entity.kind not in NOT_SUPPORTED:  # launch's frontend/expose.py's words
+        raise entity.error(f"Unrecognized entity of the type: {entity.kind}{did_you_mean(entity.kind, _ACTIONS)}")
     if parse is None:
-        kind = ("is not supported here (a full ROS 2 install has it)" if entity.kind in NOT_SUPPORTED
-                else "is not a launch tag")
-        raise entity.error(f"<{entity.kind}> {kind}{did_you_mean(entity.kind, _ACTIONS)}; supported tags: "
+        raise entity.error(f"<{entity.kind}> is not supported here (a full ROS 2 install has it); supported tags: "
                            f"{', '.join(_SUPPORTED_TAGS)}")
     action, supported = parse(entity)
-    entity.check_all_read(supported)
+    entity.check_all_read(supported, KNOWN.get(entity.kind, frozenset()))
     return action
 
 
@@ -118,7 +139,7 @@ def _pairs(entity: Entity, kind: str, first: str, second: str) -> list[tuple[lis
     pairs = []
     for tag in entity.nested(kind):
         pairs.append((_text(tag, first, required=True), _text(tag, second, required=True)))
-        tag.check_all_read(f"{first}, {second}")
+        tag.check_all_read(f"{first}, {second}", KNOWN.get(f"{entity.kind}/{kind}", KNOWN.get(kind, frozenset())))
     return pairs
 
 
@@ -162,7 +183,7 @@ def _parameters(tags: list[Entity]) -> list:
         if source is not None:
             allow = tag.get_bool("allow_substs")
             result.append(parameters.ParamFile(_text(tag, "from"), bool(allow), tag.file, tag.line))
-            tag.check_all_read("from, allow_substs (or name with value or nested <param> tags)")
+            tag.check_all_read("from, allow_substs (or name with value or nested <param> tags)", KNOWN["param"])
         elif name is not None:
             if tag.has("allow_substs"):
                 raise tag.error("<param> allow_substs goes with from=, not with name=", "allow_substs")
@@ -185,7 +206,7 @@ def _parameter(tag: Entity):
         value = parameters.ParamGroup([_parameter(inner) for inner in nested], tag.file, tag.line)
     else:
         raise tag.error("<param> needs value= or nested <param> tags")
-    tag.check_all_read("name, value, nested <param>")
+    tag.check_all_read("name, value, nested <param>", KNOWN["param"])
     return name, value
 
 

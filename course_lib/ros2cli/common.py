@@ -21,10 +21,9 @@ QUIET_SECONDS = 0.2
 #: busy machine).
 COMPLETE_SECONDS = 4.0
 
-#: Seconds a verb that names a node or topic waits for discovery to show it, after --spin-time.
-#: It goes on as soon as the name shows. ros2cli waits 1 s (the param verbs' --timeout default),
-#: too short on a busy machine, where a new process can take seconds to see the others.
-NAMED_TIMEOUT = 5
+#: Seconds discovery may take in a new process at most: the backstop of the discovery wait
+#: (course_lib.discovery), which ends as soon as the graph has stopped changing.
+DISCOVERY_BACKSTOP = 5
 
 
 class Unsupported(Exception):
@@ -119,8 +118,24 @@ def wait_for_whole_graph(spin_time: float) -> None:
                                  complete_within=COMPLETE_SECONDS)
 
 
-def wait_for_named_only() -> None:
-    """Before a verb that names its node or topic: no general wait, it waits for that name."""
+def wait_for_name(shown: typing.Callable[[], bool], spin_time: float, timeout: float = 0.0) -> bool:
+    """Before a verb that names a node or topic: wait until ``shown()``, or until discovery has
+    settled (the graph no longer changes and every other ROS process here has shown its nodes)
+    and ``spin_time`` + ``timeout`` seconds have passed, as ros2cli spins --spin-time and then
+    waits --timeout for a node. An unknown name fails as soon as that, not after a fixed wait.
+
+    Returns:
+        shown(), at the end of the wait.
+    """
+    from course_lib import discovery
+
+    discovery.wait_for_discovery(minimum=spin_time + timeout, quiet=min(QUIET_SECONDS, spin_time),
+                                 complete_within=COMPLETE_SECONDS, until=shown)
+    return bool(shown())
+
+
+def wait_for_nothing() -> None:
+    """Before a verb that needs nothing from the graph to begin (a type was given): no wait."""
     from course_lib import discovery
 
     discovery.wait_for_discovery(minimum=0.0, quiet=0.0, complete_within=0.0)
@@ -172,13 +187,13 @@ def loop_limit(seconds: float | None) -> float | None:
     """How long a wait that the user bounds to ``seconds`` (None: until Ctrl-C) may last.
 
     Live, just ``seconds``. Under the test suite or the grader, also at most
-    course_lib.session.time_limit after the NAMED_TIMEOUT that discovery may take in a new
+    course_lib.session.time_limit after the DISCOVERY_BACKSTOP that discovery may take in a new
     process, so that a ``!ros2 topic hz`` cell cannot hang a notebook run.
     """
     from course_lib import session
 
     limit = session.time_limit(seconds)
-    return limit + NAMED_TIMEOUT if limit is not None and limit != seconds else limit
+    return limit + DISCOVERY_BACKSTOP if limit is not None and limit != seconds else limit
 
 
 def wait_until(done: typing.Callable[[], bool], seconds: float | None = None) -> bool:

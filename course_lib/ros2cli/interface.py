@@ -38,8 +38,10 @@ def _show(args) -> str | None:
     name = sys.stdin.readline().strip() if args.type == "-" else args.type
     if not name:
         return "the passed value is empty"
+    if len(name.split("/")) != 3:  # the library also reads "std_msgs/String"; ros2cli does not
+        return f"Invalid name '{name}'. Expected three parts separated by '/'"
     comments = "all" if args.all_comments else "none" if args.no_comments else "top"
-    print(interfaces.show(name, comments=comments))
+    print(interfaces.show(name, comments=comments))  # LookupError: rosidl_runtime_py's words
     return None
 
 

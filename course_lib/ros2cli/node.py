@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import sys
 
-from course_lib.ros2cli.common import NAMED_TIMEOUT, Verb, add_discovery_arguments, run_group, wait_for_whole_graph
+from course_lib.ros2cli.common import Verb, add_discovery_arguments, run_group, wait_for_whole_graph
 
 
 def _list_arguments(parser) -> None:
@@ -35,17 +35,20 @@ def _info_arguments(parser) -> None:
                         help="Display hidden topics, services, and actions as well")
 
 
-def _info(args) -> None:
+def _info(args) -> str | None:
     from course_lib import graph
 
     wait_for_whole_graph(args.spin_time)  # all the node's endpoints, not the first found
-    info = graph.node_info(args.node_name, include_hidden=args.include_hidden,
-                           timeout=args.spin_time + NAMED_TIMEOUT)
-    count = graph.node_list(all=True).count(info.name)
+    # Like ros2cli: the name as given (a full name), among the nodes --include-hidden shows.
+    count = graph.node_list(all=args.include_hidden).count(args.node_name)
+    if not count:
+        return f"Unable to find node '{args.node_name}'"
+    info = graph.node_info(args.node_name, include_hidden=args.include_hidden, timeout=0.0)
     if count > 1:
         print(f'There are {count} nodes in the graph with the exact name "{info.name}". '
               "You are seeing information about only one of them.", file=sys.stderr)
     print(graph.format_node_info(info), end="")
+    return None
 
 
 VERBS = {

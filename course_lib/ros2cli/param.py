@@ -4,8 +4,11 @@ from __future__ import annotations
 
 import re
 
-from course_lib.ros2cli.common import (NAMED_TIMEOUT, Verb, add_discovery_arguments, run_group, say,
-                                       wait_for_named_only, wait_for_whole_graph)
+from course_lib.ros2cli.common import Verb, add_discovery_arguments, run_group, say, wait_for_name, wait_for_whole_graph
+
+#: ros2cli's default --timeout of the param verbs: seconds to wait for the node after --spin-time
+#: (the wait goes on while discovery still changes the graph; see common.wait_for_name).
+NODE_TIMEOUT = 1
 
 #: Verbs of ros2cli's ``ros2 param`` that the course leaves out.
 LEFT_OUT = ("delete", "describe")
@@ -30,7 +33,7 @@ def _node_arguments(parser, parameter: bool = False) -> None:
 
 
 def _add_timeout(parser) -> None:
-    parser.add_argument("--timeout", metavar="N", type=int, default=NAMED_TIMEOUT,
+    parser.add_argument("--timeout", metavar="N", type=int, default=NODE_TIMEOUT,
                         help="Wait for N seconds until node becomes available (default %(default)s sec)")
 
 
@@ -38,11 +41,10 @@ def _find_node(args) -> str | None:
     """The node's full name once it is in the graph (waiting like ros2cli does), else None."""
     from course_lib import graph
 
-    wait_for_named_only()
     name = _absolute(args.node_name)
-    found = graph.node_list(all=args.include_hidden_nodes, wait_for=[name],
-                            timeout=args.spin_time + args.timeout)
-    return name if name in found else None
+    shown = wait_for_name(lambda: name in graph.node_list(all=args.include_hidden_nodes), args.spin_time,
+                          args.timeout)
+    return name if shown else None
 
 
 # --- ros2 param list ---------------------------------------------------------------------
@@ -61,7 +63,7 @@ def _list(args) -> str | None:
     from course_lib import graph, parameters
 
     if args.node_name:
-        args.timeout = NAMED_TIMEOUT
+        args.timeout = 0  # ros2cli's param list looks once, after --spin-time
         node = _find_node(args)
         if node is None:
             return "Node not found"

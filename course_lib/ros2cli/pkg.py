@@ -98,13 +98,16 @@ def _executables_arguments(parser) -> None:
     parser.add_argument("--full-path", action="store_true", default=False, help="Show full path of each executable")
 
 
-def _executables(args) -> None:
+def _executables(args) -> str | None:
     from course_lib import ament
 
     names = [args.package_name] if args.package_name else list(ament.packages())
+    if args.package_name and args.package_name not in ament.packages():
+        return f"Package '{args.package_name}' not found"
     for package in sorted(names):
-        for name in ament.executables(package):  # LookupError names the fix
+        for name in ament.executables(package):
             print(ament.executable(package, name) if args.full_path else f"{package} {name}")
+    return None
 
 
 def _prefix_arguments(parser) -> None:
@@ -112,10 +115,14 @@ def _prefix_arguments(parser) -> None:
     parser.add_argument("--share", action="store_true", help="Show share directory for the package")
 
 
-def _prefix(args) -> None:
+def _prefix(args) -> str | None:
     from course_lib import ament
 
-    print(ament.share(args.package_name) if args.share else ament.prefix(args.package_name))
+    try:
+        print(ament.share(args.package_name) if args.share else ament.prefix(args.package_name))
+    except LookupError:
+        return "Package not found"  # ros2pkg's PACKAGE_NOT_FOUND
+    return None
 
 
 VERBS = {

@@ -23,7 +23,12 @@ def main(argv: list[str]) -> int | str:
     args = parser.parse_args(argv)
     from course_lib import ament
 
-    path = ament.executable(args.package_name, args.executable_name)  # LookupError names the fix
+    if args.package_name not in ament.packages():
+        return f"Package '{args.package_name}' not found"  # ros2run's words
+    try:
+        path = ament.executable(args.package_name, args.executable_name)
+    except ament.NoExecutable:
+        return "No executable found"
     sys.stdout.flush()
     sys.stderr.flush()
     # exec keeps an ignored signal ignored: started with `&` from a script, ros2 inherited SIGINT

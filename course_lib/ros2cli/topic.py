@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import time
 
-from course_lib.ros2cli.common import (NAMED_TIMEOUT, Verb, add_discovery_arguments, add_qos_arguments, loop_limit,
-                                       qos_from_arguments, qos_overridden, run_group, say, wait_for_named_only,
-                                       wait_for_whole_graph, wait_until)
+from course_lib.ros2cli.common import (DISCOVERY_BACKSTOP, Verb, add_discovery_arguments, add_qos_arguments,
+                                       loop_limit, qos_from_arguments, qos_overridden, run_group, say, wait_for_name,
+                                       wait_for_nothing, wait_for_whole_graph, wait_until)
 
 #: Verbs of ros2cli's ``ros2 topic`` that the course leaves out.
 LEFT_OUT = ("bw", "delay", "find", "type")
@@ -44,6 +44,18 @@ def _nonnegative_int(text: str) -> int:
     if value < 0:
         raise ValueError("Value must be positive or zero")
     return value
+
+
+def _topic_shown(topic: str):
+    """A function telling whether the graph shows ``topic`` (hidden or not) with its type."""
+    from course_lib import graph, session
+
+    name = session.tool_node().resolve_topic_name(topic)
+    return lambda: any(other == name for other in graph.topic_list(include_hidden=True))
+
+
+def _not_published_yet(topic: str) -> None:
+    say(f"WARNING: topic [{topic}] does not appear to be published yet")
 
 
 # --- ros2 topic list ---------------------------------------------------------------------
@@ -103,10 +115,18 @@ def _echo_arguments(parser) -> None:
 def _echo(args) -> int | str | None:
     from course_lib import graph, message_yaml
 
-    wait_for_named_only()
     field = None if args.field is None else [part for part in args.field.split(".") if part]
     if field == []:
         return f"Invalid field value '{args.field}'"
+    if args.message_type is not None:
+        wait_for_nothing()
+        try:
+            message_yaml.message_class(args.message_type)
+        except ValueError:
+            return "The passed message type is invalid"
+    elif not wait_for_name(_topic_shown(args.topic_name), args.spin_time):
+        _not_published_yet(args.topic_name)
+        return "Could not determine the type for the passed topic"
     truncate = None if args.full_length else args.truncate_length
     seen = {"messages": 0, "bad field": False}  # counts only: an echo may run for hours
 
@@ -117,7 +137,7 @@ def _echo(args) -> int | str | None:
             try:
                 msg = getattr(msg, part)
             except AttributeError as error:
-                say(f"Invalid field '{args.field}': {error}", error=True)
+                say(f"Invalid field '{'.'.join(field)}': {error}", error=True)
                 seen["bad field"] = True
                 return
         seen["messages"] += 1
@@ -127,12 +147,8 @@ def _echo(args) -> int | str | None:
             print(msg, end="\n---\n")
 
     qos = qos_from_arguments(args) if qos_overridden(args) else None  # None: what the publishers offer
-    try:
-        with graph.subscription(args.topic_name, show, args.message_type, args.spin_time + NAMED_TIMEOUT, qos):
-            wait_until(lambda: seen["bad field"] or (args.once and seen["messages"] > 0), args.timeout)
-    except TimeoutError:
-        say(f"WARNING: topic [{args.topic_name}] does not appear to be published yet")
-        return "Could not determine the type for the passed topic"
+    with graph.subscription(args.topic_name, show, args.message_type, 0.0, qos):
+        wait_until(lambda: seen["bad field"] or (args.once and seen["messages"] > 0), args.timeout)
     return 1 if seen["bad field"] else None
 
 
@@ -152,7 +168,7 @@ def _hz(args) -> None:
 
     from course_lib import graph, rates
 
-    wait_for_named_only()
+    shown = wait_for_name(_topic_shown(args.topic_name), args.spin_time)
     arrivals: list[float] = []
     printed_at = [None]
 
@@ -173,11 +189,9 @@ def _hz(args) -> None:
                                 timeout=timeout, qos=qos_profile_sensor_data, raw=True):
             wait_until(report)
 
-    try:
-        measure(args.spin_time + NAMED_TIMEOUT)
-    except TimeoutError:  # like ros2cli: say so once, then wait for the topic as long as it takes
-        say(f"WARNING: topic [{args.topic_name}] does not appear to be published yet")
-        measure(None)
+    if not shown:  # like ros2cli: say so once, then wait for the topic as long as it takes
+        _not_published_yet(args.topic_name)
+    measure(0.0 if shown else None)
 
 
 # --- ros2 topic info ---------------------------------------------------------------------
@@ -194,10 +208,10 @@ def _info(args) -> str | None:
     from course_lib import graph
 
     wait_for_whole_graph(args.spin_time)  # counts and endpoints: all of them, not the first found
-    try:
-        info = graph.topic_info(args.topic_name, verbose=args.verbose, timeout=args.spin_time + NAMED_TIMEOUT)
-    except ValueError:
+    if not _topic_shown(args.topic_name)():
         return f"Unknown topic '{args.topic_name}'"
+    # The wait is for the endpoints' node names, which DDS may announce a moment after them.
+    info = graph.topic_info(args.topic_name, verbose=args.verbose, timeout=args.spin_time + DISCOVERY_BACKSTOP)
     # ros2cli ends every part (the last one too) with a blank line in verbose mode.
     print(graph.format_topic_info(info, verbose=args.verbose), end="\n" if args.verbose else "")
     return None
