@@ -227,7 +227,9 @@ def write_python_package(package_dir, name: str, *, build_type: str = "ament_pyt
         The others as for create_package.
 
     Returns:
-        The files written, in order.
+        The folders and files made, in the order ``ros2 pkg create`` makes them (ros2pkg's
+        api/create.py: the package folder, package.xml, the source folder, setup.py, ...); a
+        file kept because it existed is left out.
     """
     if build_type != "ament_python":
         raise ValueError(f"build_type {build_type!r} is not supported here: use 'ament_python' for Python "
@@ -246,28 +248,35 @@ def write_python_package(package_dir, name: str, *, build_type: str = "ament_pyt
     body += ([""] if body else []) + [f"  <test_depend>{test}</test_depend>" for test in
                                       ("ament_copyright", "ament_flake8", "ament_pep257", "python3-pytest")]
     scripts = [f"{node} = {name}.{node}:main" for node in node_names]
-    files = {
-        "package.xml": _package_xml(name, description, maintainer, maintainer_email, license, body,
-                                    "ament_python"),
-        "setup.py": _setup_py(name, description, maintainer, maintainer_email, license, scripts),
-        "setup.cfg": _setup_cfg(name),
-        f"resource/{name}": "",
-        "test/test_copyright.py": _TEST_COPYRIGHT,
-        "test/test_flake8.py": _TEST_FLAKE8,
-        "test/test_pep257.py": _TEST_PEP257,
-    }
-    keep_if_present = {f"{name}/__init__.py": ""}
-    for node in node_names:
-        keep_if_present[f"{name}/{node}.py"] = _node_source(name, node, rclpy_node)
-    written = []
-    for relative, text in files.items():
-        _write(package_dir / relative, text)
-        written.append(package_dir / relative)
-    for relative, text in keep_if_present.items():
-        if not (package_dir / relative).exists():
-            _write(package_dir / relative, text)
-            written.append(package_dir / relative)
-    return written
+    # (path, text) in ros2 pkg create's order; text None: a folder; kept: a file written only if absent.
+    steps = [
+        ("", None),
+        ("package.xml", _package_xml(name, description, maintainer, maintainer_email, license, body,
+                                     "ament_python")),
+        (name, None),
+        ("setup.py", _setup_py(name, description, maintainer, maintainer_email, license, scripts)),
+        ("setup.cfg", _setup_cfg(name)),
+        ("resource", None),
+        (f"resource/{name}", ""),
+        (f"{name}/__init__.py", ""),
+        ("test", None),
+        ("test/test_copyright.py", _TEST_COPYRIGHT),
+        ("test/test_flake8.py", _TEST_FLAKE8),
+        ("test/test_pep257.py", _TEST_PEP257),
+        *[(f"{name}/{node}.py", _node_source(name, node, rclpy_node)) for node in node_names],
+    ]
+    kept = {f"{name}/__init__.py", *(f"{name}/{node}.py" for node in node_names)}
+    made = []
+    for relative, text in steps:
+        path = package_dir / relative
+        if text is None:
+            path.mkdir(parents=True, exist_ok=True)
+        elif relative in kept and path.exists():
+            continue
+        else:
+            _write(path, text)
+        made.append(path)
+    return made
 
 
 def create_interface_package(ws_dir, name: str, messages: dict[str, str], *,

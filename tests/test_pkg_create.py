@@ -57,11 +57,15 @@ def test_create_package_refuses_to_overwrite_but_can_rerun(tmp_path):
 
 
 def test_write_python_package_puts_the_package_where_asked_with_ros2_pkg_creates_node(tmp_path):
-    """Any folder, the files written listed in order, and the plain main of `ros2 pkg create`."""
-    written = pkg_create.write_python_package(tmp_path / "here", "demo", dependencies=["rclpy"],
+    """Any folder, what is made listed in ros2pkg's order (its api/create.py), and the plain main
+    of `ros2 pkg create`."""
+    here = tmp_path / "here"
+    written = pkg_create.write_python_package(here, "demo", dependencies=["rclpy"],
                                              node_name="hello", rclpy_node=False)
-    assert written[0] == tmp_path / "here" / "package.xml"
-    assert written[-1] == tmp_path / "here" / "demo" / "hello.py"
+    assert [path.relative_to(here).as_posix() for path in written] == [
+        ".", "package.xml", "demo", "setup.py", "setup.cfg", "resource", "resource/demo", "demo/__init__.py",
+        "test", "test/test_copyright.py", "test/test_flake8.py", "test/test_pep257.py", "demo/hello.py"]
+    written = written[1:]
     assert "print('Hi from demo.')" in written[-1].read_text()
     assert "<depend>rclpy</depend>" in written[0].read_text()
 

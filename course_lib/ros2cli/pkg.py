@@ -73,14 +73,13 @@ def _create(args) -> str | None:
         package_path, args.package_name, dependencies=args.dependencies, node_name=args.node_name,
         rclpy_node=False, description=args.description, maintainer=args.maintainer_name,
         maintainer_email=email, license=args.license)
-    announced = set()
-    for path in [package_path] + [str(file) for file in written]:
-        folder = path if path == package_path else os.path.dirname(path)
-        if folder not in announced:
-            print("creating folder", folder)
-            announced.add(folder)
-        if path != package_path:
-            print("creating", path)
+    source = os.path.join(package_path, args.package_name)
+    for made in written:  # in ros2pkg's order, named from --destination-directory ("./pkg/...")
+        relative = os.path.relpath(made, written[0])
+        path = package_path if relative == os.curdir else os.path.join(package_path, relative)
+        if path == source:
+            print("creating source folder")
+        print("creating folder" if made.is_dir() else "creating", path)
     return None
 
 
