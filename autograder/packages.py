@@ -42,9 +42,7 @@ import xml.etree.ElementTree as ElementTree
 from pathlib import Path
 
 from course_lib import colcon, contract, package_files, workspace
-
-#: The workspace folder beside the notebook.
-WORKSPACE = "ros2_ws"
+from course_lib.checks.assignments import ASSIGNMENTS, WORKSPACE
 
 #: Seconds one colcon build may take (an interface package takes 10-40 s on a busy machine).
 BUILD_SECONDS = 240.0
@@ -553,9 +551,7 @@ def build_for_checks(assignment: str, course: Path, work: Path, workdir: Path, u
 def needed(assignment: str, workdir: Path) -> bool:
     """Whether a submission's workspace is built: the assignment's checks run packages, or the
     notebook wrote a workspace."""
-    from course_lib.checks import packages as checked
-
-    return assignment in checked.PACKAGES or (Path(workdir) / WORKSPACE).exists()
+    return assignment in ASSIGNMENTS or (Path(workdir) / WORKSPACE).exists()
 
 
 def run_here(command, cwd, env, wall_seconds):
@@ -579,11 +575,10 @@ def reference_interfaces(assignment: str, cache: InterfaceCache, scratch: Path) 
         RuntimeError: a reference package does not build (the course's fault, not the student's).
     """
     from autograder.reference import REFERENCE_SRC
-    from course_lib.checks import packages as checked
 
     found = []
     env = colcon.build_environment()
-    for name in checked.PACKAGES.get(assignment, {}):
+    for name in ASSIGNMENTS[assignment].packages if assignment in ASSIGNMENTS else ():
         folder = REFERENCE_SRC / name
         if not is_interface_package(folder):
             continue

@@ -47,16 +47,16 @@ REFERENCE_SRC = SOURCE.parent / "reference_ws" / "src"
 def reference_files(assignment: str) -> dict[str, str]:
     """{path relative to the notebook's folder (ros2_ws/src/...): text} of an assignment's
     reference packages, solution markers removed, their tests and caches left out."""
-    from course_lib.checks import packages
+    from course_lib.checks.assignments import WORKSPACE, spec
 
     files = {}
-    for package in packages.PACKAGES[assignment]:
+    for package in spec(assignment).packages:
         folder = REFERENCE_SRC / package
         for path in sorted(p for p in folder.rglob("*") if p.is_file()):
             relative = path.relative_to(folder)
             if relative.parts[0] in ("test", "__pycache__") or path.suffix == ".pyc" or "__pycache__" in relative.parts:
                 continue
-            files[f"{packages.WORKSPACE}/src/{package}/{relative.as_posix()}"] = solution_source(path.read_text())
+            files[f"{WORKSPACE}/src/{package}/{relative.as_posix()}"] = solution_source(path.read_text())
     return files
 
 

@@ -35,8 +35,9 @@ import zoo  # noqa: E402 (tests/zoo builds submissions from the reference soluti
 from autograder import grading, release, sandbox  # noqa: E402
 from zoo.brightness import CALLBACK  # noqa: E402
 from zoo.brightness import entries as brightness_entries  # noqa: E402
+from course_lib.checks import assignments  # noqa: E402
 
-ASSIGNMENTS = ["brightness", "pubsub", "catdog_warp"]
+ASSIGNMENTS = list(assignments.ASSIGNMENTS)
 #: The first statement of crop_pictures in the catdog_warp reference (readmarker/crop.py).
 CROP_START = "    frame = _check_frame(frame_bgr)\n"
 EVERY_OTHER = ("        self.n = getattr(self, 'n', 0) + 1\n        if self.n % 2 == 0:\n"

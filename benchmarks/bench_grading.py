@@ -41,8 +41,9 @@ sys.path[:0] = [str(ROOT), str(ROOT / "tests")]  # the grader runs from the repo
 import zoo  # noqa: E402 (tests/zoo builds submissions from the reference solutions)
 from autograder import grading, packages, pipeline, release, sandbox  # noqa: E402
 from course_lib import contract  # noqa: E402
+from course_lib.checks import assignments  # noqa: E402
 
-ASSIGNMENTS = ["brightness", "pubsub", "catdog_warp"]
+ASSIGNMENTS = list(assignments.ASSIGNMENTS)
 #: The steps shown on their own (autograder.pipeline.STEPS); the others are summed as "other".
 SHOWN_STEPS = ["run_notebook", "early_build_and_checks", "build_workspace", "run_hidden_checks"]
 

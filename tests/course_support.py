@@ -23,7 +23,9 @@ import os
 import shutil
 from pathlib import Path
 
-ASSIGNMENTS = ("brightness", "catdog_warp", "pubsub")
+from course_lib.checks import assignments as specs
+
+ASSIGNMENTS = tuple(sorted(specs.ASSIGNMENTS))
 
 
 def shared_folder(tmp_path_factory) -> Path:
@@ -76,7 +78,6 @@ def seed_interface_cache(tmp_path_factory, course: Path, assignments: list[str])
     """Put the assignments' reference interface packages, built once, into COURSE's interface cache."""
     from autograder import packages
     from autograder.reference import REFERENCE_SRC
-    from course_lib.checks import packages as checked
 
     shared = shared_folder(tmp_path_factory)
     cache, target = packages.local_cache(), packages.cache_of(course)
@@ -84,7 +85,7 @@ def seed_interface_cache(tmp_path_factory, course: Path, assignments: list[str])
         for assignment in assignments:
             packages.reference_interfaces(assignment, cache, shared / "interface-scratch")
     for assignment in assignments:
-        for name in checked.PACKAGES.get(assignment, {}):
+        for name in specs.spec(assignment).packages:
             folder = REFERENCE_SRC / name
             if packages.is_interface_package(folder):
                 key = packages.content_key(folder)

@@ -13,9 +13,14 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from autograder import packages, reference, sandbox  # noqa: E402
 from course_lib import contract
-from course_lib.checks import registry, runner, validate  # noqa: E402
+from course_lib.checks import (  # noqa: E402
+    assignments,  # noqa: E402
+    registry,
+    runner,
+    validate,
+)
 
-ASSIGNMENTS = ["brightness", "pubsub", "catdog_warp"]
+ASSIGNMENTS = list(assignments.ASSIGNMENTS)
 REPO = Path(__file__).resolve().parent.parent
 
 

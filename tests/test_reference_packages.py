@@ -27,6 +27,7 @@ from rclpy.parameter import Parameter
 from sensor_msgs.msg import Image
 
 from course_lib import images, marker_board, pictures, rosenv, scenes, workspace
+from course_lib.checks import assignments
 
 SOURCE = Path(__file__).resolve().parents[1] / "assignments" / "reference_ws" / "src"
 PACKAGES = ("webcam", "readmarker")
@@ -409,15 +410,14 @@ def test_built_nodes_stop_cleanly_on_ctrl_c(pipeline):
 
 # ---- every assignment's reference packages ------------------------------------------------------
 
-@pytest.mark.parametrize("assignment", ["brightness", "pubsub", "catdog_warp"])
+@pytest.mark.parametrize("assignment", sorted(assignments.ASSIGNMENTS))
 def test_the_source_notebook_writes_exactly_the_reference_packages(tmp_path, assignment):
     """The source notebook's cells write exactly the files of the assignment's reference packages
     (markers removed), and its solution cells are the files with solution regions."""
     from autograder import reference
-    from course_lib.checks import packages
 
     files = reference.reference_files(assignment)
-    assert set(packages.PACKAGES[assignment]) == {name.split("/")[2] for name in files}
+    assert set(assignments.spec(assignment).packages) == {name.split("/")[2] for name in files}
     nb = reference.source_notebook(assignment)
     reference.write_files(nb, tmp_path)
     written = {str(p.relative_to(tmp_path)): p.read_text() for p in tmp_path.rglob("*") if p.is_file()}

@@ -173,17 +173,17 @@ class Context:
 
     @property
     def module(self) -> str:
-        """The dotted name of the student's module of plain functions (course_lib.checks.packages)."""
-        from course_lib.checks import packages
+        """The dotted name of the student's module of plain functions (its assignment's spec)."""
+        from course_lib.checks import assignments
 
-        return packages.FUNCTION_MODULES[self.spec.assignment][1]
+        return assignments.spec(self.spec.assignment).functions[1]
 
     @property
     def module_root(self) -> Path:
         """The folder the student's module is imported from: its package's source, ros2_ws/src/<package>."""
-        from course_lib.checks import packages
+        from course_lib.checks import assignments, packages
 
-        return packages.package_dir(self, packages.FUNCTION_MODULES[self.spec.assignment][0])
+        return packages.package_dir(self, assignments.spec(self.spec.assignment).functions[0])
 
     def require_module(self) -> None:
         """Raise StudentError with the fix when the student's module file does not exist."""

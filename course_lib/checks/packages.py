@@ -4,7 +4,8 @@ An assignment's work is a colcon workspace beside the notebook (``ros2_ws/src/<p
 written by the notebook's ``%%writefile`` cells). The checks
 
 - call plain functions (``average_brightness``, ``crop_pictures``) from the package's source,
-  without a build (course_lib.checks.context.Context.call, with the module named in :data:`FUNCTION_MODULES`);
+  without a build (course_lib.checks.context.Context.call, with the module its spec names:
+  course_lib.checks.assignments);
 - start executables as ``ros2 run <package> <executable>`` would: the console script colcon
   installed in ``ros2_ws/install/<package>/lib/<package>/``, in the environment of
   ``source ros2_ws/install/setup.bash`` (:func:`run`);
@@ -24,22 +25,9 @@ import xml.etree.ElementTree as ElementTree
 from pathlib import Path
 
 from course_lib import contract, package_files
+from course_lib.checks.assignments import WORKSPACE
 from course_lib.checks.context import StudentError
 from course_lib.checks.student_processes import student_env as _student_env
-
-#: The workspace folder beside the notebook.
-WORKSPACE = "ros2_ws"
-
-#: The packages of each assignment and their executables (what ``ros2 run`` offers).
-PACKAGES = {
-    "brightness": {"brightness": ("brightness_node",)},
-    "pubsub": {"tutorial_interfaces": (), "pubsub": ("topic_publisher", "topic_subscriber")},
-    "catdog_warp": {"catdog_interfaces": (), "webcam": ("image_publisher",), "readmarker": ("marker_reader",)},
-}
-
-#: The module holding each assignment's plain functions: (package, dotted module name).
-FUNCTION_MODULES = {"brightness": ("brightness", "brightness.brightness_node"),
-                    "catdog_warp": ("readmarker", "readmarker.crop")}
 
 #: Python modules that belong to no ROS package (a <depend> on them is not needed here). Every
 #: other top-level module whose name is a ROS package (installed, or in the workspace) must be
