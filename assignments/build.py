@@ -17,10 +17,11 @@ from pathlib import Path, PurePosixPath
 
 import nbformat
 
+from course_lib.checks.assignments import WORKSPACE
+
 HERE = Path(__file__).resolve().parent
 SOURCE = HERE / "source"
 REFERENCE_SRC = HERE / "reference_ws" / "src"
-WORKSPACE = "ros2_ws"
 
 
 def _meta(kind: str, grade_id: str, points: float = 0) -> dict:
