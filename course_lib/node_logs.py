@@ -93,11 +93,13 @@ def _add_view(name: str, since: float) -> "_NodeLog":
     return view
 
 
-def attach(node, since: float | None = None) -> None:
+def attach(node, reader, since: float | None = None) -> None:
     """Show the log lines of ``node`` under the current cell (inside a kernel).
 
     Args:
         node: a node the session spins.
+        reader: a function of no arguments giving the node that reads /rosout (the session's tool
+            node), called only inside a kernel.
         since: the time given to expect() when the node was created; None: from now on.
     """
     if not in_kernel() or node.get_name().startswith("_") or \
@@ -115,7 +117,7 @@ def attach(node, since: float | None = None) -> None:
         view.widget = widget
         view.render()
     display(widget)
-    _subscribe()
+    _subscribe(reader())
 
 
 def text(name: str) -> str:
@@ -125,15 +127,12 @@ def text(name: str) -> str:
         return "\n".join(views[-1].lines) if views else ""
 
 
-def _subscribe() -> None:
+def _subscribe(tool) -> None:
     """Read /rosout on the session's tool node, once per session."""
     global _subscribed_node
     from rcl_interfaces.msg import Log
     from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 
-    from course_lib import session
-
-    tool = session.tool_node()
     with _lock:
         if _subscribed_node is tool:
             return

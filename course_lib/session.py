@@ -322,7 +322,7 @@ def add_node(node):
         state.nodes[name] = node
         state.executor.add_node(node)
         since = state.created_at.pop(name, None)
-    node_logs.attach(node, since)
+    node_logs.attach(node, tool_node, since)
     return node
 
 

@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from course_lib import contract
-from course_lib.checks import packages
+from course_lib.checks import context, packages
 from course_lib.checks.context import StudentError
 
 
@@ -22,6 +22,8 @@ class Recorder:
     def item(self, ok, message, weight=1.0):
         self.items.append({"ok": bool(ok), "message": message, "weight": weight})
         return bool(ok)
+
+    package_dir = context.Context.package_dir
 
 
 def write_package(workdir: Path, depends: list[str], code: str) -> Path:

@@ -181,9 +181,15 @@ class Context:
     @property
     def module_root(self) -> Path:
         """The folder the student's module is imported from: its package's source, ros2_ws/src/<package>."""
-        from course_lib.checks import assignments, packages
+        from course_lib.checks import assignments
 
-        return packages.package_dir(self, assignments.spec(self.spec.assignment).functions[0])
+        return self.package_dir(assignments.spec(self.spec.assignment).functions[0])
+
+    def package_dir(self, package: str) -> Path:
+        """A package's source folder beside the notebook, ros2_ws/src/<package>."""
+        from course_lib.checks import assignments
+
+        return Path(self.workdir) / assignments.WORKSPACE / "src" / package
 
     def require_module(self) -> None:
         """Raise StudentError with the fix when the student's module file does not exist."""

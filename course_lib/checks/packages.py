@@ -39,11 +39,6 @@ def workspace_dir(ctx) -> Path:
     return Path(ctx.workdir) / WORKSPACE
 
 
-def package_dir(ctx, package: str) -> Path:
-    """The package's source folder, ros2_ws/src/<package>."""
-    return workspace_dir(ctx) / "src" / package
-
-
 def require_build(ctx) -> Path:
     """The built workspace; raises StudentError with the reason when it is not built."""
     ws = workspace_dir(ctx)
@@ -124,7 +119,7 @@ def dependency_items(ctx, package: str, weight: float = 1.0) -> None:
     <exec_depend> of its package.xml (``rosdep`` and a full ROS install rely on it). Like every
     package item it costs `weight` when wrong and earns nothing when right (the release's
     package.xml is right already: an untouched release must score 0)."""
-    folder = package_dir(ctx, package)
+    folder = ctx.package_dir(package)
     try:
         have = package_files.run_dependencies(folder / "package.xml")
     except (OSError, ElementTree.ParseError) as error:
@@ -176,7 +171,7 @@ def message_fields(path: Path) -> list[tuple[str, str]]:
 def message_item(ctx, package: str, message: str, expected: list[tuple[str, str]], weight: float = 1.0) -> bool:
     """One item: the student's msg/<message>.msg of `package` has exactly the contract's fields
     (costs `weight` when wrong, earns nothing when right, as dependency_items)."""
-    path = package_dir(ctx, package) / "msg" / f"{message}.msg"
+    path = ctx.package_dir(package) / "msg" / f"{message}.msg"
     if not path.is_file():
         return ctx.item(False, f"{package}/msg/{message}.msg does not exist: write it with the notebook's cell",
                         weight=weight)
