@@ -12,11 +12,12 @@ import numpy as np
 
 # --- message types ----------------------------------------------------------------------
 
-def message_class(type_name: str):
-    """The Python class of a message type name.
+def message_class(type_name: str, kind: str = "msg"):
+    """The Python class of a message type name (or of a service or action type).
 
     Args:
         type_name: "std_msgs/msg/String" (the form the graph reports) or "std_msgs/String".
+        kind: what a two-part name leaves out: "msg", or "srv"/"action" ("std_srvs/SetBool").
 
     Returns:
         The message class, e.g. ``std_msgs.msg.String``.
@@ -27,7 +28,7 @@ def message_class(type_name: str):
     """
     parts = type_name.split("/")
     if len(parts) == 2:
-        parts = [parts[0], "msg", parts[1]]
+        parts = [parts[0], kind, parts[1]]
     if len(parts) != 3 or not all(parts):
         raise ValueError(f"Message type {type_name!r} is not of the form 'package/msg/Type', "
                          "e.g. 'std_msgs/msg/String'")

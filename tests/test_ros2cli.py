@@ -12,10 +12,9 @@ from pathlib import Path
 import pytest
 import yaml
 from process_support import in_background_of_a_script, wait_until
+from ros2cli_support import ROS2, ros2, ros2_together
 
 from course_lib import colcon, processes, rosenv, workspace
-
-ROS2 = Path(sys.executable).parent / "ros2"
 
 # Two nodes, each in a process of its own: `python live_nodes.py talker|listener [ros args]`.
 LIVE_NODES = '''
@@ -79,27 +78,6 @@ main()
 '''
 
 
-def ros2(*args, env, timeout=60, check=True):
-    """Run the installed ros2 with ``args``; the CompletedProcess (text), checked for exit code 0."""
-    done = subprocess.run([str(ROS2), *args], env=env, capture_output=True, text=True, timeout=timeout,
-                          stdin=subprocess.DEVNULL)
-    if check:
-        assert done.returncode == 0, f"ros2 {' '.join(args)} failed ({done.returncode}):\n{done.stderr}"
-    return done
-
-
-def ros2_together(*commands, env, timeout=60):
-    """Run several independent ros2 commands at the same time (each one mostly waits for
-    discovery); their CompletedProcesses, in order."""
-    started = [subprocess.Popen([str(ROS2), *args], env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                                text=True, stdin=subprocess.DEVNULL) for args in commands]
-    done = []
-    for args, process in zip(commands, started):
-        out, err = process.communicate(timeout=timeout)
-        done.append(subprocess.CompletedProcess([str(ROS2), *args], process.returncode, out, err))
-    return done
-
-
 @pytest.fixture(scope="module")
 def live(tmp_path_factory):
     """A talker and a listener in processes of their own, on a reserved domain; yields ros2's env."""
@@ -132,8 +110,8 @@ def test_the_command_is_installed_in_the_venv():
 def test_help_lists_the_supported_commands_and_verbs():
     env = rosenv.ros_environment()
     top = ros2("--help", env=env).stdout
-    assert re.findall(r"^  ([a-z]+) ", top, re.MULTILINE) == ["interface", "launch", "node", "param", "pkg", "run",
-                                                             "topic"]
+    assert re.findall(r"^  ([a-z]+) ", top, re.MULTILINE) == ["action", "interface", "launch", "node", "param", "pkg",
+                                                             "run", "service", "topic"]
     assert "a full ROS 2 install (ros2cli) has more" in top
     topic = ros2("topic", "--help", env=env).stdout
     assert re.findall(r"^  ([a-z]+) ", topic, re.MULTILINE) == ["echo", "hz", "info", "list", "pub"]
@@ -141,7 +119,7 @@ def test_help_lists_the_supported_commands_and_verbs():
 
 
 @pytest.mark.parametrize("args, names", [
-    (["service", "list"], "ros2 service is not supported"),
+    (["bag", "record", "-a"], "ros2 bag is not supported"),
     (["topic", "bw", "/x"], "ros2 topic bw is not supported"),
     (["topic", "echo", "/x", "--csv"], "ros2 topic echo: --csv is not supported"),
     (["topic", "echo", "/x", "--times", "3"], "ros2 topic echo: --times is not supported"),

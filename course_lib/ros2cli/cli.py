@@ -12,18 +12,19 @@ from course_lib.ros2cli.common import FULL_INSTALL, Unsupported, unsupported
 
 #: The commands the course's ros2 has, with ros2cli's help line for each.
 COMMANDS = {
+    "action": "Various action related sub-commands",
     "interface": "Show information about ROS interfaces",
     "launch": "Run a launch file",
     "node": "Various node related sub-commands",
     "param": "Various param related sub-commands",
     "pkg": "Various package related sub-commands",
     "run": "Run a package specific executable",
+    "service": "Various service related sub-commands",
     "topic": "Various topic related sub-commands",
 }
 
 #: Commands of a full ros2cli install that the course's ros2 leaves out (named in --help).
-LEFT_OUT = ("action", "bag", "component", "daemon", "doctor", "lifecycle", "multicast", "service",
-            "wtf")
+LEFT_OUT = ("bag", "component", "daemon", "doctor", "lifecycle", "multicast", "wtf")
 
 
 def usage() -> str:

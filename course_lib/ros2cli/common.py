@@ -61,7 +61,7 @@ class VerbParser(argparse.ArgumentParser):
 
 
 def run_group(prog: str, description: str, verbs: dict[str, Verb], argv: list[str],
-              missing: typing.Iterable[str] = ()) -> int | str | None:
+              missing: typing.Iterable[str] = (), defaults: dict | None = None) -> int | str | None:
     """Parse ``argv`` (what follows ``ros2 COMMAND``) and run the chosen verb.
 
     Args:
@@ -70,6 +70,8 @@ def run_group(prog: str, description: str, verbs: dict[str, Verb], argv: list[st
         verbs: the verbs the course supports.
         argv: the verb and its arguments.
         missing: verbs of the real ros2cli command that the course leaves out (for --help).
+        defaults: values of the command's own options, given before the verb (``ros2 service
+            --include-hidden-services type ...``), for every verb's arguments.
     """
     if not argv or argv[0] in ("-h", "--help"):
         width = max(len(name) for name in verbs)
@@ -88,6 +90,7 @@ def run_group(prog: str, description: str, verbs: dict[str, Verb], argv: list[st
     verb = verbs[name]
     parser = VerbParser(prog=f"{prog} {name}", description=verb.help)
     verb.add_arguments(parser)
+    parser.set_defaults(**(defaults or {}))
     return verb.main(parser.parse_args(rest))
 
 
