@@ -14,6 +14,8 @@ DEFAULT_DESCRIPTION = "TODO: Package description"
 
 _PACKAGE_NAME = re.compile(r"^[a-z][a-z0-9_]*$")
 _MESSAGE_NAME = re.compile(r"^[A-Z][A-Za-z0-9]*$")
+#: The kinds of interface files a package of interfaces holds, each in the folder of its name.
+_KINDS = {"msg": "message", "srv": "service", "action": "action"}
 
 # --- creating packages -------------------------------------------------------------------------
 
@@ -288,11 +290,14 @@ def create_interface_package(ws_dir, name: str, messages: dict[str, str], *,
     Args:
         ws_dir: the workspace folder (created when missing).
         name: the package name, e.g. "tutorial_interfaces".
-        messages: {message name: definition}, e.g.
-            {"MsgTutorial": "builtin_interfaces/Time stamp\\nint32 data\\n"}.
-        dependencies: message packages the definitions use (find_package and DEPENDENCIES).
+        messages: {interface name: definition}, e.g.
+            {"MsgTutorial": "builtin_interfaces/Time stamp\\nint32 data\\n"}; a name ending in
+            ".srv" is a service ("int64 a\\nint64 b\\n---\\nint64 sum\\n"), one ending in ".action"
+            an action (goal, result and feedback between "---" lines), any other a message.
+        dependencies: message packages the definitions use (find_package and DEPENDENCIES);
+            action_msgs is added when there are actions (their generated types use it).
         exist_ok: when the package exists, rewrite CMakeLists.txt, package.xml and the given
-            messages (other .msg files are kept).
+            interfaces (other interface files are kept).
 
     Returns:
         The package folder.
@@ -303,19 +308,22 @@ def create_interface_package(ws_dir, name: str, messages: dict[str, str], *,
     """
     if not messages:
         raise ValueError("messages is empty: give at least one, e.g. {'MsgTutorial': 'int32 data'}")
-    names = []
+    files = []  # "msg/Name.msg", "srv/Name.srv", "action/Name.action"
     for message in messages:
-        stem = message[:-4] if message.endswith(".msg") else message
+        stem, dot, kind = message.rpartition(".")
+        stem, kind = (stem, kind) if dot and kind in _KINDS else (message, "msg")
         if not _MESSAGE_NAME.match(stem):
-            raise ValueError(f"message name {message!r} must be CamelCase starting with a capital letter "
-                             "(e.g. 'MsgTutorial'); ROS turns it into the file msg/MsgTutorial.msg")
-        names.append(stem)
+            raise ValueError(f"{_KINDS[kind]} name {message!r} must be CamelCase starting with a capital letter "
+                             f"(e.g. 'MsgTutorial'); ROS turns it into the file {kind}/MsgTutorial.{kind}")
+        files.append(f"{kind}/{stem}.{kind}")
+    if any(file.startswith("action/") for file in files):
+        dependencies = [*dependencies, "action_msgs"]
     dependencies = list(dict.fromkeys(dependencies))
     for dependency in dependencies:
         _check_package_name(dependency)
     package_dir = _prepare_package_dir(Path(ws_dir) / "src" / name, name, exist_ok)
     finds = "".join(f"find_package({dependency} REQUIRED)\n" for dependency in dependencies)
-    listed = "".join(f'  "msg/{stem}.msg"\n' for stem in names)
+    listed = "".join(f'  "{file}"\n' for file in files)
     depends_clause = f"  DEPENDENCIES {' '.join(dependencies)}\n" if dependencies else ""
     cmake = f"""cmake_minimum_required(VERSION 3.8)
 project({name})
@@ -342,9 +350,9 @@ ament_package()
     _write(package_dir / "CMakeLists.txt", cmake)
     _write(package_dir / "package.xml",
            _package_xml(name, description, maintainer, maintainer_email, license, body, "ament_cmake"))
-    for message, stem in zip(messages, names):
+    for message, file in zip(messages, files):
         definition = messages[message]
-        _write(package_dir / "msg" / f"{stem}.msg", definition if definition.endswith("\n") else definition + "\n")
+        _write(package_dir / file, definition if definition.endswith("\n") else definition + "\n")
     return package_dir
 
 

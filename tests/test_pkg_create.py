@@ -102,3 +102,17 @@ def test_create_interface_package_declares_the_generators(tmp_path):
 def test_message_names_must_be_camel_case(tmp_path):
     with pytest.raises(ValueError, match="CamelCase"):
         pkg_create.create_interface_package(tmp_path, "my_interfaces", {"msg_tutorial": "int32 data"})
+
+
+def test_create_interface_package_lists_services_and_actions_in_their_folders(tmp_path):
+    """ROS 2's "Creating custom msg and srv files" and "Creating an action" tutorials: srv/X.srv and
+    action/X.action in rosidl_generate_interfaces, and action_msgs as a dependency for actions."""
+    package = pkg_create.create_interface_package(
+        tmp_path, "tutorial_interfaces", {"Num": "int64 num", "AddThreeInts.srv": "int64 a\n---\nint64 sum",
+                                          "Fibonacci.action": "int32 order\n---\nint32[] sequence\n---\nint32[] partial"})
+    cmake = (package / "CMakeLists.txt").read_text()
+    assert re.search(r'"msg/Num.msg"\s+"srv/AddThreeInts.srv"\s+"action/Fibonacci.action"\s+'
+                     r"DEPENDENCIES builtin_interfaces action_msgs\s*\)", cmake), cmake
+    assert (package / "srv" / "AddThreeInts.srv").read_text() == "int64 a\n---\nint64 sum\n"
+    assert (package / "action" / "Fibonacci.action").is_file()
+    assert "<depend>action_msgs</depend>" in (package / "package.xml").read_text()
