@@ -114,13 +114,14 @@ def test_help_lists_the_supported_commands_and_verbs():
                                                              "run", "service", "topic"]
     assert "a full ROS 2 install (ros2cli) has more" in top
     topic = ros2("topic", "--help", env=env).stdout
-    assert re.findall(r"^  ([a-z]+) ", topic, re.MULTILINE) == ["echo", "hz", "info", "list", "pub"]
+    assert re.findall(r"^  ([a-z]+) ", topic, re.MULTILINE) == ["bw", "delay", "echo", "find", "hz", "info", "list",
+                                                               "pub", "type"]
     assert "--once" in ros2("topic", "echo", "--help", env=env).stdout
 
 
 @pytest.mark.parametrize("args, names", [
     (["bag", "record", "-a"], "ros2 bag is not supported"),
-    (["topic", "bw", "/x"], "ros2 topic bw is not supported"),
+    (["service", "echo", "/x"], "ros2 service echo is not supported"),
     (["topic", "echo", "/x", "--csv"], "ros2 topic echo: --csv is not supported"),
     (["topic", "echo", "/x", "--times", "3"], "ros2 topic echo: --times is not supported"),
     (["param", "dump", "/x", "--output-dir", "/tmp"], "ros2 param dump: --output-dir is not supported"),

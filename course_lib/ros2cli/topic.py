@@ -1,4 +1,4 @@
-"""``ros2 topic list|echo|hz|info|pub``, printed from course_lib.graph and its tool node."""
+"""``ros2 topic list|echo|hz|bw|delay|info|type|find|pub``, from course_lib.graph and its tool node."""
 
 from __future__ import annotations
 
@@ -9,7 +9,10 @@ from course_lib.ros2cli.common import (DISCOVERY_BACKSTOP, Verb, add_discovery_a
                                        wait_for_nothing, wait_for_whole_graph, wait_until)
 
 #: Verbs of ros2cli's ``ros2 topic`` that the course leaves out.
-LEFT_OUT = ("bw", "delay", "find", "type")
+LEFT_OUT = ()
+#: ros2topic's default --window of ``bw`` and of ``delay``.
+BW_WINDOW = 100
+DELAY_WINDOW = 10000
 #: Seconds ``ros2 topic pub`` waits at most, after its last message, for reliable subscriptions
 #: to acknowledge what it sent (it ends as soon as they have).
 ACK_SECONDS = 10.0
@@ -194,6 +197,151 @@ def _hz(args) -> None:
     measure(0.0 if shown else None)
 
 
+# --- ros2 topic bw / delay ---------------------------------------------------------------
+
+def _window_arguments(parser, default: int) -> None:
+    parser.add_argument("topic", help="Topic name to monitor")
+    parser.add_argument("--window", "-w", type=_positive_int, default=default, metavar="WINDOW",
+                        help=f"maximum window size, in # of messages, for calculating rate (default: {default})")
+    add_discovery_arguments(parser, daemon=False)
+
+
+def _subscribe_for_seconds(args, callback, report, raw: bool, announce: bool) -> str | None:
+    """Like ros2topic's bw and delay: find the topic's type (waiting for it as long as it takes,
+    after a warning), subscribe with the sensor-data QoS and call ``report()`` once a second
+    until Ctrl-C; report() may return the text of a failure that ends the verb. ``announce``:
+    say "Subscribed to [TOPIC]" first (bw does)."""
+    from rclpy.qos import qos_profile_sensor_data
+
+    from course_lib import graph
+
+    shown = wait_for_name(_topic_shown(args.topic), args.spin_time)
+    if not shown:
+        _not_published_yet(args.topic)
+    with graph.subscription(args.topic, callback, timeout=0.0 if shown else None, qos=qos_profile_sensor_data,
+                            raw=raw) as name:
+        if announce:
+            print(f"Subscribed to [{name}]")
+        limit = loop_limit(None)
+        started = time.monotonic()
+        while limit is None or time.monotonic() - started < limit:
+            wait_until(lambda: False, 1.0)
+            failure = report()
+            if failure:
+                return failure
+    return None
+
+
+def _bytes(size: float, per_second: float) -> str:
+    """ros2topic bw's units: B below 1000 B/s, KB below 1 MB/s, else MB (powers of 1000)."""
+    if per_second < 1000:
+        return f"{size:.0f} B"
+    return f"{size / 1000:.2f} KB" if per_second < 1000000 else f"{size / 1000 / 1000:.2f} MB"
+
+
+def _bw(args) -> str | None:
+    import collections
+    import threading
+
+    lock = threading.Lock()
+    window = collections.deque(maxlen=args.window)  # (arrival, size)
+
+    def arrived(data) -> None:
+        with lock:
+            window.append((time.monotonic(), len(data)))
+
+    def report() -> None:
+        with lock:
+            if len(window) < 2:
+                return
+            sizes = [size for _, size in window]
+            rate = sum(sizes) / (time.monotonic() - window[0][0])
+        mean, low, high = (_bytes(value, rate) for value in (sum(sizes) / len(sizes), min(sizes), max(sizes)))
+        print(f"{_bytes(rate, rate)}/s from {len(sizes)} messages\n\tMessage size mean: {mean} min: {low} max: {high}")
+
+    return _subscribe_for_seconds(args, arrived, report, raw=True, announce=True)
+
+
+def _delay(args) -> str | None:
+    import math
+    import threading
+
+    from rclpy.time import Time
+
+    from course_lib import session
+
+    clock = session.tool_node().get_clock()
+    lock = threading.Lock()
+    seen = {"delays": [], "first": False, "new": False, "no header": False}
+
+    def arrived(msg) -> None:
+        if not hasattr(msg, "header"):
+            seen["no header"] = True
+            return
+        with lock:
+            now = clock.now()
+            if not seen["first"]:  # like ros2topic: the first message only starts the clock
+                seen["first"] = True
+                return
+            seen["delays"] = (seen["delays"] + [(now - Time.from_msg(msg.header.stamp)).nanoseconds])[-args.window:]
+            seen["new"] = True
+
+    def report() -> str | None:
+        if seen["no header"]:
+            return "msg does not have header"
+        with lock:
+            delays, new, seen["new"] = list(seen["delays"]), seen["new"], False
+        if not delays:
+            return None
+        if not new:
+            print("no new messages")
+            return None
+        mean = sum(delays) / len(delays)
+        deviation = math.sqrt(sum((delay - mean) ** 2 for delay in delays) / len(delays))
+        print(f"average delay: {mean * 1e-9:.3f}\n\tmin: {min(delays) * 1e-9:.3f}s max: {max(delays) * 1e-9:.3f}s "
+              f"std dev: {deviation * 1e-9:.5f}s window: {len(delays)}")
+        return None
+
+    return _subscribe_for_seconds(args, arrived, report, raw=False, announce=False)
+
+
+# --- ros2 topic type / find --------------------------------------------------------------
+
+def _type_arguments(parser) -> None:
+    add_discovery_arguments(parser)
+    parser.add_argument("topic_name", help="Name of the ROS topic to get type (e.g. '/chatter')")
+    parser.set_defaults(include_hidden_topics=False)  # an option of `ros2 topic`, before the verb
+
+
+def _type(args) -> int:
+    from course_lib import graph
+
+    def kinds() -> list[str]:
+        return dict(graph.topic_list(types=True, include_hidden=args.include_hidden_topics)).get(args.topic_name, [])
+
+    wait_for_name(lambda: bool(kinds()), args.spin_time)  # unknown: nothing printed, exit code 1
+    found = kinds()
+    for kind in found:
+        print(kind)
+    return 0 if found else 1
+
+
+def _find_arguments(parser) -> None:
+    add_discovery_arguments(parser)
+    parser.add_argument("topic_type", help="Name of the ROS topic type to filter for (e.g. 'std_msg/msg/String')")
+    parser.add_argument("-c", "--count-topics", action="store_true", help="Only display the number of topics discovered")
+    parser.add_argument("--include-hidden-topics", action="store_true", help="Consider hidden topics as well")
+
+
+def _find(args) -> None:
+    from course_lib import graph
+
+    wait_for_whole_graph(args.spin_time)
+    names = [name for name, kinds in graph.topic_list(types=True, include_hidden=args.include_hidden_topics)
+             if args.topic_type in kinds]
+    print(len(names) if args.count_topics else "\n".join(names), end="\n" if args.count_topics or names else "")
+
+
 # --- ros2 topic info ---------------------------------------------------------------------
 
 def _info_arguments(parser) -> None:
@@ -311,13 +459,21 @@ def _pub(args) -> str | None:
 
 
 VERBS = {
+    "bw": Verb("Display bandwidth used by topic", lambda parser: _window_arguments(parser, BW_WINDOW), _bw),
+    "delay": Verb("Display delay of topic from timestamp in header",
+                  lambda parser: _window_arguments(parser, DELAY_WINDOW), _delay),
     "echo": Verb("Output messages from a topic", _echo_arguments, _echo),
     "hz": Verb("Print the average publishing rate to screen", _hz_arguments, _hz),
     "info": Verb("Print information about a topic", _info_arguments, _info),
     "list": Verb("Output a list of available topics", _list_arguments, _list),
+    "find": Verb("Output a list of available topics of a given type", _find_arguments, _find),
     "pub": Verb("Publish a message to a topic", _pub_arguments, _pub),
+    "type": Verb("Print a topic's type", _type_arguments, _type),
 }
 
 
 def main(argv: list[str]):
-    return run_group("ros2 topic", "Various topic related sub-commands", VERBS, argv, missing=LEFT_OUT)
+    # ros2topic's own option comes before the verb: `ros2 topic --include-hidden-topics type /_x`.
+    hidden = bool(argv) and argv[0] == "--include-hidden-topics"
+    return run_group("ros2 topic", "Various topic related sub-commands", VERBS, argv[hidden:], missing=LEFT_OUT,
+                     defaults={"include_hidden_topics": True} if hidden else None)
