@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from course_lib.ros2cli.common import DEFAULT_SPIN_TIME, Verb, run_group, wait_for_name, wait_for_whole_graph, wait_until
+from course_lib.ros2cli.common import (DEFAULT_SPIN_TIME, Verb, print_names, print_types, run_group, wait_for_name,
+                                       wait_for_whole_graph, wait_until)
 
 #: ros2action's words for the states of action_msgs/msg/GoalStatus.
 STATUS_WORDS = {1: "ACCEPTED", 2: "EXECUTING", 3: "CANCELING", 4: "SUCCEEDED", 5: "CANCELED", 6: "ABORTED"}
@@ -27,12 +28,7 @@ def _list_arguments(parser) -> None:
 
 def _list(args) -> None:
     wait_for_whole_graph(DEFAULT_SPIN_TIME)  # ros2action's verbs have no --spin-time
-    pairs = action_pairs()
-    if args.count_actions:
-        print(len(pairs))
-        return
-    for name, kinds in pairs:
-        print(f"{name} [{', '.join(kinds)}]" if args.show_types else name)
+    print_names(action_pairs(), args.show_types, args.count_actions)
 
 
 def _type_arguments(parser) -> None:
@@ -43,11 +39,8 @@ def _type(args) -> int:
     def kinds() -> list[str]:
         return next((kinds for name, kinds in action_pairs() if name == args.action_name), [])
 
-    wait_for_name(lambda: bool(kinds()), DEFAULT_SPIN_TIME)  # unknown: nothing printed, exit code 1
-    found = kinds()
-    for kind in found:
-        print(kind)
-    return 0 if found else 1
+    wait_for_name(lambda: bool(kinds()), DEFAULT_SPIN_TIME)
+    return print_types(kinds())
 
 
 # --- ros2 action info --------------------------------------------------------------------

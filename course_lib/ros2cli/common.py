@@ -61,7 +61,7 @@ class VerbParser(argparse.ArgumentParser):
 
 
 def run_group(prog: str, description: str, verbs: dict[str, Verb], argv: list[str],
-              missing: typing.Iterable[str] = (), defaults: dict | None = None) -> int | str | None:
+              missing: typing.Iterable[str] = (), hidden_flag: str | None = None) -> int | str | None:
     """Parse ``argv`` (what follows ``ros2 COMMAND``) and run the chosen verb.
 
     Args:
@@ -70,9 +70,13 @@ def run_group(prog: str, description: str, verbs: dict[str, Verb], argv: list[st
         verbs: the verbs the course supports.
         argv: the verb and its arguments.
         missing: verbs of the real ros2cli command that the course leaves out (for --help).
-        defaults: values of the command's own options, given before the verb (``ros2 service
-            --include-hidden-services type ...``), for every verb's arguments.
+        hidden_flag: the command's own option that shows hidden names, given before the verb
+            (``ros2 service --include-hidden-services type /_x``), if it has one.
     """
+    defaults = {}
+    if hidden_flag and argv and argv[0] == hidden_flag:
+        defaults[hidden_flag.lstrip("-").replace("-", "_")] = True
+        argv = argv[1:]
     if not argv or argv[0] in ("-h", "--help"):
         width = max(len(name) for name in verbs)
         lines = [f"usage: {prog} [-h] Call `{prog} <command> -h` for more detailed usage. ...", "",
@@ -90,8 +94,26 @@ def run_group(prog: str, description: str, verbs: dict[str, Verb], argv: list[st
     verb = verbs[name]
     parser = VerbParser(prog=f"{prog} {name}", description=verb.help)
     verb.add_arguments(parser)
-    parser.set_defaults(**(defaults or {}))
+    parser.set_defaults(**defaults)
     return verb.main(parser.parse_args(rest))
+
+
+def print_names(pairs: list[tuple[str, list[str]]], show_types: bool, count: bool) -> None:
+    """(name, [type, ...]) pairs as ros2cli's list verbs print them: how many (-c), or each name,
+    followed by its types in brackets (-t)."""
+    if count:
+        print(len(pairs))
+        return
+    for name, kinds in pairs:
+        print(f"{name} [{', '.join(kinds)}]" if show_types else name)
+
+
+def print_types(kinds: list[str]) -> int:
+    """The types of one name as ros2cli's type verbs print them; exit code 1 (nothing printed)
+    when the name is unknown."""
+    for kind in kinds:
+        print(kind)
+    return 0 if kinds else 1
 
 
 # --- discovery ----------------------------------------------------------------------------

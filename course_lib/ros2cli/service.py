@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import time
 
-from course_lib.ros2cli.common import (DEFAULT_SPIN_TIME, Verb, add_discovery_arguments, run_group,
-                                       wait_for_name, wait_for_whole_graph, wait_until)
+from course_lib.ros2cli.common import (DEFAULT_SPIN_TIME, Verb, add_discovery_arguments, print_names, print_types,
+                                       run_group, wait_for_name, wait_for_whole_graph, wait_until)
 
 #: Verbs of ros2cli's ``ros2 service`` (Jazzy) that the course leaves out.
 LEFT_OUT = ("echo", "info")
@@ -38,12 +38,7 @@ def _list_arguments(parser) -> None:
 
 def _list(args) -> None:
     wait_for_whole_graph(args.spin_time)
-    pairs = service_pairs(args.include_hidden_services)
-    if args.count_services:
-        print(len(pairs))
-        return
-    for name, kinds in pairs:
-        print(f"{name} [{', '.join(kinds)}]" if args.show_types else name)
+    print_names(service_pairs(args.include_hidden_services), args.show_types, args.count_services)
 
 
 # --- ros2 service type -------------------------------------------------------------------
@@ -60,10 +55,7 @@ def _type(args) -> int:
 
     # Like ros2service: an unknown service prints nothing and ends with exit code 1.
     wait_for_name(lambda: bool(kinds()), DEFAULT_SPIN_TIME)
-    found = kinds()
-    for kind in found:
-        print(kind)
-    return 0 if found else 1
+    return print_types(kinds())
 
 
 # --- ros2 service find -------------------------------------------------------------------
@@ -177,7 +169,5 @@ VERBS = {
 
 
 def main(argv: list[str]):
-    # ros2service's own option comes before the verb: `ros2 service --include-hidden-services type /_x`.
-    hidden = bool(argv) and argv[0] == "--include-hidden-services"
-    return run_group("ros2 service", "Various service related sub-commands", VERBS, argv[hidden:],
-                     missing=LEFT_OUT, defaults={"include_hidden_services": True} if hidden else None)
+    return run_group("ros2 service", "Various service related sub-commands", VERBS, argv, missing=LEFT_OUT,
+                     hidden_flag="--include-hidden-services")

@@ -5,8 +5,9 @@ from __future__ import annotations
 import time
 
 from course_lib.ros2cli.common import (DISCOVERY_BACKSTOP, Verb, add_discovery_arguments, add_qos_arguments,
-                                       loop_limit, qos_from_arguments, qos_overridden, run_group, say, wait_for_name,
-                                       wait_for_nothing, wait_for_whole_graph, wait_until)
+                                       loop_limit, print_names, print_types, qos_from_arguments, qos_overridden,
+                                       run_group, say, wait_for_name, wait_for_nothing, wait_for_whole_graph,
+                                       wait_until)
 
 #: Verbs of ros2cli's ``ros2 topic`` that the course leaves out.
 LEFT_OUT = ()
@@ -77,9 +78,7 @@ def _list(args) -> None:
 
     wait_for_whole_graph(args.spin_time)
     pairs = graph.topic_list(types=True, include_hidden=args.include_hidden_topics)
-    if args.count_topics:
-        print(len(pairs))
-    elif pairs and args.verbose:
+    if pairs and args.verbose and not args.count_topics:
         counts = {name: graph.topic_info(name, verbose=False) for name, _ in pairs}
         for title, count_of, noun in (("Published", "publisher_count", "publisher"),
                                       ("Subscribed", "subscription_count", "subscriber")):
@@ -90,8 +89,7 @@ def _list(args) -> None:
                     print(f" * {name} [{', '.join(kinds)}] {count} {noun}{'s' if count > 1 else ''}")
             print()
     else:
-        for name, kinds in pairs:
-            print(f"{name} [{', '.join(kinds)}]" if args.show_types else name)
+        print_names(pairs, args.show_types, args.count_topics)
 
 
 # --- ros2 topic echo ---------------------------------------------------------------------
@@ -319,11 +317,8 @@ def _type(args) -> int:
     def kinds() -> list[str]:
         return dict(graph.topic_list(types=True, include_hidden=args.include_hidden_topics)).get(args.topic_name, [])
 
-    wait_for_name(lambda: bool(kinds()), args.spin_time)  # unknown: nothing printed, exit code 1
-    found = kinds()
-    for kind in found:
-        print(kind)
-    return 0 if found else 1
+    wait_for_name(lambda: bool(kinds()), args.spin_time)
+    return print_types(kinds())
 
 
 def _find_arguments(parser) -> None:
@@ -473,7 +468,5 @@ VERBS = {
 
 
 def main(argv: list[str]):
-    # ros2topic's own option comes before the verb: `ros2 topic --include-hidden-topics type /_x`.
-    hidden = bool(argv) and argv[0] == "--include-hidden-topics"
-    return run_group("ros2 topic", "Various topic related sub-commands", VERBS, argv[hidden:], missing=LEFT_OUT,
-                     defaults={"include_hidden_topics": True} if hidden else None)
+    return run_group("ros2 topic", "Various topic related sub-commands", VERBS, argv, missing=LEFT_OUT,
+                     hidden_flag="--include-hidden-topics")
