@@ -54,8 +54,8 @@ def domain_id():
 #: hands out the files with the most tests first (test_launch_parser.py), and the hub and the
 #: lessons in Chromium started 7-8 minutes into an 11-minute run.
 LONGEST_FIRST = ("test_term.py", "test_browser.py", "test_autograder_zoo.py", "test_browser_lessons.py",
-                 "test_hub.py", "test_browser_validate.py", "test_autograder.py", "test_lesson_commands.py",
-                 "test_autograder_pipeline.py")
+                 "test_hub.py", "test_ros2cli_interface_builds.py", "test_browser_validate.py", "test_autograder.py",
+                 "test_lesson_commands.py", "test_autograder_pipeline.py")
 
 
 #: Set to 1 to run the lessons under nbmake even when tests/test_browser.py runs them in Chromium.
