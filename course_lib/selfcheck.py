@@ -277,30 +277,47 @@ def _message_type_name(cls) -> str:
     return f"{module[0]}/{module[1]}/{cls.__name__}" if len(module) > 1 else cls.__name__
 
 
-def publisher_exercise(node_or_class, topic: str = "/announcements", prefix: str = "Announcement ",
-                       period: float = 0.5) -> Verdict:
-    """Exercise (lesson 01): a node that publishes std_msgs/String "Announcement N" (N = 0, 1, ...)
-    on /announcements every 0.5 s. The check runs the node briefly and listens to it."""
-    import statistics
-    import time
+def _seconds(value: float) -> str:
+    return f"{value:g} s"
 
+
+def _depth_problem(endpoint, asked: int, what: str, call: str) -> Verdict | None:
+    """A Verdict when a publisher's or subscription's queue is not the asked depth (found vs asked)."""
+    from rclpy.qos import HistoryPolicy
+
+    qos = endpoint.qos_profile
+    if qos.history == HistoryPolicy.KEEP_ALL:
+        return _verdict(False, f"The {what} keeps all messages (KEEP_ALL history); the exercise asks for a queue "
+                               f"depth of {asked}: pass the depth as the last argument of {call}.")
+    if qos.depth != asked:
+        return _verdict(False, f"The {what} has queue depth {qos.depth}; the exercise asks for {asked}: pass "
+                               f"{asked} as the last argument of {call}.")
+    return None
+
+
+def publisher_exercise(node_or_class, topic: str = "/announcements", prefix: str = "Announcement ",
+                       period: float = 0.5, depth: int = 10) -> Verdict:
+    """Exercise (lesson 01): a node that publishes std_msgs/String "Announcement N" (N = 0, 1, ...)
+    on /announcements (queue depth 10) every 0.5 s. The period is read from the node's timers; then
+    the check runs the node until it published three times and listens to it."""
     from std_msgs.msg import String
 
     from course_lib import session
+    from course_lib.checks.context import scaled
 
     hint = (f"Pass your node class; in __init__ create a publisher of String on {topic.lstrip('/')!r} and a "
-            f"timer of {period} s whose callback publishes '{prefix}0', '{prefix}1', ...")
+            f"timer that calls a method every {_seconds(period)}; the method publishes '{prefix}0', '{prefix}1', ...")
     node, problem = _exercise_node(node_or_class, "Announcer", hint)
     if problem is not None:
         return problem
     tool = session.tool_node()
-    heard: list[tuple[float, str]] = []
+    heard: list[str] = []
     listener = None
     try:
         publishers = [p for p in node.publishers if p.topic_name != "/parameter_events"]
         if not publishers:
             return _verdict(False, "Not done yet: the node has no publisher. In __init__: self.publisher = "
-                                   f"self.create_publisher(String, {topic.lstrip('/')!r}, 10).")
+                                   f"self.create_publisher(String, {topic.lstrip('/')!r}, {depth}).")
         mine = [p for p in publishers if p.topic_name == topic]
         if not mine:
             names = ", ".join(p.topic_name for p in publishers)
@@ -309,28 +326,38 @@ def publisher_exercise(node_or_class, topic: str = "/announcements", prefix: str
         if mine[0].msg_type is not String:
             return _verdict(False, f"The publisher sends {_message_type_name(mine[0].msg_type)}; the exercise asks "
                                    "for std_msgs/msg/String (from std_msgs.msg import String).")
-        listener = tool.create_subscription(String, topic, lambda msg: heard.append((time.monotonic(), msg.data)), 10)
-        session.wait_for(lambda: len(heard) >= 3, timeout=3 * period + 1.0)
+        if (problem := _depth_problem(mine[0], depth, "publisher", "create_publisher")) is not None:
+            return problem
+        timers = list(node.timers)
+        if not timers:
+            return _verdict(False, "Not done yet: the node has no timer. In __init__: "
+                                   f"self.create_timer({period}, self.announce).")
+        periods = [timer.timer_period_ns * 1e-9 for timer in timers]
+        on_time = [timer for timer, p in zip(timers, periods) if abs(p - period) < 1e-3]
+        if not on_time:
+            found = " and every ".join(_seconds(p) for p in sorted(set(periods)))
+            return _verdict(False, f"The node's timer fires every {found}; the exercise asks for every "
+                                   f"{_seconds(period)}: the first argument of create_timer is the period in seconds.")
+        ticks = _count_calls(on_time[0])
+        listener = tool.create_subscription(String, topic, lambda msg: heard.append(msg.data), depth)
+        session.wait_for(lambda: mine[0].get_subscription_count() > 0, timeout=scaled(5.0))
+        ticks.clear()
+        # Three messages, or a timer that fired four times without one (one tick's grace for delivery).
+        session.wait_for(lambda: len(heard) >= 3 or (not heard and len(ticks) >= 4), timeout=scaled(6 * period + 2))
         if not heard:
-            return _verdict(False, f"No message arrived on {topic} in {3 * period + 1:g} s. Does __init__ create a "
-                                   f"timer (self.create_timer({period}, self.announce)), and does its callback call "
-                                   "self.publisher.publish(String(data=...))?")
-        texts = [text for _, text in heard]
-        numbers = [text[len(prefix):] for text in texts if text.startswith(prefix)]
-        if len(numbers) != len(texts) or not all(n.isdigit() for n in numbers):
-            return _verdict(False, f"The node sent {texts[0]!r}; the exercise asks for '{prefix}0', then "
-                                   f"'{prefix}1', and so on (an f-string: f'{prefix}{{self.count}}').")
+            return _verdict(False, f"The node's timer fires every {_seconds(period)}, but no message arrived on "
+                                   f"{topic} after {len(ticks)} of its calls: does the method the timer calls "
+                                   "publish a String with the node's publisher?")
+        numbers = [text[len(prefix):] for text in heard if text.startswith(prefix)]
+        if len(numbers) != len(heard) or not all(n.isdigit() for n in numbers):
+            return _verdict(False, f"The node sent {heard[0]!r}; the exercise asks for '{prefix}0', then "
+                                   f"'{prefix}1', and so on: put the count into the text.")
         counts = [int(n) for n in numbers]
         if any(b != a + 1 for a, b in zip(counts, counts[1:])):
-            return _verdict(False, f"The numbers go {counts}: count up by one per message (self.count += 1 after "
-                                   "publishing, with self.count = 0 in __init__).")
-        if len(heard) >= 2:
-            gap = statistics.median(b - a for (a, _), (b, _) in zip(heard, heard[1:]))
-            if not 0.5 * period <= gap <= 1.6 * period:
-                return _verdict(False, f"Messages come every {gap:.2f} s; the exercise asks for every {period} s: "
-                                       f"self.create_timer({period}, ...).")
-        return _verdict(True, f"The node publishes {texts[0]!r}, {texts[1] if len(texts) > 1 else '...'!r} ... on "
-                              f"{topic}, every {period} s. In a terminal: ros2 topic echo {topic}.")
+            return _verdict(False, f"The numbers go {counts}: count up by one per message, starting from 0.")
+        return _verdict(True, f"The node's timer fires every {_seconds(period)} and it publishes {heard[0]!r}, "
+                              f"{heard[1] if len(heard) > 1 else '...'!r} ... on {topic}. In a terminal: "
+                              f"ros2 topic echo {topic}.")
     finally:
         if listener is not None:
             tool.destroy_subscription(listener)
@@ -340,7 +367,23 @@ def publisher_exercise(node_or_class, topic: str = "/announcements", prefix: str
             pass
 
 
-def subscriber_exercise(node_or_class, msg_type, topic: str = "/ros_tutorial_msg") -> Verdict:
+def _count_calls(timer) -> list:
+    """A list that gets an entry each time `timer`'s callback has run (the executor reads
+    timer.callback at every call)."""
+    calls: list = []
+    callback = timer.callback
+
+    def counted(*args):
+        try:
+            return callback(*args)
+        finally:
+            calls.append(None)
+
+    timer.callback = counted
+    return calls
+
+
+def subscriber_exercise(node_or_class, msg_type, topic: str = "/ros_tutorial_msg", depth: int = 100) -> Verdict:
     """Exercise (lesson 01b): a node subscribed to ros_tutorial_msg (MsgTutorial, depth 100) that
     appends (stamp in seconds, data) to self.received for every message. The check sends it three
     messages of its own, marked by negative data, and looks at what the node kept."""
@@ -371,7 +414,7 @@ def subscriber_exercise(node_or_class, msg_type, topic: str = "/ros_tutorial_msg
         if not subscriptions:
             return _verdict(False, "Not done yet: the node has no subscription. In __init__: "
                                    f"self.create_subscription({msg_type.__name__}, {topic.lstrip('/')!r}, "
-                                   "self.on_message, 100).")
+                                   f"self.on_message, {depth}).")
         mine = [s for s in subscriptions if s.topic_name == topic]
         if not mine:
             names = ", ".join(s.topic_name for s in subscriptions)
@@ -379,10 +422,12 @@ def subscriber_exercise(node_or_class, msg_type, topic: str = "/ros_tutorial_msg
         if mine[0].msg_type is not msg_type:
             return _verdict(False, f"The subscription takes {_message_type_name(mine[0].msg_type)}; the publisher "
                                    f"sends {_message_type_name(msg_type)}, so nothing would ever arrive.")
+        if (problem := _depth_problem(mine[0], depth, "subscription", "create_subscription")) is not None:
+            return problem
         if not isinstance(getattr(node, "received", None), list):
             return _verdict(False, "Keep what arrives in a list self.received, created empty in __init__ "
                                    "(self.received = []).")
-        publisher = tool.create_publisher(msg_type, topic, QoSProfile(depth=100))
+        publisher = tool.create_publisher(msg_type, topic, QoSProfile(depth=depth))
         session.wait_for(lambda: publisher.get_subscription_count() > 0, timeout=3.0)
         for msg, _ in sent:
             publisher.publish(msg)

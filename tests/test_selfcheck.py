@@ -154,7 +154,8 @@ def test_task4_catches_taking_the_two_highest_points_as_the_top():
 
 # --- the exercises of lessons 01 (a publisher) and 01b (the MsgTutorial subscriber) -----------
 
-def _announcer(period=0.5, topic="announcements", text="Announcement {}", msg_type=None, publish=True):
+def _announcer(period=0.5, topic="announcements", text="Announcement {}", msg_type=None, timer=True, depth=10,
+               publish=True):
     """A publisher node class for the lesson 01 exercise, right by default, wrong as asked."""
     from std_msgs.msg import String
 
@@ -162,12 +163,13 @@ def _announcer(period=0.5, topic="announcements", text="Announcement {}", msg_ty
         def __init__(self):
             super().__init__("announcer")
             self.count = 0
-            self.publisher = self.create_publisher(msg_type or String, topic, 10)
-            if publish:
+            self.publisher = self.create_publisher(msg_type or String, topic, depth)
+            if timer:
                 self.create_timer(period, self.announce)
 
         def announce(self):
-            self.publisher.publish(String(data=text.format(self.count)))
+            if publish:
+                self.publisher.publish(String(data=text.format(self.count)))
             self.count += 1
 
     return Announcer
@@ -198,21 +200,32 @@ def test_publisher_exercise_passes_a_correct_node(exercise_session):
     (None, "Not done yet"),
     (AnnouncerStub, "Not done yet: the node has no publisher"),
     (_announcer(topic="announcement"), "not on /announcements"),
-    (_announcer(publish=False), "No message arrived"),
+    (_announcer(timer=False), "Not done yet: the node has no timer"),
+    (_announcer(publish=False), "but no message arrived on /announcements after"),
     (_announcer(text="Announcement"), "'Announcement 0', then"),
-    (_announcer(period=0.1), "every 0.5 s"),
+    (_announcer(period=0.1), "every 0.1 s; the exercise asks for every 0.5 s"),
+    (_announcer(depth=1), "queue depth 1; the exercise asks for 10"),
 ])
 def test_publisher_exercise_names_what_is_wrong(exercise_session, answer, named):
     verdict = selfcheck.publisher_exercise(answer)
     assert not verdict and named in str(verdict), verdict
 
 
-def _tutorial_listener(keep, topic="ros_tutorial_msg", msg_type=Header):
+@pytest.mark.parametrize("period", [2.0, 5.0])
+def test_publisher_exercise_judges_the_timer_period_the_node_has(exercise_session, period):
+    """A slow timer fails by its period, read from the node's timer (not from how many messages came
+    in a moment): a 2 s timer does not pass as "every 0.5 s", a 5 s one is not "no timer"."""
+    verdict = selfcheck.publisher_exercise(_announcer(period=period))
+    assert not verdict and f"every {period:g} s; the exercise asks for every 0.5 s" in str(verdict), verdict
+    assert "create a timer" not in str(verdict)
+
+
+def _tutorial_listener(keep, topic="ros_tutorial_msg", msg_type=Header, depth=100):
     class TutorialListener(Node):
         def __init__(self):
             super().__init__("tutorial_listener")
             self.received = []
-            self.create_subscription(msg_type, topic, self.on_message, 100)
+            self.create_subscription(msg_type, topic, self.on_message, depth)
 
         def on_message(self, msg):
             self.received.append(keep(msg))
@@ -238,6 +251,8 @@ class ListenerStub(Node):
     (_tutorial_listener(lambda msg: (int(msg.frame_id), _stamp(msg))), "(stamp, data), not (data, stamp)"),
     (_tutorial_listener(lambda msg: (_stamp(msg), int(msg.frame_id)), topic="chatter"), "not to /ros_tutorial_msg"),
     (_tutorial_listener(lambda msg: (_stamp(msg), 0)), "has none of them"),
+    (_tutorial_listener(lambda msg: (_stamp(msg), int(msg.frame_id)), depth=10),
+     "queue depth 10; the exercise asks for 100"),
 ])
 def test_subscriber_exercise(exercise_session, answer, named):
     """Header stands in for MsgTutorial (its counter in frame_id), as in lesson 01b without a build."""
