@@ -316,8 +316,9 @@ def publisher_exercise(node_or_class, topic: str = "/announcements", prefix: str
     try:
         publishers = [p for p in node.publishers if p.topic_name != "/parameter_events"]
         if not publishers:
-            return _verdict(False, "Not done yet: the node has no publisher. In __init__: self.publisher = "
-                                   f"self.create_publisher(String, {topic.lstrip('/')!r}, {depth}).")
+            return _verdict(False, "Not done yet: the node has no publisher. In __init__, create one with "
+                                   "self.create_publisher, giving it the message type, the topic and the queue "
+                                   "depth, as the talker of §2 does.")
         mine = [p for p in publishers if p.topic_name == topic]
         if not mine:
             names = ", ".join(p.topic_name for p in publishers)
@@ -330,8 +331,9 @@ def publisher_exercise(node_or_class, topic: str = "/announcements", prefix: str
             return problem
         timers = list(node.timers)
         if not timers:
-            return _verdict(False, "Not done yet: the node has no timer. In __init__: "
-                                   f"self.create_timer({period}, self.announce).")
+            return _verdict(False, "Not done yet: the node has no timer. In __init__, create one with "
+                                   "self.create_timer, giving it the period in seconds and the method to call, as "
+                                   "the talker of §2 does.")
         periods = [timer.timer_period_ns * 1e-9 for timer in timers]
         on_time = [timer for timer, p in zip(timers, periods) if abs(p - period) < 1e-3]
         if not on_time:
@@ -412,9 +414,9 @@ def subscriber_exercise(node_or_class, msg_type, topic: str = "/ros_tutorial_msg
     try:
         subscriptions = [s for s in node.subscriptions]
         if not subscriptions:
-            return _verdict(False, "Not done yet: the node has no subscription. In __init__: "
-                                   f"self.create_subscription({msg_type.__name__}, {topic.lstrip('/')!r}, "
-                                   f"self.on_message, {depth}).")
+            return _verdict(False, "Not done yet: the node has no subscription. In __init__, create one with "
+                                   "self.create_subscription, giving it the message type, the topic, the method "
+                                   "to call for each message and the queue depth, as topic_subscriber does.")
         mine = [s for s in subscriptions if s.topic_name == topic]
         if not mine:
             names = ", ".join(s.topic_name for s in subscriptions)
@@ -666,9 +668,10 @@ def _package_files(ws) -> Verdict | None:
             return _verdict(False, f"setup.py calls the executable {others[0]!r}; `ros2 run {BRIGHTNESS_PACKAGE} "
                                    f"{BRIGHTNESS_EXECUTABLE}` needs it to be called {BRIGHTNESS_EXECUTABLE!r} (the name "
                                    "left of the = in console_scripts).")
-        return _verdict(False, f"Not done yet: setup.py has no executable {BRIGHTNESS_EXECUTABLE}. Add the entry "
-                               f"{BRIGHTNESS_ENTRY_POINT!r} to the list of 'console_scripts' (executable = "
-                               "module:function).")
+        return _verdict(False, f"Not done yet: setup.py has no executable {BRIGHTNESS_EXECUTABLE}. Add an entry for "
+                               "it to the list of 'console_scripts': 'executable = module:function', where the "
+                               "module is the node file's (package folder, a dot, file name without .py) and the "
+                               "function the one the executable calls.")
     target = scripts[BRIGHTNESS_EXECUTABLE]
     if target != wanted:
         module, colon, function = target.partition(":")
@@ -679,8 +682,7 @@ def _package_files(ws) -> Verdict | None:
                    f"file name without .py), not {module}")
         else:
             why = f"the function to call is main, not {function}"
-        return _verdict(False, f"setup.py runs {target!r} for {BRIGHTNESS_EXECUTABLE}: {why}. Write "
-                               f"{BRIGHTNESS_ENTRY_POINT!r}.")
+        return _verdict(False, f"setup.py runs {target!r} for {BRIGHTNESS_EXECUTABLE}: {why}.")
     return None
 
 
@@ -794,8 +796,8 @@ def _run_brightness_node(ws) -> Verdict:
             probe.spin_until(lambda: all(_node_endpoints(probe, name, namespace)) or not process.running(), 5.0)
             subscriptions, publishers = _node_endpoints(probe, name, namespace)
             if not subscriptions:
-                return _verdict(False, "The node subscribes to nothing: in __init__, self.create_subscription(Image, "
-                                       "'image', self.on_image, qos_profile_sensor_data).")
+                return _verdict(False, "The node subscribes to nothing: create its subscription of 'image' in "
+                                       "__init__, where rclpy.spin finds it.")
             if CHECK_CAMERA_TOPIC not in subscriptions:
                 topic = next(iter(subscriptions))
                 return _verdict(False, f"Started with -r /image:={CHECK_CAMERA_TOPIC}, the node still subscribes "
@@ -806,8 +808,8 @@ def _run_brightness_node(ws) -> Verdict:
                                        "frames are sensor_msgs/msg/Image.")
             if "/brightness" not in publishers:
                 shown = ", ".join(publishers) or "nothing"
-                return _verdict(False, f"The node publishes {shown}, not /brightness: "
-                                       "self.create_publisher(UInt8, 'brightness', qos_profile_sensor_data).")
+                return _verdict(False, f"The node publishes {shown}, not /brightness: create its publisher "
+                                       "of 'brightness' in __init__.")
             if publishers["/brightness"] != ["std_msgs/msg/UInt8"]:
                 return _verdict(False, f"The node publishes {publishers['/brightness'][0]} on /brightness; the "
                                        "exercise (and the assignment) publish std_msgs/msg/UInt8, a number 0-255.")
@@ -840,8 +842,8 @@ def _run_brightness_node(ws) -> Verdict:
                                            f"({process.describe_exit()}).{_crash_text(process)}")
                 if not replies:
                     return _verdict(False, "The check sent frames on the remapped topic, but nothing came back on "
-                                           "/brightness in 3 s: does on_image publish, self.publisher.publish("
-                                           "UInt8(data=...))?")
+                                           "/brightness in 3 s: does on_image publish a UInt8 with the node's "
+                                           "publisher?")
                 if replies[0] != expected:
                     return _verdict(False, f"For a frame 80 wide and 60 high whose centre pixel (row 30, column 40) is "
                                            f"(blue, green, red) = {tuple(int(v) for v in frame[30, 40])}, the node "

@@ -1,5 +1,7 @@
 """Tests for course_lib.selfcheck: stubs get 'not done yet', wrong answers a specific hint."""
 
+import re
+
 import lesson_answers
 import pytest
 from rclpy.node import Node
@@ -211,6 +213,19 @@ def test_publisher_exercise_names_what_is_wrong(exercise_session, answer, named)
     assert not verdict and named in str(verdict), verdict
 
 
+#: A call written out with its arguments, as in "self.create_publisher(String, 'announcements', 10)".
+CALL_WITH_ARGUMENTS = re.compile(r"\w+\([^()]*,[^()]*\)")
+
+
+@pytest.mark.parametrize("stub, named", [
+    (AnnouncerStub, "no publisher"),
+    (_announcer(timer=False), "no timer"),
+])
+def test_publisher_exercise_stub_hints_say_what_to_do_without_the_line_to_write(exercise_session, stub, named):
+    text = str(selfcheck.publisher_exercise(stub))
+    assert "Not done yet" in text and named in text and not CALL_WITH_ARGUMENTS.search(text), text
+
+
 @pytest.mark.parametrize("period", [2.0, 5.0])
 def test_publisher_exercise_judges_the_timer_period_the_node_has(exercise_session, period):
     """A slow timer fails by its period, read from the node's timer (not from how many messages came
@@ -261,6 +276,11 @@ def test_subscriber_exercise(exercise_session, answer, named):
         assert verdict, verdict
     else:
         assert not verdict and named in str(verdict), verdict
+
+
+def test_subscriber_exercise_stub_hint_says_what_to_do_without_the_line_to_write(exercise_session):
+    text = str(selfcheck.subscriber_exercise(ListenerStub, Header))
+    assert "Not done yet" in text and not CALL_WITH_ARGUMENTS.search(text), text
 
 
 def test_subscriber_exercise_with_a_data_field(exercise_session):
@@ -400,6 +420,13 @@ def test_brightness_package_check_names_what_is_missing_before_starting_anything
         brightness_package(tmp_path, node, setup, dependencies or ("rclpy", "sensor_msgs", "std_msgs"))
     verdict = selfcheck.brightness_package_exercise(tmp_path)
     assert not verdict and expected in str(verdict), str(verdict)
+
+
+def test_brightness_package_setup_py_stub_hint_does_not_give_the_entry_point(tmp_path):
+    brightness_package(tmp_path, ANSWER_NODE, SETUP_STUB)
+    text = str(selfcheck.brightness_package_exercise(tmp_path))
+    assert "Not done yet" in text and "console_scripts" in text, text
+    assert selfcheck.BRIGHTNESS_ENTRY_POINT not in text and "brightness.brightness_node:main" not in text, text
 
 
 @pytest.fixture(scope="module")
