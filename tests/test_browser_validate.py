@@ -113,8 +113,8 @@ def test_validate_fails_a_wrong_average_and_shows_the_failing_checks(browser, la
     failed = re.findall(r"The following cell failed:\s*#[^\n]*\nchecks\.selfcheck\('(\w+)'\)", result.text)
     assert failed == ["values", "node"], said(result, lab)
     # A wrong number fails the self-checks, without a crash or a timeout: each check ran, and
-    # Validate lists what to fix (the ✘ lines), not a bare "Partial credit".
-    assert result.text.count("What to fix:") == 2 and "✘" in result.text, said(result, lab)
+    # Validate lists its verdict (what failed, ✘, and what passed), not a bare "Partial credit".
+    assert result.text.count("[self-check · seed") == 2 and "✘" in result.text, said(result, lab)
     assert "Partial credit" not in result.text, said(result, lab)
     assert "Traceback" not in result.text and "CellTimeoutError" not in result.text, said(result, lab)
 

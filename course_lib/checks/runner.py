@@ -45,17 +45,17 @@ from pathlib import Path
 
 from course_lib import contract
 from course_lib.checks.registry import get_check
-from course_lib.checks.result import Result, images_html, points_text, verdict_text
+from course_lib.checks.result import Result, images_html, verdict_text
 
 #: The fixed seed of self-checks (what the student sees when running the notebook).
 SELFCHECK_SEED = 2024
 
 
 def selfcheck(assignment: str, name: str) -> None:
-    """Run a check with the fixed self-check seed and print what passed and failed; when points
-    were lost, also write what to fix to stderr, where nbgrader's Validate looks for a cell's
-    errors (it then lists those lines instead of a bare "Partial credit"). Returns nothing, so that
-    the cell does not end with a bare number.
+    """Run a check with the fixed self-check seed and print its verdict once: what passed and what
+    failed. When points were lost the verdict goes to stderr, where nbgrader's Validate looks for
+    a cell's errors (it then lists the verdict instead of a bare "Partial credit"), else to stdout.
+    Returns nothing, so that the cell does not end with a bare number.
 
     Under grading (COURSE_LIB_GRADING=1) it does nothing: the hidden test that follows it in the
     same cell runs the check with a fresh seed.
@@ -64,12 +64,11 @@ def selfcheck(assignment: str, name: str) -> None:
 
     if rosenv.under_grading():
         return
-    result = run_check(assignment, name, SELFCHECK_SEED)
-    if result.points < result.max_points:
-        lines = [line.strip() for line in result.verdict_lines() if line.lstrip().startswith(("✘", "↳", "!"))]
-        sys.stderr.write(f"Self-check {name}: {points_text(result.points)} of {points_text(result.max_points)} points. "
-                         "What to fix:\n" + "\n".join(lines) + "\n")
-        sys.stderr.flush()
+    result = execute(assignment, name, SELFCHECK_SEED)
+    stream = sys.stderr if result.points < result.max_points else sys.stdout
+    stream.write(verdict_text(result, graded=False) + "\n")
+    stream.flush()
+    _display_images(result)
 
 
 #: Set by the course's grader (autograder.grading) for the notebook run: the hidden tests do not
