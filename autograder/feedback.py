@@ -16,6 +16,7 @@ import html
 from pathlib import Path
 
 from autograder import nbgrader_cli, store
+from course_lib.checks.result import points_text
 
 #: Added to nbgrader's feedback pages: output lines (the verdicts) wrap at the page's width.
 WRAP_STYLE = ("<style id='autograder-wrap'>div.output_area pre, div.output_subarea pre "
@@ -55,7 +56,7 @@ def _write_index(course: Path, student: str, results: list) -> Path:
     for r in results:
         links = " ".join(f"<a href='{html.escape(p.relative_to(folder).as_posix())}'>{html.escape(p.stem)}</a>"
                          for p in sorted((folder / r.assignment).glob("*.html")))
-        checks = "".join(f"<li>{html.escape(c['cell'])}: {c['auto_score'] or 0:g} / {c['max_score']:g}</li>"
+        checks = "".join(f"<li>{html.escape(c['cell'])}: {points_text(c['auto_score'] or 0)} / {points_text(c['max_score'])}</li>"
                          for c in r.cells)
         reason = f"<pre>{html.escape(r.reason.strip())}</pre>" if r.reason.strip() else ""
         rows.append(f"<tr><td>{html.escape(r.assignment)}</td><td>{_score(gradebook.lateness(course, student, r.assignment), r)}</td>"
@@ -75,15 +76,15 @@ def _write_index(course: Path, student: str, results: list) -> Path:
 def _score(late: dict | None, result) -> str:
     """The score cell: the final score, and when there is a due date, the submission time and the penalty."""
     if late is None:
-        return f"{result.score:g} / {result.max_score:g}"
-    text = f"{late['score']:g} / {late['max_score']:g}"
+        return f"{points_text(result.score)} / {points_text(result.max_score)}"
+    text = f"{points_text(late['score'])} / {points_text(late['max_score'])}"
     if late["duedate"] is not None:
         text += f"<br><small>due {late['duedate']:%Y-%m-%d %H:%M} UTC"
         if late["timestamp"] is not None:
             text += f", submitted {late['timestamp']:%Y-%m-%d %H:%M} UTC"
         if late["seconds_late"] > 0:
-            text += (f"<br>late by {_duration(late['seconds_late'])}: {late['raw_score']:g} points "
-                     f"− late penalty {late['penalty']:g}")
+            text += (f"<br>late by {_duration(late['seconds_late'])}: {points_text(late['raw_score'])} points "
+                     f"− late penalty {points_text(late['penalty'])}")
         text += "</small>"
     return text
 

@@ -23,6 +23,8 @@ import math
 from nbgrader.plugins import LateSubmissionPlugin
 from traitlets import Dict, Float
 
+from course_lib.checks.result import round_points
+
 DAY = 24 * 3600.0
 
 
@@ -39,7 +41,7 @@ class LatePenalty(LateSubmissionPlugin):
         assignment = getattr(self.parent, "assignment_id", None)
         if assignment not in self.per_day:
             return super().late_submission_penalty(student_id, score, total_seconds_late)
-        return round(score * fraction(self.per_day[assignment], self.maximum, total_seconds_late), 3)
+        return round_points(score * fraction(self.per_day[assignment], self.maximum, total_seconds_late))
 
 
 def fraction(per_day: float, maximum: float, seconds_late: float) -> float:

@@ -52,6 +52,7 @@ from autograder.staging import private_copy, stage_grader
 from autograder.submissions import Submission, submission_digest
 from course_lib import contract, rosenv
 from course_lib.checks import context
+from course_lib.checks.result import round_points
 
 #: Seconds one submission's grading may take on an idle machine, every step included (issue #14:
 #: a hostile submission must not stall the class). Each step gets at most what is left of it.
@@ -332,7 +333,7 @@ def grade_submission(sub: Submission, course: Path, domain_id: int) -> GradeResu
         if grading.early is not None:  # a step raised: stop it before its folder goes
             grading.early.cancel()
         _remove_tree(grading.work)
-    result.score = round(sum(c["auto_score"] or 0 for c in result.cells), 3) if result.status != "failed" else 0.0
+    result.score = round_points(sum(c["auto_score"] or 0 for c in result.cells)) if result.status != "failed" else 0.0
     result.seconds = round(time.monotonic() - started, 1)
     return result
 

@@ -16,6 +16,7 @@ from pathlib import Path
 from autograder import packages, reference
 from course_lib import contract
 from course_lib.checks import answers, registry, runner
+from course_lib.checks.result import points_text
 
 ANSWER_KEYS = Path(__file__).resolve().parent / "answers"
 
@@ -48,7 +49,7 @@ def record_answers(assignments: list[str] | None = None) -> list[Path]:
                 for name in registry.checks_of(assignment):
                     result = runner.execute(assignment, name, runner.SELFCHECK_SEED, workdir=workdir, mode="record")
                     if result.points < result.max_points:
-                        raise RuntimeError(f"the reference solution got {result.points:g} of {result.max_points:g} "
+                        raise RuntimeError(f"the reference solution got {points_text(result.points)} of {points_text(result.max_points)} "
                                            f"points in {assignment}/{name}:\n" + "\n".join(result.verdict_lines()))
         finally:
             os.environ.pop(contract.BUILD_REPORT_ENV, None)

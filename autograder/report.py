@@ -15,6 +15,8 @@ import csv
 import os
 from pathlib import Path
 
+from course_lib.checks.result import points_text
+
 FILE_NAME = "grading_report.csv"
 
 FIELDS = ["student_id", "assignment", "score", "max_score", "status", "from_cache", "seconds", "isolation",
@@ -46,7 +48,7 @@ def write_report(course_dir, results=()) -> Path:
         writer.writerow(FIELDS)
         for key in sorted(rows):
             r = rows[key]
-            writer.writerow([r.student, r.assignment, f"{r.score:g}", f"{r.max_score:g}", r.status,
+            writer.writerow([r.student, r.assignment, points_text(r.score), points_text(r.max_score), r.status,
                              int(r.from_cache or key not in this_run), f"{r.seconds:g}", r.isolation,
                              _first_line(r.reason), _first_line(r.detail), step_seconds(r)])
     os.replace(temporary, path)

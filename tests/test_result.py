@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
-from course_lib.checks.result import Result
+import pytest
+
+from course_lib.checks.result import Result, earned_points, points_text, round_points
 
 
 def test_verdict_names_causes_first_then_their_consequences_then_what_passed():
@@ -19,3 +21,21 @@ def test_verdict_names_causes_first_then_their_consequences_then_what_passed():
         "  ✔ a node runs",
         "  ✔ publishes /brightness",
     ]
+
+
+@pytest.mark.parametrize("value, given", [(6.125, 6.13), (2.675, 2.68), (4.375, 4.38), (2.25, 2.25), (7, 7.0),
+                                          (7 * 2 / 3, 4.67), (0.004, 0.0)])
+def test_points_are_given_to_two_decimals_rounded_half_up(value, given):
+    """What nbgrader's feedback page shows (two decimals) is what the grader gives and records."""
+    assert round_points(value) == given
+
+
+def test_a_check_earns_its_share_of_points_as_the_grader_rounds_them():
+    """7 points, 7 of 8 items passed: 6.13, in the points and in the verdict alike."""
+    items = [{"ok": True, "message": f"item {i}", "weight": 1.0} for i in range(7)]
+    items.append({"ok": False, "message": "the last item", "weight": 1.0})
+    points = earned_points(7, items, failed=False)
+    assert points == 6.13 and points_text(points) == "6.13"
+    assert Result("brightness", "node", points, 7.0, 5, items=items).verdict_lines()[0] == "node: 6.13 of 7 points"
+    assert earned_points(7, items[-1:], failed=True) == 0.0 and earned_points(7, [], failed=False) == 0.0
+    assert earned_points(7, items, failed=True) == 6.13  # an error after items passed keeps their points

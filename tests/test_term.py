@@ -27,6 +27,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import course_support  # noqa: E402
 import zoo  # noqa: E402
 
+from course_lib.checks.result import round_points  # noqa: E402
+
 pytestmark = [pytest.mark.slow, pytest.mark.timeout(900)]
 
 REPO = Path(__file__).resolve().parent.parent
@@ -151,8 +153,8 @@ def test_export_has_every_student_and_assignment_with_the_late_penalty(term):
     bob = rows["bob", "pubsub"]
     raw = results["bob", "pubsub"].score
     assert float(bob["raw_score"]) == pytest.approx(raw)
-    assert float(bob["late_submission_penalty"]) == pytest.approx(round(raw * 2 * PER_DAY, 3))
-    assert float(bob["score"]) == pytest.approx(raw - round(raw * 2 * PER_DAY, 3))
+    assert float(bob["late_submission_penalty"]) == pytest.approx(round_points(raw * 2 * PER_DAY))
+    assert float(bob["score"]) == pytest.approx(raw - round_points(raw * 2 * PER_DAY))
     assert bob["last_name"] == "Baker, Jr."
     assert float(rows["alice", "pubsub"]["late_submission_penalty"]) == 0
     assert float(rows["alice", "pubsub"]["score"]) == 10

@@ -14,7 +14,7 @@ from pathlib import Path
 from course_lib import contract, processes
 from course_lib.checks.context import Context, StudentError
 from course_lib.checks.registry import get_check
-from course_lib.checks.result import Result
+from course_lib.checks.result import Result, earned_points
 from course_lib.checks.runner import SELFCHECK_SEED
 from course_lib.checks.student_processes import StudentProcesses
 
@@ -37,13 +37,8 @@ def run_in_this_process(assignment: str, name: str, seed: int, workdir: Path, ou
         error = "The checker itself failed (tell your instructor):\n" + traceback.format_exc(limit=4)
     finally:
         ctx.close()
-    total = sum(item["weight"] for item in ctx.items)
-    if error and not any(item["ok"] for item in ctx.items):
-        points = 0.0
-    else:
-        passed = sum(item["weight"] for item in ctx.items if item["ok"])
-        points = spec.points * passed / total if total else 0.0
-    return Result(assignment, name, round(points, 3), spec.points, seed, ctx.items, ctx.notes, ctx.images, error)
+    points = earned_points(spec.points, ctx.items, failed=error is not None)
+    return Result(assignment, name, points, spec.points, seed, ctx.items, ctx.notes, ctx.images, error)
 
 
 def main(argv=None) -> int:

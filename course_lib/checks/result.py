@@ -3,8 +3,14 @@
 from __future__ import annotations
 
 import dataclasses
+from decimal import ROUND_HALF_UP, Decimal
 
 from course_lib.checks.registry import get_check
+
+#: Points are given and shown to this many decimals, rounded half up. nbgrader's feedback page
+#: shows scores to two decimals, so the self-check, the grader, the gradebook, the grades file and
+#: every page agree on one number (7 points for 7 of 8 items: 6.125 is 6.13 everywhere).
+POINT_DECIMALS = 2
 
 
 @dataclasses.dataclass
@@ -40,9 +46,24 @@ class Result:
         return lines
 
 
+def round_points(value: float) -> float:
+    """Points as the grader gives them: POINT_DECIMALS decimals, rounded half up (6.125 -> 6.13)."""
+    step = Decimal(1).scaleb(-POINT_DECIMALS)
+    return float(Decimal(repr(float(value))).quantize(step, rounding=ROUND_HALF_UP))
+
+
+def earned_points(points: float, items: list[dict], failed: bool) -> float:
+    """What a check earns: its `points` × the weight of its passed items / the weight of all, rounded
+    by round_points; 0 when it `failed` (ended with an error) before any item passed."""
+    total = sum(item["weight"] for item in items)
+    if not total or (failed and not any(item["ok"] for item in items)):
+        return 0.0
+    return round_points(points * sum(item["weight"] for item in items if item["ok"]) / total)
+
+
 def points_text(value: float) -> str:
-    """Points as a verdict writes them: 4, 2.5, 0.333."""
-    return f"{value:g}"
+    """Points as a verdict writes them, rounded as the grader gives them: 4, 2.5, 6.13."""
+    return f"{round_points(value):g}"
 
 
 def verdict_text(result: Result, graded: bool) -> str:

@@ -27,7 +27,8 @@ gave for the self-check's inputs, recorded as data. Nothing a student can import
 a reference solution, and nothing the student's process can read holds a graded answer.
 
 Points: the check's items each pass or fail; the check earns ``points × passed weight / total
-weight``. The value of the test cell is that number, which nbgrader 0.9 takes as partial credit
+weight``, to two decimals (course_lib.checks.result.round_points). The value of the test cell is
+that number, which nbgrader 0.9 takes as partial credit
 (an ``execute_result`` that converts to float; an error or anything on stderr gives 0).
 """
 
@@ -45,7 +46,7 @@ from pathlib import Path
 
 from course_lib import contract
 from course_lib.checks.registry import get_check
-from course_lib.checks.result import Result, images_html, verdict_text
+from course_lib.checks.result import Result, images_html, round_points, verdict_text
 
 #: The fixed seed of self-checks (what the student sees when running the notebook).
 SELFCHECK_SEED = 2024
@@ -88,7 +89,7 @@ def grade(assignment: str, name: str) -> float:
         print(f"[graded] {get_check(assignment, name).description}\n"
               "  The autograder runs this check outside the notebook; its verdict replaces this text.")
         return 0.0
-    return round(run_check(assignment, name, fresh_seed(), graded=True).points, 3)
+    return round_points(run_check(assignment, name, fresh_seed(), graded=True).points)
 
 
 def fresh_seed() -> int:
