@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import argparse
 import importlib
 import os
 import signal
@@ -27,19 +28,32 @@ COMMANDS = {
 LEFT_OUT = ("bag", "component", "daemon", "doctor", "lifecycle", "multicast", "wtf")
 
 
-def usage() -> str:
+#: ros2cli's one option before the command (Jazzy), with its help text.
+BUFFERING_OPTION = "--use-python-default-buffering"
+BUFFERING_HELP = ("Do not force line buffering in stdout and instead use the python default buffering, which might "
+                  "be affected by PYTHONUNBUFFERED/-u and depends on whatever stdout is interactive or not")
+
+
+def parser() -> argparse.ArgumentParser:
+    """The top-level parser, laid out as ros2cli's: usage, description, options, the Commands
+    section (its "Call ..." line last); what the course's ros2 leaves out follows, as an epilog."""
+    top = argparse.ArgumentParser(
+        prog="ros2", description="ros2 is an extensible command-line tool for ROS 2.",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        epilog=f"This is the course's ros2 for the pip install of ROS 2 (course_lib.ros2cli): the commands above,\n"
+               f"with the verbs and options the course teaches; {FULL_INSTALL}\n({', '.join(LEFT_OUT)}).")
+    top.add_argument(BUFFERING_OPTION, action="store_true", default=False, help=BUFFERING_HELP)
     width = max(map(len, COMMANDS))
-    return "\n".join([
-        "usage: ros2 [-h] Call `ros2 <command> -h` for more detailed usage. ...", "",
-        "ros2 is an extensible command-line tool for ROS 2.", "",
-        "This is the course's ros2 for the pip install of ROS 2 (course_lib.ros2cli): the commands",
-        f"below, with the verbs and options the course teaches; {FULL_INSTALL}",
-        f"({', '.join(LEFT_OUT)}).", "",
-        "options:", "  -h, --help  show this help message and exit", "",
-        "Commands:",
-        *[f"  {name.ljust(width)}  {text}" for name, text in COMMANDS.items()], "",
-        "  Call `ros2 <command> -h` for more detailed usage.",
-    ])
+    commands = top.add_subparsers(
+        title="Commands", description="".join(f"{name.ljust(width)}  {text}\n" for name, text in COMMANDS.items()),
+        metavar="Call `ros2 <command> -h` for more detailed usage.", dest=" command")
+    for name in COMMANDS:
+        commands.add_parser(name, add_help=False)
+    return top
+
+
+def usage() -> str:
+    return parser().format_help().rstrip("\n")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -50,10 +64,13 @@ def main(argv: list[str] | None = None) -> int:
     ros2 does not support is one line on stderr (exit code 2).
     """
     argv = list(sys.argv[1:] if argv is None else argv)
-    try:
-        sys.stdout.reconfigure(line_buffering=True)  # ros2cli prints line by line, also into pipes
-    except AttributeError:  # stdout replaced by something without reconfigure (a notebook)
-        pass
+    if argv[:1] == [BUFFERING_OPTION]:
+        argv = argv[1:]
+    else:
+        try:
+            sys.stdout.reconfigure(line_buffering=True)  # ros2cli prints line by line, also into pipes
+        except AttributeError:  # stdout replaced by something without reconfigure (a notebook)
+            pass
     previous = _handle_signals()
     try:
         outcome = _dispatch(argv)
@@ -105,7 +122,7 @@ def _dispatch(argv: list[str]) -> int | str | None:
         return 0
     command, rest = argv[0], argv[1:]
     if command.startswith("-"):
-        raise unsupported(f"ros2 {command}", ["-h", "--help"])
+        raise unsupported(f"ros2 {command}", ["-h", "--help", BUFFERING_OPTION])
     if command not in COMMANDS:
         raise unsupported(f"ros2 {command}", sorted(COMMANDS))
     module = importlib.import_module(f"course_lib.ros2cli.{command}")
