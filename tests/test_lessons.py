@@ -20,15 +20,20 @@ def _cells(path: Path, kind: str) -> list[str]:
     return [cell.source for cell in nbformat.read(path, as_version=4).cells if cell.cell_type == kind]
 
 
+def _python(source: str) -> str:
+    """A code cell as Python: IPython's ! and % lines are no Python, and a `pass` in their place keeps
+    an `if` around them valid."""
+    return "\n".join(line[:len(line) - len(line.lstrip())] + "pass" if line.lstrip().startswith(("%", "!"))
+                     else line for line in source.splitlines())
+
+
 def _classes_and_functions(sources: list[str]) -> str:
     """The class and function definitions of these cells (without the cells' other statements)."""
     kept = []
     for source in sources:
         if source.startswith("%%writefile"):  # a file of a package, not the notebook's code
             continue
-        # IPython's ! and % lines are no Python: a `pass` in their place keeps an `if` around them valid.
-        source = "\n".join(line[:len(line) - len(line.lstrip())] + "pass" if line.lstrip().startswith(("%", "!"))
-                           else line for line in source.splitlines())
+        source = _python(source)
         tree = ast.parse(source)
         kept += [ast.get_source_segment(source, node) for node in tree.body
                  if isinstance(node, (ast.ClassDef, ast.FunctionDef, ast.Import, ast.ImportFrom))]
@@ -89,3 +94,17 @@ def test_lesson_02_exercise_uses_the_names_its_self_check_and_the_brightness_ass
     assert "!ros2 topic echo /brightness --once" in code
     text = "\n".join(_cells(LESSON_02, "markdown"))
     assert f"ros2 run {package} {executable} --ros-args -r /image:=/camera/image_raw" in text
+
+
+def test_no_lesson_prints_a_count_times_a_number_that_reads_as_hexadecimal():
+    """f"turned {k}x90°" prints "turned 0x90°" for k = 0, which reads as a hexadecimal number: a
+    lesson writes the product (0°, 90°) or words instead."""
+    for lesson in sorted(NOTEBOOKS.glob("*.ipynb")):
+        for source in _cells(lesson, "code"):
+            if source.startswith("%%writefile"):
+                continue
+            for node in ast.walk(ast.parse(_python(source))):
+                if isinstance(node, ast.JoinedStr):
+                    for value, text in zip(node.values, node.values[1:]):
+                        assert not (isinstance(value, ast.FormattedValue) and isinstance(text, ast.Constant)
+                                    and re.match(r"x\d", text.value)), f"{lesson.name}: {ast.unparse(node)}"
