@@ -162,11 +162,58 @@ def _failure_message(result: BuildResult) -> str:
         package = result.failed[0]
         log = result.log_path(package)
         details = log.read_text(errors="replace") if log.is_file() else result.output
+        setup_error = _setup_py_error(result.ws_dir, package, details)
+        if setup_error is not None:
+            if log.is_file():  # colcon ran setup.py outside its logging: its log has colcon's traceback only
+                with log.open("a") as stream:
+                    stream.write(f"--- {SETUP_PY_ERROR_TITLE}:\n{setup_error}\n---\n")
+            return (f"colcon build failed in package {package!r} (exit code {result.returncode}): "
+                    f"{SETUP_PY_ERROR_TITLE}:\n{setup_error}\nMend setup.py and build again "
+                    f"(this is also at the end of the package's log: {log}).")
         hint = _hint(details)
         return (f"colcon build failed in package {package!r} (exit code {result.returncode})."
                 f"{hint} Last lines of its log (full log: {log}):\n{_tail(details)}")
     return (f"colcon build failed (exit code {result.returncode}) before building a package. "
             f"Last lines of its output:\n{_tail(result.output)}")
+
+
+#: How a build error introduces what Python printed when colcon ran a package's setup.py.
+SETUP_PY_ERROR_TITLE = "colcon runs setup.py to read the package (name, version, entry points), and Python stopped it"
+
+
+def _setup_py_error(ws_dir: Path, package: str, log: str) -> str | None:
+    """What Python prints for the package's setup.py when colcon failed to read it (colcon's log then
+    holds only its own CalledProcessError; the error went to the console, with the file shown as
+    "<string>"); None when the failure was another one. setup.py runs again as a script, in its
+    folder, so that the error names the file and line."""
+    if "get_setup_information" not in log:
+        return None
+    folder = package_dir(ws_dir, package)
+    if folder is None or not (folder / "setup.py").is_file():
+        return None
+    try:
+        done = subprocess.run([sys.executable, "setup.py", "--name"], cwd=folder, env=build_environment(),
+                              capture_output=True, text=True, errors="replace", stdin=subprocess.DEVNULL, timeout=60)
+    except subprocess.TimeoutExpired:
+        return f"{folder / 'setup.py'} did not finish within 60 s when run as a script"
+    return done.stderr.lstrip("\n").rstrip() or None if done.returncode else None
+
+
+def package_dir(ws_dir, name: str) -> Path | None:
+    """The folder below the workspace's src/ whose package.xml names the package `name`, as colcon
+    finds it (folders with a COLCON_IGNORE file are left out); None when there is none."""
+    import xml.etree.ElementTree as ElementTree
+
+    for package_xml in sorted(Path(ws_dir, "src").rglob("package.xml")):
+        if any((parent / "COLCON_IGNORE").exists() for parent in package_xml.parents):
+            continue
+        try:
+            found = ElementTree.parse(package_xml).findtext("name")
+        except ElementTree.ParseError:
+            continue
+        if found is not None and found.strip() == name:
+            return package_xml.parent
+    return None
 
 
 def _hint(log: str) -> str:

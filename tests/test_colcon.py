@@ -39,7 +39,38 @@ def test_command_line_build_failure_exits_nonzero(tmp_path):
     done = subprocess.run([sys.executable, "-m", "course_lib", "build", str(tmp_path)],
                           capture_output=True, text=True, timeout=300, env=rosenv.ros_environment())
     assert done.returncode == 1
-    assert "failed in package 'bad_python_pkg'" in done.stderr
+    assert "failed in package 'bad_python_pkg'" in done.stderr and "setup.py is broken on purpose" in done.stderr
+
+
+@pytest.mark.slow
+def test_a_setup_py_syntax_error_is_shown_with_its_file_and_line_and_kept_in_the_log_named(tmp_path):
+    """colcon reads setup.py in a process of its own, whose error goes to the console only (with the
+    file shown as "<string>"); its package log holds colcon's CalledProcessError. The build error
+    shows what Python says about the file, as plain colcon in a shell shows it, and the log it
+    names ends with the same."""
+    package = pkg_create.create_package(tmp_path, "comma_pkg")
+    setup = package / "setup.py"
+    lines = setup.read_text().splitlines()
+    number = next(i for i, line in enumerate(lines, start=1) if "version=" in line)
+    lines[number - 1] = lines[number - 1].rstrip(",")
+    setup.write_text("\n".join(lines) + "\n")
+    with pytest.raises(colcon.BuildError) as caught:
+        colcon.build(tmp_path, timeout=300)
+    message = str(caught.value)
+    said = f'File "{setup}", line {number}'
+    assert said in message and "SyntaxError: invalid syntax. Perhaps you forgot a comma?" in message, message
+    assert "CalledProcessError" not in message, message
+    log = caught.value.result.log_path("comma_pkg")
+    assert str(log) in message
+    assert said in log.read_text() and "Perhaps you forgot a comma?" in log.read_text()
+
+
+def test_package_dir_finds_a_package_by_its_name_as_colcon_does(tmp_path):
+    pkg_create.create_package(tmp_path, "wanted")
+    ignored = pkg_create.create_package(tmp_path, "ignored")
+    (ignored / "COLCON_IGNORE").touch()
+    assert colcon.package_dir(tmp_path, "wanted") == tmp_path / "src" / "wanted"
+    assert colcon.package_dir(tmp_path, "ignored") is None and colcon.package_dir(tmp_path, "nowhere") is None
 
 
 def test_build_errors_name_a_missing_cmake_package_and_its_wheel():
