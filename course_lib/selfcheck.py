@@ -472,8 +472,33 @@ def subscriber_exercise(node_or_class, msg_type, topic: str = "/ros_tutorial_msg
             pass
 
 
-def _launch_nodes(path) -> list[dict]:
-    """What each node of a launch file would start with, without starting it."""
+#: What ros2 launch (launch_ros) logs, and skips, for a <param from=...> that is no file.
+_NOT_A_FILE = "Parameter file path is not a file: "
+
+
+def _parameter_file(path, temp_dir) -> str:
+    """A --params-file of a node as the launch file says it: ``$(find-pkg-share PKG)/...`` for a
+    file in a package's share folder, else its path; the parameters themselves, as one line of YAML,
+    for a file the launch wrote (a <param name= value=>)."""
+    from pathlib import Path
+
+    import yaml
+
+    from course_lib import ament
+
+    path = Path(path)
+    if path.is_relative_to(temp_dir):
+        return "parameters " + yaml.safe_dump(yaml.safe_load(path.read_text()), default_flow_style=True).strip()
+    for package, prefix in ament.packages().items():
+        share = prefix / "share" / package
+        if path.is_relative_to(share):
+            return f"$(find-pkg-share {package})/{path.relative_to(share).as_posix()}"
+    return str(path)
+
+
+def _launch_nodes(path) -> tuple[list[dict], list[str]]:
+    """What each node of a launch file would start with, without starting it; and the parameter
+    files it names that are no files (ros2 launch warns and skips them)."""
     from pathlib import Path
 
     from course_lib.launch.actions import run_launch_file
@@ -489,13 +514,18 @@ def _launch_nodes(path) -> list[dict]:
                 if flag == "-r" and not value.startswith("__"):
                     remaps.append(value)
                 elif flag == "--params-file":
-                    params.append(Path(value).read_text())
+                    params.append(_parameter_file(value, context.temp_dir()))
             nodes.append({"executable": "/".join(Path(command[0]).parts[-2:]), "output": node.output,
                           "name": node.node_name, "namespace": node.namespace, "remaps": sorted(remaps),
                           "parameter files": params})
-        return nodes
+        missing = [message[len(_NOT_A_FILE):] for _, message in context.warnings if message.startswith(_NOT_A_FILE)]
+        return nodes, missing
     finally:
         context.remove_files()
+
+
+def _listed(values) -> str:
+    return ", ".join(map(str, values)) if values else "none"
 
 
 def task_launch_yaml(yaml_file, xml_file) -> Verdict:
@@ -505,16 +535,23 @@ def task_launch_yaml(yaml_file, xml_file) -> Verdict:
     hint = ("Write the YAML file as a list under `launch:`, one `- node:` per <node> tag, with the keys pkg, "
             "exec, output, and lists `param:` and `remap:`.")
     try:
-        wanted = _launch_nodes(xml_file)
+        wanted, _ = _launch_nodes(xml_file)
     except (LaunchFileError, LookupError, OSError) as error:
         return _verdict(False, f"The XML launch file does not run ({error}); build the workspace and call "
                                "workspace.use_workspace(WS) first.")
     try:
-        given = _launch_nodes(yaml_file)
+        given, missing = _launch_nodes(yaml_file)
     except (LaunchFileError, LookupError, OSError) as error:
         return _verdict(False, f"Your YAML launch file cannot run: {error}")
     if not given:
         return _verdict(False, "Not done yet: your launch file starts no node. " + hint)
+    by_package = sorted({f for node in wanted for f in node["parameter files"] if f.startswith("$(find-pkg-share")})
+    why = ("$(find-pkg-share) finds the installed file wherever ros2 launch runs; a relative path is relative to "
+           "the folder it runs in, not to the launch file's")
+    if missing:
+        return _verdict(False, f"Your launch file names the parameter file {missing[0]}, which is no file (ros2 "
+                               "launch warns and starts the node without it)."
+                               + (f" The XML file names {by_package[0]}: {why}." if by_package else ""))
     if len(given) != len(wanted):
         return _verdict(False, f"Your launch file starts {len(given)} node(s); the XML file starts {len(wanted)}.")
     for index, (mine, theirs) in enumerate(zip(given, wanted), start=1):
@@ -523,8 +560,13 @@ def task_launch_yaml(yaml_file, xml_file) -> Verdict:
                                    f"{theirs['executable']} (pkg and exec, in the same order).")
         for key in ("output", "name", "namespace", "remaps", "parameter files"):
             if mine[key] != theirs[key]:
-                return _verdict(False, f"Node {index} ({theirs['executable']}): {key} is {mine[key]!r}, the XML "
-                                       f"file gives {theirs[key]!r}.")
+                if isinstance(mine[key], list):
+                    said = f"{key} are {_listed(mine[key])}, the XML file gives {_listed(theirs[key])}"
+                else:
+                    said = f"{key} is {mine[key]!r}, the XML file gives {theirs[key]!r}"
+                if key == "parameter files" and any(f in by_package for f in theirs[key]):
+                    said += f": {why}"
+                return _verdict(False, f"Node {index} ({theirs['executable']}): {said}.")
     return _verdict(True, f"Your YAML launch file starts the same {len(given)} nodes as the XML one.")
 
 
