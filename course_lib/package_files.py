@@ -78,3 +78,23 @@ def console_scripts(setup_py) -> dict[str, str]:
             if match:
                 scripts[match.group(1)] = match.group(2)
     return scripts
+
+
+def built_console_scripts(ws_dir, package: str) -> dict[str, str] | None:
+    """{executable: "module:function"} as the workspace's last build of an ament_python package
+    installed them: the ``entry_points.txt`` that setuptools wrote from setup.py (in build/ with
+    --symlink-install, where the installed scripts look them up, else in install/); None when there
+    is none (not built)."""
+    import configparser
+
+    ws_dir = Path(ws_dir)
+    found = sorted([*(ws_dir / "build" / package).glob("*.egg-info/entry_points.txt"),
+                    *(ws_dir / "install" / package).glob("lib/python*/site-packages/*.egg-info/entry_points.txt")],
+                   key=lambda path: path.stat().st_mtime)
+    if not found:
+        return None
+    parser = configparser.ConfigParser(delimiters=("=",))
+    parser.optionxform = str  # executable names keep their case
+    parser.read(found[-1])
+    return {name: value.replace(" ", "") for name, value in parser["console_scripts"].items()} \
+        if parser.has_section("console_scripts") else {}

@@ -728,8 +728,14 @@ def _package_files(ws) -> Verdict | None:
     return None
 
 
+def _entries(scripts: dict[str, str]) -> str:
+    return ", ".join(f"{name} = {target}" for name, target in sorted(scripts.items())) or "none"
+
+
 def _build_state(ws) -> Verdict | None:
     """Is what ros2 run would start built from the current files?"""
+    from course_lib import package_files
+
     install = ws / "install" / BRIGHTNESS_PACKAGE
     build = _BUILD_COMMAND.format(ws=ws)
     if not install.is_dir():
@@ -740,9 +746,15 @@ def _build_state(ws) -> Verdict | None:
                                f"again ({build}). A new or changed executable always needs a build, also with "
                                "--symlink-install.")
     source = ws / "src" / BRIGHTNESS_PACKAGE
+    # A %%writefile cell run again rewrites setup.py with the same text: what counts is whether the
+    # executables it declares are those the build installed.
     if (source / "setup.py").stat().st_mtime > script.stat().st_mtime + 0.5:
-        return _verdict(False, f"setup.py changed after the last build: build again ({build}); changes to setup.py "
-                               "need a build, also with --symlink-install.")
+        declared = package_files.console_scripts(source / "setup.py")
+        built = package_files.built_console_scripts(ws, BRIGHTNESS_PACKAGE)
+        if built != declared:
+            return _verdict(False, f"setup.py changed after the last build: its executables are "
+                                   f"{_entries(declared)}, the build installed {_entries(built or {})}. Build again "
+                                   f"({build}); changes to setup.py need a build, also with --symlink-install.")
     node_file = f"{BRIGHTNESS_EXECUTABLE}.py"
     for copy in install.glob(f"lib/python*/site-packages/{BRIGHTNESS_PACKAGE}/{node_file}"):
         if not copy.is_symlink() and copy.read_bytes() != (source / BRIGHTNESS_PACKAGE / node_file).read_bytes():

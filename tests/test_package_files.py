@@ -62,3 +62,20 @@ def test_dependencies_of_chosen_tags(tmp_path):
     (tmp_path / "package.xml").write_text(PACKAGE_XML)
     assert package_files.dependencies(tmp_path / "package.xml") == {"rclpy", "sensor_msgs", "std_msgs"}
     assert package_files.dependencies(tmp_path / "package.xml", ("test_depend",)) == {"ament_flake8"}
+
+
+def test_built_console_scripts_are_read_from_the_newest_egg_info_of_the_build(tmp_path):
+    """--symlink-install keeps the egg-info in build/, a copying build in install/; the last build's counts."""
+    import os
+
+    assert package_files.built_console_scripts(tmp_path, "pkg") is None
+    symlinked = tmp_path / "build/pkg/pkg.egg-info/entry_points.txt"
+    symlinked.parent.mkdir(parents=True)
+    symlinked.write_text("[console_scripts]\nTalker = pkg.talker:main\nlistener = pkg.listener:main\n")
+    assert package_files.built_console_scripts(tmp_path, "pkg") == {"Talker": "pkg.talker:main",
+                                                                    "listener": "pkg.listener:main"}
+    copied = tmp_path / "install/pkg/lib/python3.11/site-packages/pkg-0.0.0-py3.11.egg-info/entry_points.txt"
+    copied.parent.mkdir(parents=True)
+    copied.write_text("[console_scripts]\ntalker = pkg.talker:main\n")
+    os.utime(symlinked, (1, 1))
+    assert package_files.built_console_scripts(tmp_path, "pkg") == {"talker": "pkg.talker:main"}

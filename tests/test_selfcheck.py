@@ -473,19 +473,31 @@ def built_brightness(tmp_path_factory):
 
 
 @pytest.mark.slow
-def test_brightness_package_check_wants_a_build_after_setup_py_changes(built_brightness):
+def test_brightness_package_check_wants_a_build_after_setup_py_changes_not_after_it_is_written_again(
+        built_brightness):
+    """Running the %%writefile cell of setup.py again writes the same text, newer: no build is due. A
+    setup.py whose executables differ from those the build installed needs one."""
     import os
     import time
 
     setup = built_brightness / "src/brightness/setup.py"
     script = built_brightness / "install/brightness/lib/brightness/brightness_node"
-    before = setup.stat().st_mtime
-    os.utime(setup, (time.time() + 10, time.time() + 10))
+    text, before = setup.read_text(), setup.stat().st_mtime
+    later = (time.time() + 10, time.time() + 10)
     try:
+        os.utime(setup, later)
+        verdict = selfcheck.brightness_package_exercise(built_brightness)
+        assert verdict, str(verdict)
+        entry = f"'{selfcheck.BRIGHTNESS_ENTRY_POINT}',"
+        setup.write_text(text.replace(entry, entry + "\n            'other = brightness.other:main',"))
+        os.utime(setup, later)
         verdict = selfcheck.brightness_package_exercise(built_brightness)
     finally:
+        setup.write_text(text)
         os.utime(setup, (before, before))
-    assert not verdict and "setup.py changed after the last build" in str(verdict), str(verdict)
+    assert not verdict and "setup.py changed after the last build: its executables are brightness_node = " \
+                           "brightness.brightness_node:main, other = brightness.other:main, the build installed " \
+                           "brightness_node = brightness.brightness_node:main" in str(verdict), str(verdict)
     hidden = script.with_name("hidden")
     script.rename(hidden)  # built while setup.py had no entry point
     try:
