@@ -638,8 +638,8 @@ def task_picture_corners(function) -> Verdict:
 
 # ---- lesson 02: the brightness node as a package -----------------------------------------------
 
-#: The package and executable of lesson 02's exercise (the brightness assignment
-#: continues from this package).
+#: The package and executable of lesson 02's exercise (the brightness assignment asks for the
+#: same package, in its own notebook).
 BRIGHTNESS_PACKAGE = "brightness"
 BRIGHTNESS_EXECUTABLE = "brightness_node"
 BRIGHTNESS_ENTRY_POINT = f"{BRIGHTNESS_EXECUTABLE} = {BRIGHTNESS_PACKAGE}.{BRIGHTNESS_EXECUTABLE}:main"

@@ -108,3 +108,19 @@ def test_no_lesson_prints_a_count_times_a_number_that_reads_as_hexadecimal():
                     for value, text in zip(node.values, node.values[1:]):
                         assert not (isinstance(value, ast.FormattedValue) and isinstance(text, ast.Constant)
                                     and re.match(r"x\d", text.value)), f"{lesson.name}: {ast.unparse(node)}"
+
+
+def test_lesson_02_says_truly_where_the_brightness_assignment_starts():
+    """The assignment does not start from the lesson's files: its notebook, which is handed in and
+    graded, writes the same package into its own workspace ros2_ws. The lesson says so, and says to
+    copy the node there, instead of "the assignment continues from this very package"."""
+    from course_lib import selfcheck
+
+    package, executable = selfcheck.BRIGHTNESS_PACKAGE, selfcheck.BRIGHTNESS_EXECUTABLE
+    assignment = "\n".join(_cells(NOTEBOOKS.parent / "assignments/source/brightness/brightness.ipynb", "code"))
+    assert f"%%writefile ros2_ws/src/{package}/{package}/{executable}.py" in assignment
+    text = " ".join("\n".join(_cells(LESSON_02, "markdown")).split())
+    for claim in ("continues from this very package", "you start from this package", "continues from your"):
+        assert claim not in text
+    assert "in a workspace of its own (`ros2_ws`, next to the assignment's notebook)" in text
+    assert "Copy your `BrightnessNode` into the node file's cell there" in text
