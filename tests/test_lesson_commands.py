@@ -115,16 +115,6 @@ def shown_commands(notebook: str) -> list[str]:
     return numbered
 
 
-def lesson_files(notebook: str) -> dict[str, str]:
-    """{path: text} of the lesson's %%writefile cells."""
-    files = {}
-    for cell in json.loads((NOTEBOOKS / notebook).read_text())["cells"]:
-        first, _, body = "".join(cell["source"]).partition("\n")
-        if cell["cell_type"] == "code" and first.startswith("%%writefile"):
-            files[first.split(maxsplit=1)[1]] = body
-    return files
-
-
 def run_shell(command: str, ws: Path, env: dict) -> str:
     line = command.split("#")[0].replace("{WS}", str(ws))
     done = subprocess.run(["bash", "-c", line], env=env, capture_output=True, text=True, timeout=120,
@@ -158,7 +148,7 @@ def built(tmp_path_factory):
     ws = root / "packages_ws"
     (ws / "src").mkdir(parents=True)
     env = dict(os.environ)
-    files = lesson_files(LESSON)
+    files = lesson_answers.lesson_files(LESSON)
     outputs = {}
     for command in shown_commands(LESSON)[:4]:
         if command.startswith("cd {WS} && colcon"):
@@ -167,7 +157,7 @@ def built(tmp_path_factory):
                 (root / path).write_text(text)
         outputs[command] = run_shell(command, ws, env)
     # Lesson 02's exercise: the package brightness, in the same workspace, with a right answer.
-    files = lesson_files(LESSON_02)
+    files = lesson_answers.lesson_files(LESSON_02)
     files["brightness_ws/src/brightness/brightness/brightness_node.py"] = lesson_answers.brightness_node()
     files["brightness_ws/src/brightness/setup.py"] = lesson_answers.brightness_setup(
         files["brightness_ws/src/brightness/setup.py"])
@@ -243,7 +233,7 @@ def test_lesson_00_commands(tmp_path):
     """The lesson's package built as the lesson builds it, its node running: the ! lines print what it shows."""
     ws = tmp_path / "ros2_ws"
     pkg_create.create_package(ws, "my_package", dependencies=["rclpy"], node_name="my_node")
-    (ws / "src/my_package/my_package/my_node.py").write_text(lesson_files(LESSON_00)["ros2_ws/src/my_package/my_package/my_node.py"])
+    (ws / "src/my_package/my_package/my_node.py").write_text(lesson_answers.lesson_files(LESSON_00)["ros2_ws/src/my_package/my_package/my_node.py"])
     colcon.build(ws, ["my_package"])
     env = workspace.workspace_environment(ws)
     node = workspace.run(ws, "my_package", "my_node")
@@ -262,7 +252,7 @@ def test_lesson_01_commands(tmp_path):
     from rclpy.node import Node
     from std_msgs.msg import String
 
-    (tmp_path / "talker.py").write_text(lesson_files(LESSON_01)["nodes_01/talker.py"])
+    (tmp_path / "talker.py").write_text(lesson_answers.lesson_files(LESSON_01)["nodes_01/talker.py"])
     talker = processes.python_node("talker:main", name="talker", cwd=tmp_path)
     session.start()
     try:
