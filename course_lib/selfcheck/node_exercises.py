@@ -32,6 +32,23 @@ def _message_type_name(cls) -> str:
     return f"{module[0]}/{module[1]}/{cls.__name__}" if len(module) > 1 else cls.__name__
 
 
+def _endpoint(endpoints: list, topic: str, msg_type, depth: int, call: str, none: str, elsewhere: str,
+              wrong_type: str):
+    """(the node's publisher or subscription on `topic`, None), or (None, a Verdict): `none` when the
+    node has none at all, `elsewhere` (with {names} and {topic}) when they are on other topics,
+    `wrong_type` (with {found}) when it carries another type than `msg_type`, and what was found
+    and asked when its queue depth is not `depth`; `call` creates it (create_publisher)."""
+    if not endpoints:
+        return None, _verdict(False, none)
+    mine = [e for e in endpoints if e.topic_name == topic]
+    if not mine:
+        return None, _verdict(False, elsewhere.format(names=", ".join(e.topic_name for e in endpoints), topic=topic))
+    if mine[0].msg_type is not msg_type:
+        return None, _verdict(False, wrong_type.format(found=_message_type_name(mine[0].msg_type)))
+    what = "publisher" if call == "create_publisher" else "subscription"
+    return mine[0], _depth_problem(mine[0], depth, what, call)
+
+
 def _seconds(value: float) -> str:
     return f"{value:g} s"
 
@@ -69,20 +86,15 @@ def publisher_exercise(node_or_class, topic: str = "/announcements", prefix: str
     heard: list[str] = []
     listener = None
     try:
-        publishers = [p for p in node.publishers if p.topic_name != "/parameter_events"]
-        if not publishers:
-            return _verdict(False, "Not done yet: the node has no publisher. In __init__, create one with "
-                                   "self.create_publisher, giving it the message type, the topic and the queue "
-                                   "depth, as the talker of §2 does.")
-        mine = [p for p in publishers if p.topic_name == topic]
-        if not mine:
-            names = ", ".join(p.topic_name for p in publishers)
-            return _verdict(False, f"The node publishes on {names}, not on {topic}: check the topic name you pass "
-                                   "to create_publisher.")
-        if mine[0].msg_type is not String:
-            return _verdict(False, f"The publisher sends {_message_type_name(mine[0].msg_type)}; the exercise asks "
-                                   "for std_msgs/msg/String (from std_msgs.msg import String).")
-        if (problem := _depth_problem(mine[0], depth, "publisher", "create_publisher")) is not None:
+        publisher, problem = _endpoint(
+            [p for p in node.publishers if p.topic_name != "/parameter_events"], topic, String, depth,
+            "create_publisher",
+            "Not done yet: the node has no publisher. In __init__, create one with self.create_publisher, giving "
+            "it the message type, the topic and the queue depth, as the talker of §2 does.",
+            "The node publishes on {names}, not on {topic}: check the topic name you pass to create_publisher.",
+            "The publisher sends {found}; the exercise asks for std_msgs/msg/String (from std_msgs.msg import "
+            "String).")
+        if problem is not None:
             return problem
         timers = list(node.timers)
         if not timers:
@@ -97,7 +109,7 @@ def publisher_exercise(node_or_class, topic: str = "/announcements", prefix: str
                                    f"{_seconds(period)}: the first argument of create_timer is the period in seconds.")
         ticks = _count_calls(on_time[0])
         listener = tool.create_subscription(String, topic, lambda msg: heard.append(msg.data), depth)
-        session.wait_for(lambda: mine[0].get_subscription_count() > 0, timeout=scaled(5.0))
+        session.wait_for(lambda: publisher.get_subscription_count() > 0, timeout=scaled(5.0))
         ticks.clear()
         # Three messages, or a timer that fired four times without one (one tick's grace for delivery).
         session.wait_for(lambda: len(heard) >= 3 or (not heard and len(ticks) >= 4), timeout=scaled(6 * period + 2))
@@ -167,19 +179,15 @@ def subscriber_exercise(node_or_class, msg_type, topic: str = "/ros_tutorial_msg
     tool = session.tool_node()
     publisher = None
     try:
-        subscriptions = [s for s in node.subscriptions]
-        if not subscriptions:
-            return _verdict(False, "Not done yet: the node has no subscription. In __init__, create one with "
-                                   "self.create_subscription, giving it the message type, the topic, the method "
-                                   "to call for each message and the queue depth, as topic_subscriber does.")
-        mine = [s for s in subscriptions if s.topic_name == topic]
-        if not mine:
-            names = ", ".join(s.topic_name for s in subscriptions)
-            return _verdict(False, f"The node subscribes to {names}, not to {topic}: check the topic name.")
-        if mine[0].msg_type is not msg_type:
-            return _verdict(False, f"The subscription takes {_message_type_name(mine[0].msg_type)}; the publisher "
-                                   f"sends {_message_type_name(msg_type)}, so nothing would ever arrive.")
-        if (problem := _depth_problem(mine[0], depth, "subscription", "create_subscription")) is not None:
+        _, problem = _endpoint(
+            list(node.subscriptions), topic, msg_type, depth, "create_subscription",
+            "Not done yet: the node has no subscription. In __init__, create one with self.create_subscription, "
+            "giving it the message type, the topic, the method to call for each message and the queue depth, as "
+            "topic_subscriber does.",
+            "The node subscribes to {names}, not to {topic}: check the topic name.",
+            "The subscription takes {found}; the publisher sends " + _message_type_name(msg_type) + ", so nothing "
+            "would ever arrive.")
+        if problem is not None:
             return problem
         if not isinstance(getattr(node, "received", None), list):
             return _verdict(False, "Keep what arrives in a list self.received, created empty in __init__ "

@@ -4,7 +4,7 @@ and 03).
 
 from __future__ import annotations
 
-from course_lib.selfcheck.verdicts import Verdict, _call, _not_done, _verdict
+from course_lib.selfcheck.verdicts import Verdict, _call, _not_a_function, _not_done, _verdict
 
 def task1_node_name(answer, expected_node: str = "my_node") -> Verdict:
     """Task 1 (lesson 00): the name of the student's node as `ros2 node list` prints it."""
@@ -62,11 +62,8 @@ def task3_brightness_on_change(function) -> Verdict:
 
     hint = ("Write should_publish(last_sent, current, threshold) so that it returns True when nothing was "
             "sent yet (last_sent is None) or the brightness moved by more than threshold, else False.")
-    if (result := _not_done(function, hint)) is not None:
+    if (result := _not_a_function(function, "should_publish", hint)) is not None:
         return result
-    if not callable(function):
-        return _verdict(False, f"Pass the function itself (should_publish, without brackets), not a "
-                               f"{type(function).__name__}.")
     first, problem = _call(function, None, 120, 5)
     if problem is not None:
         if "Not done yet" in problem.text:
@@ -141,11 +138,8 @@ def task4_order_corners(function) -> Verdict:
 
     hint = ("Write order_corners(points): given 4 (x, y) points in any order, return them as a (4, 2) array in "
             "the order top-left, top-right, bottom-right, bottom-left (clockwise on screen).")
-    if (result := _not_done(function, hint)) is not None:
+    if (result := _not_a_function(function, "order_corners", hint)) is not None:
         return result
-    if not callable(function):
-        return _verdict(False, f"Pass the function itself (order_corners, without brackets), not a "
-                               f"{type(function).__name__}.")
     a = math.radians(30)
     thin = np.array([[0, 0], [160 * math.cos(a), -160 * math.sin(a)],
                      [160 * math.cos(a) + 40 * math.sin(a), -160 * math.sin(a) + 40 * math.cos(a)],
@@ -235,10 +229,8 @@ def task_picture_corners(function) -> Verdict:
     hint = ("Write picture_corners_of(markers, picture): for each marker of marker_board.PICTURES[picture] (top-left, "
             "top-right, bottom-right, bottom-left), take the one of its four corners that touches the picture, and "
             "return the four points as a (4, 2) array.")
-    if (result := _not_done(function, hint)) is not None:
+    if (result := _not_a_function(function, "picture_corners_of", hint)) is not None:
         return result
-    if not callable(function):
-        return _verdict(False, f"Pass the function itself (picture_corners_of), not a {type(function).__name__}.")
     places = ("top-left", "top-right", "bottom-right", "bottom-left")
     for view, markers, pictures in _board_views():
         for picture, expected in pictures.items():

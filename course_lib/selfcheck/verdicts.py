@@ -34,6 +34,16 @@ def _not_done(answer, hint: str) -> Verdict | None:
     return None
 
 
+def _not_a_function(function, name: str, hint: str) -> Verdict | None:
+    """A Verdict when the answer to a function task is a stub ("not done yet" and `hint`) or no
+    function (the function `name` called, say); None when it is a function."""
+    if (result := _not_done(function, hint)) is not None:
+        return result
+    if not callable(function):
+        return _verdict(False, f"Pass the function itself ({name}, without brackets), not a {type(function).__name__}.")
+    return None
+
+
 def _call(function, *args):
     """(result, None) or (None, a Verdict naming the exception) for one call of a student's function."""
     import warnings
