@@ -57,6 +57,14 @@ EXPOSE_ENV = "AUTOGRADER_EXPOSE"
 BLOCKED_ENV = "AUTOGRADER_BLOCKED"
 STAGE_ENV = "AUTOGRADER_STAGE"
 
+# --- points ------------------------------------------------------------------------------------
+
+#: Points are given and shown to this many decimals, rounded half up (checks.result.round_points).
+#: nbgrader's feedback page shows scores to two decimals, so the self-check, the grader, the
+#: gradebook, the grades file and every page agree on one number (7 of 8 items of a 7-point
+#: check: 6.125 is 6.13 everywhere).
+POINT_DECIMALS = 2
+
 # --- limits of the student's code ---------------------------------------------------------------
 
 #: Address space (MB) of each process of a submission's notebook run and of its build (CMake, the

@@ -5,12 +5,8 @@ from __future__ import annotations
 import dataclasses
 from decimal import ROUND_HALF_UP, Decimal
 
+from course_lib import contract
 from course_lib.checks.registry import get_check
-
-#: Points are given and shown to this many decimals, rounded half up. nbgrader's feedback page
-#: shows scores to two decimals, so the self-check, the grader, the gradebook, the grades file and
-#: every page agree on one number (7 points for 7 of 8 items: 6.125 is 6.13 everywhere).
-POINT_DECIMALS = 2
 
 
 @dataclasses.dataclass
@@ -47,8 +43,8 @@ class Result:
 
 
 def round_points(value: float) -> float:
-    """Points as the grader gives them: POINT_DECIMALS decimals, rounded half up (6.125 -> 6.13)."""
-    step = Decimal(1).scaleb(-POINT_DECIMALS)
+    """Points as the grader gives them: contract.POINT_DECIMALS decimals, rounded half up (6.125 -> 6.13)."""
+    step = Decimal(1).scaleb(-contract.POINT_DECIMALS)
     return float(Decimal(repr(float(value))).quantize(step, rounding=ROUND_HALF_UP))
 
 
