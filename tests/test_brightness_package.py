@@ -122,6 +122,11 @@ def test_brightness_package_check_finds_a_stale_copy_of_a_build_without_symlinks
     ({"int(frame[height // 2, width // 2, 0])": "frame[height // 2, width // 2, 0]"}, "wrap it in int(...)"),
     ({"frame[height // 2, width // 2, 0]": "frame[width // 2, height // 2, 0]"}, "numpy indexes [row, column]"),
     ({"import UInt8": "import Float32", "UInt8": "Float32"}, "publishes std_msgs/msg/Float32 on /brightness"),
+    # Answers wrong, computes for a while, then fails: judged by its crash however long it takes to come
+    # (a wait of 1 s took a crash on a busy machine for a wrong value: "published 255").
+    ({"self.publisher.publish(UInt8(data=centre_value(images.msg_to_image(msg))))":
+      "self.publisher.publish(UInt8(data=255)); sum(range(60_000_000)); raise ValueError('late failure')"},
+     "crashed on the first frame"),
 ])
 @pytest.mark.slow
 def test_brightness_package_check_runs_the_node_as_ros2_run_would(built_brightness, change, expected):

@@ -137,3 +137,18 @@ def test_a_process_waits_when_it_uses_next_to_no_processor_time(share, waits):
     assert not spent.waiting()
     time.sleep(ProcessorTime.WAITING_WINDOW + 0.2)
     assert spent.waiting() == waits and not spent.used_up()
+
+
+class _Ended(_Using):
+    """A stand-in for a NodeProcess that computed and has just ended: its tree's time reads 0."""
+
+    def cpu_seconds(self) -> float:
+        return 0.0 if time.monotonic() - self.start > ProcessorTime.WAITING_WINDOW else super().cpu_seconds()
+
+
+def test_a_process_that_has_just_ended_is_not_waiting():
+    """Its processor time reads 0 once it is gone, while its supervisor may not have said so yet: a
+    self-check took a node that computed and then crashed for one waiting without an answer."""
+    spent = ProcessorTime(_Ended(1.0), budget=None)
+    time.sleep(ProcessorTime.WAITING_WINDOW + 0.2)
+    assert not spent.waiting()

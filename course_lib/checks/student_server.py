@@ -163,7 +163,9 @@ class ProcessorTime:
         self._sample()
         (first, used_first), (last, used_last) = self.samples[0], self.samples[-1]
         span = last - first
-        return span >= self.WAITING_WINDOW and used_last - used_first < self.WAITING_SHARE * span
+        # Less than before: the process has just ended (its time reads 0 once it is gone) and is not
+        # waiting; the caller sees it end.
+        return span >= self.WAITING_WINDOW and 0.0 <= used_last - used_first < self.WAITING_SHARE * span
 
     def waits_after(self, seconds: float) -> bool:
         """True once `seconds` have passed since this was made and the process is waiting."""

@@ -192,6 +192,7 @@ def _run_brightness_node(ws) -> Verdict:
 
     from course_lib import images, rosenv, workspace
     from course_lib.checks.probe import RosProbe
+    from course_lib.checks.student_server import ProcessorTime
 
     command = (f"ros2 run {BRIGHTNESS_PACKAGE} {BRIGHTNESS_EXECUTABLE} --ros-args -r /image:={CHECK_CAMERA_TOPIC}")
     with rosenv.reserve_domain_id() as reservation, RosProbe(reservation.domain_id) as probe:
@@ -257,15 +258,20 @@ def _run_brightness_node(ws) -> Verdict:
                     camera.publish(msg)
                     if probe.spin_until(lambda: replies or not process.running(), 0.5):
                         break
-                if replies and replies[0] != expected:
-                    # publish() with a numpy integer in UInt8.data sends 255 before it raises: wait for the crash
-                    probe.spin_until(lambda: not process.running(), 1.0)
+                if not replies or replies[0] != expected:
+                    # A node that fails on a frame takes a moment to end (publish() with a numpy integer in
+                    # UInt8.data even sends 255 before it raises), a busy machine's more: wait until it has
+                    # ended, answered right, or waits for frames without answering (processor time, not a
+                    # clock, tells).
+                    idle = ProcessorTime(process)
+                    probe.spin_until(lambda: (replies and replies[0] == expected) or not process.running()
+                                     or idle.waiting(), 60.0)
                 if not process.running():
                     return _verdict(False, f"The node crashed on the first frame the check sent "
                                            f"({process.describe_exit()}).{_crash_text(process)}")
                 if not replies:
                     return _verdict(False, "The check sent frames on the remapped topic, but nothing came back on "
-                                           "/brightness in 3 s: does on_image publish a UInt8 with the node's "
+                                           "/brightness, and the node waits for more: does on_image publish a UInt8 with the node's "
                                            "publisher?")
                 if replies[0] != expected:
                     return _verdict(False, f"For a frame 80 wide and 60 high whose centre pixel (row 30, column 40) is "
