@@ -111,14 +111,14 @@ def _send_goal(args) -> str | None:
     except (ValueError, AttributeError):
         return "The passed action type is invalid"
     values = read_values(sys.stdin.read() if args.stdin else args.goal, "goal")
-    node = session.tool_node()
-    client = ActionClient(node, action, args.action_name)
     goal = action.Goal()
     try:
         message_yaml.fill_message(goal, values)
     except ValueError as error:
-        client.destroy()
         return f"Failed to populate message fields: {error!r}"
+    # Made only now: an action client destroyed while the session's executor waits on it makes that
+    # executor report "action client pointer is invalid" (a bad goal did, under load).
+    client = ActionClient(session.tool_node(), action, args.action_name)
     handle = None
     # Feedback comes in the session's thread, and may come before this thread has seen the goal
     # accepted: held until then, it is printed after "Goal accepted", as ros2action's one thread does.
@@ -167,7 +167,8 @@ def _send_goal(args) -> str | None:
         if handle is not None and STATUS_WORDS.get(handle.status) in ("ACCEPTED", "EXECUTING"):
             # Ctrl-C while the goal runs: like ros2action, cancel it
             _cancel(handle)
-        client.destroy()
+        # The client is not destroyed here: the command's process ends, and the session's stop
+        # destroys its tool node (the client with it) once the executor no longer waits on it.
 
 
 def _cancel(handle) -> None:
