@@ -26,3 +26,31 @@ def ros2_together(*commands, env, timeout=60):
         out, err = process.communicate(timeout=timeout)
         done.append(subprocess.CompletedProcess([str(ROS2), *args], process.returncode, out, err))
     return done
+
+
+#: The end of a node script the tests run as a process, as a package's main() runs its node:
+#: ``node_script(code, "Talker()")`` appends it, `node` being the expression that makes the node.
+_NODE_MAIN = """
+
+def main():
+    rclpy.init(args=sys.argv)
+    node = None
+    try:
+        node = {node}
+        rclpy.spin(node)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()
+
+
+main()
+"""
+
+
+def node_script(code: str, node: str) -> str:
+    """`code` (imports and node classes; it imports sys, rclpy and ExternalShutdownException) followed
+    by a main() that spins the node `node` makes until Ctrl-C, then shuts down cleanly."""
+    return code.rstrip("\n") + "\n" + _NODE_MAIN.format(node=node)

@@ -12,13 +12,13 @@ from pathlib import Path
 import pytest
 import yaml
 from process_support import in_background_of_a_script, wait_until
-from ros2cli_support import ROS2, ros2, ros2_together
+from ros2cli_support import ROS2, node_script, ros2, ros2_together
 
 from course_lib import colcon, processes, rosenv, workspace
 from course_lib.ros2cli.common import FULL_INSTALL
 
 # Two nodes, each in a process of its own: `python live_nodes.py talker|listener [ros args]`.
-LIVE_NODES = '''
+LIVE_NODES = node_script('''
 import sys
 
 import rclpy
@@ -60,23 +60,7 @@ class Listener(Node):
         self.create_subscription(String, 'cli_chatter', lambda msg: None, 10)
         self.create_subscription(Int32, 'cli_numbers', lambda msg: print(f'heard {msg.data}', flush=True), 10)
 
-
-def main():
-    rclpy.init(args=sys.argv)
-    node = None
-    try:
-        node = Talker() if sys.argv[1] == 'talker' else Listener()
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
-
-
-main()
-'''
+''', "Talker() if sys.argv[1] == 'talker' else Listener()")
 
 
 @pytest.fixture(scope="module")

@@ -8,13 +8,13 @@ import types
 
 import pytest
 import yaml
-from ros2cli_support import ros2, ros2_together
+from ros2cli_support import node_script, ros2, ros2_together
 
 from course_lib import processes, rosenv
 
 # ros2action's test/fixtures/fibonacci_action_server.py, written anew: feedback after each new
 # number, then the sequence as the result.
-FIBONACCI_SERVER = '''
+FIBONACCI_SERVER = node_script('''
 import sys
 
 import rclpy
@@ -38,23 +38,7 @@ class FibonacciActionServer(Node):
         goal_handle.succeed()
         return Fibonacci.Result(sequence=feedback.sequence)
 
-
-def main():
-    rclpy.init(args=sys.argv)
-    node = None
-    try:
-        node = FibonacciActionServer()
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
-
-
-main()
-'''
+''', 'FibonacciActionServer()')
 
 
 def send_goal_output(order: int, with_feedback: int = 0) -> list:

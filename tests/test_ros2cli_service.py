@@ -8,13 +8,13 @@ import sys
 import types
 
 import pytest
-from ros2cli_support import ROS2, ros2, ros2_together
+from ros2cli_support import ROS2, node_script, ros2, ros2_together
 
 from course_lib import processes, rosenv
 
 # ros2service's test/fixtures/echo_server.py, written anew: answers a BasicTypes request with
 # the same values.
-ECHO_SERVER = '''
+ECHO_SERVER = node_script('''
 import sys
 
 import rclpy
@@ -34,23 +34,7 @@ class EchoServer(Node):
             setattr(response, field, getattr(request, field))
         return response
 
-
-def main():
-    rclpy.init(args=sys.argv)
-    node = None
-    try:
-        node = EchoServer()
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
-
-
-main()
-'''
+''', 'EchoServer()')
 
 # The services every rclpy node has (ros2service's test_cli.py: expected_builtin_services).
 BUILTIN = {

@@ -9,11 +9,11 @@ import sys
 import types
 
 import pytest
-from ros2cli_support import ROS2, ros2_together
+from ros2cli_support import ROS2, node_script, ros2_together
 
 from course_lib import processes, rosenv
 
-STAMPED_TALKER = '''
+STAMPED_TALKER = node_script('''
 import sys
 
 import rclpy
@@ -39,23 +39,7 @@ class StampedTalker(Node):
         for publisher in self.words:
             publisher.publish(String(data='hello world'))
 
-
-def main():
-    rclpy.init(args=sys.argv)
-    node = None
-    try:
-        node = StampedTalker()
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
-
-
-main()
-'''
+''', 'StampedTalker()')
 
 
 @pytest.fixture(scope="module")
