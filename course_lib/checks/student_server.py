@@ -99,14 +99,14 @@ class StudentServer:
         answer = read_answer(outbox, number)
         if answer is not None:
             return answer
-        timed_out = proc.running()
+        timed_out, waited = proc.running(), spent.waiting()  # (read before the stop: then its time reads 0)
         self.stop(grace=0.1)  # a hung call is not waited for
         output = last_lines(proc.log[start_of_log:] if len(proc.log) > start_of_log else proc.log, 4)
         if spent.exceeded:
             raise ServerError(f"used {cpu_seconds:g} s of processor time without returning (an endless loop?). "
                               f"Last output:\n{output}", True)
         if timed_out:
-            how = ", waiting rather than computing (a sleep(), spin() or input()?)" if spent.waiting() else ""
+            how = ", waiting rather than computing (a sleep(), spin() or input()?)" if waited else ""
             raise ServerError(f"did not return within {time.monotonic() - started:.0f} s{how}. Last output:\n{output}",
                               True)
         raise ServerError(f"ended the process ({proc.describe_exit()}) before returning. Last output:\n{output}", False)
@@ -163,9 +163,9 @@ class ProcessorTime:
         self._sample()
         (first, used_first), (last, used_last) = self.samples[0], self.samples[-1]
         span = last - first
-        # Less than before: the process has just ended (its time reads 0 once it is gone) and is not
-        # waiting; the caller sees it end.
-        return span >= self.WAITING_WINDOW and 0.0 <= used_last - used_first < self.WAITING_SHARE * span
+        if used_last == 0.0 < used_first:
+            return False  # it has just ended (its time reads 0 once it is gone): the caller sees it end
+        return span >= self.WAITING_WINDOW and used_last - used_first < self.WAITING_SHARE * span
 
     def waits_after(self, seconds: float) -> bool:
         """True once `seconds` have passed since this was made and the process is waiting."""
