@@ -1,11 +1,11 @@
 """Pictures recovered when the board's markers touch dark picture corners, before and after the fix.
 
-Not a test: it prints counts and timings side by side (tests/test_dark_corners.py asserts the
-recovery on a small fixed set). The scenes are render_scene(seed, board=dark_corner_board(seed)):
+Not a test: it prints counts and timings side by side (tests/test_photos.py asserts the
+recovery on a small fixed set). The scenes are render_scene(seed, board=photo_board(seed, "dark")):
 photograph-like pictures whose corners are nearly black, so every board marker touches a dark
 corner, which can merge with it in the detector's threshold image.
 
-    .venv/bin/python benchmarks/bench_dark_corners.py [--easy 40] [--hard 120]
+    .venv/bin/python benchmarks/bench_photos.py [--easy 40] [--hard 120]
 
 Columns: "before" is readmarker's crop_pictures with the detector's markers only
 (second_look=False), "after" with find_board_markers' second look. A picture counts as
@@ -57,7 +57,7 @@ def main(argv=None) -> int:
     sys.path.insert(0, str(READMARKER))
     from readmarker.crop import crop_pictures
 
-    from course_lib import dark_corners, scenes
+    from course_lib import photos, scenes
 
     def before(frame):
         return crop_pictures(frame, second_look=False)
@@ -67,7 +67,7 @@ def main(argv=None) -> int:
     print("| board | scenes | fully framed pictures | recovered before | recovered after | false before / after "
           "| ms per frame before / after |")
     print("|---|---|---:|---:|---:|---:|---:|")
-    for board_name, make_board in (("dark corners (dark_corner_board)", dark_corners.dark_corner_board),
+    for board_name, make_board in (("dark corners (photo_board(seed, \"dark\"))", lambda seed: photos.photo_board(seed, "dark")),
                                    ("drawn cat and dog", lambda seed: None)):
         for difficulty, count in (("easy", args.easy), ("hard", args.hard)):
             rendered = [scenes.render_scene(seed, difficulty=difficulty, board=make_board(seed))
