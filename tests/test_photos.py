@@ -1,47 +1,43 @@
-"""Markers touching dark picture corners: the reference crops recover the pictures (issue: dark corners).
+"""Photographs on the board: the reference crops recover the pictures whatever their corners (issue #31).
 
-photos.photo_board(seed, "dark") puts photograph-like pictures with nearly black corners on the board, so
-every marker touches a dark corner and can merge with it in the detector's threshold image.
-The reference crop (readmarker's crop_pictures, which is also the catdog_warp assignment's
-solution: assignments/build.py writes it into the notebook) must recover at least 98 % of the
-fully framed pictures of a fixed seeded set of hard scenes, with no false picture; the detector's markers alone do
-not (the set really shows the failure). benchmarks/bench_photos.py measures a larger set.
+photos.photo_board puts photograph-like pictures on the board: with corners="dark" every marker
+touches a nearly black picture corner, with "any" the picture corners are of every kind (near
+black, brown, navy, mid-dark, grey, gradients, textures, light). A marker can merge with a dark
+corner in the detector's threshold image and be missed. The reference crop (readmarker's
+crop_pictures, also the catdog_warp assignment's solution: assignments/build.py writes it into
+the notebook) must recover at least 99 % of the fully framed pictures of fixed seeded sets of
+hard scenes, with no false picture; the detector's markers alone do not (the sets really show
+the failure). benchmarks/bench_photos.py measures larger sets.
 """
 
-import sys
-from pathlib import Path
-
+import cv2
+import numpy as np
 import pytest
 
-from course_lib import marker_board, photos, scenes
+from course_lib import marker_board, photos
+from photo_support import photo_scenes, recovery, reference_crop
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "assignments" / "reference_ws" / "src" / "readmarker"))
-
-from readmarker.crop import crop_pictures  # noqa: E402
+crop = reference_crop()
 
 #: Hard scenes of photo_board(seed, "dark") with at least one fully framed picture (24 pictures).
-SEEDS = (4, 6, 9, 11, 12, 13, 14, 15, 18, 23, 24, 27, 29, 32, 35, 42, 44, 47, 48, 51, 52, 53)
+DARK_SEEDS = (4, 6, 9, 11, 12, 13, 14, 15, 18, 23, 24, 27, 29, 32, 35, 42, 44, 47, 48, 51, 52, 53)
+
+#: Hard scenes of photo_board(seed), corners of every kind: the seeds below 100 whose pose can
+#: frame a picture (37 scenes, 35 fully framed pictures). The reference before issue #31 (thinned
+#: looks, then the pictures painted out) missed the cat of seed 72.
+ANY_SEEDS = range(100)
+
+BOARD_IDS = tuple(i for ids in marker_board.PICTURES.values() for i in ids)
 
 
 @pytest.fixture(scope="module")
 def dark_scenes():
-    return [scenes.render_scene(seed, difficulty="hard", board=photos.photo_board(seed, "dark")) for seed in SEEDS]
+    return list(photo_scenes(DARK_SEEDS, "dark"))
 
 
-def recovery(crop, scene_list):
-    """(fully framed pictures, recovered, false pictures) of a crop function on the scenes."""
-    framed = recovered = false = 0
-    for scene in scene_list:
-        crops = crop(scene.frame)
-        expected = scene.expected_crops()
-        visible = set(scene.visible_ids)
-        for name, markers in marker_board.PICTURES.items():
-            good = name in crops and marker_board.crop_similarity(crops[name], expected[name]) >= marker_board.SAME_CROP_THRESHOLD
-            framed += name in scene.fully_framed
-            recovered += name in scene.fully_framed and good
-            false += name in crops and (not good or not visible.issuperset(markers))
-    return framed, recovered, false
+@pytest.fixture(scope="module")
+def any_scenes():
+    return list(photo_scenes(ANY_SEEDS, "any"))
 
 
 def test_photographs_have_dark_corners_and_are_the_same_for_the_same_seed():
@@ -66,10 +62,31 @@ def test_corners_are_of_the_kinds_asked_for_and_the_same_for_the_same_seed():
 
 
 def test_the_detectors_markers_alone_miss_many_pictures(dark_scenes):
-    framed, recovered, false = recovery(lambda frame: crop_pictures(frame, second_look=False), dark_scenes)
-    assert framed == 24 and recovered <= 0.8 * framed, (framed, recovered)
+    result = recovery(lambda frame: crop.crop_pictures(frame, second_look=False), dark_scenes)
+    assert result.framed == 24 and result.recovered <= 0.8 * result.framed, result
 
 
-def test_the_reference_crop_recovers_98_percent_and_no_false_picture(dark_scenes):
-    framed, recovered, false = recovery(crop_pictures, dark_scenes)
-    assert recovered >= 0.98 * framed and false == 0, (framed, recovered, false)
+@pytest.mark.parametrize("corners", ["dark", "any"])
+def test_the_reference_crop_recovers_99_percent_and_no_false_picture(corners, request):
+    scene_list = request.getfixturevalue(f"{corners}_scenes")
+    result = recovery(crop.crop_pictures, scene_list)
+    assert result.framed >= 24, "the set exercises the claim"
+    assert result.rate >= 0.99 and result.false == 0, result
+
+
+def test_markers_the_detector_missed_are_found_where_the_board_predicts_them(any_scenes):
+    """look_where_predicted finds them at their true corners and finds nothing that is not in view."""
+    looked_for = found = 0
+    errors = []
+    for scene in any_scenes:
+        grey = cv2.cvtColor(scene.frame, cv2.COLOR_BGR2GRAY)
+        stock = crop.find_markers(scene.frame)
+        new = crop.look_where_predicted(grey, stock)
+        missed = [i for i in scene.detectable_ids if i not in stock]
+        looked_for += len(missed)
+        found += sum(i in new for i in missed)
+        assert set(new) <= set(scene.visible_ids) - set(stock), (scene.seed, sorted(new))
+        errors += [float(np.abs(new[i] - scene.marker_corners[i]).max()) for i in new]
+    assert looked_for >= 10, "the set exercises the claim"
+    assert found >= 0.9 * looked_for, (found, looked_for)
+    assert np.mean(errors) < 1.0 and max(errors) < 3.0, errors
