@@ -71,9 +71,10 @@ ERODE_PASSES = ((1, 3), (2, 5))
 #: Board units of paper kept around a predicted marker (its quiet zone is 24 units wide).
 KEPT_PAPER = 16
 
-#: Board units by which the painted-out picture reaches into the predicted marker, so that a
-#: prediction a pixel or two off leaves no sliver of a dark picture touching the marker.
-PICTURE_OVERLAP = 5
+#: Board units by which the painted-out picture reaches into the predicted marker, tried in
+#: order: a prediction a pixel or two off leaves no sliver of a dark picture touching the
+#: marker at the larger overlap, while the smaller one notches a small marker's corner less.
+PICTURE_OVERLAPS = (2, 5)
 
 #: Half the side of cv2.cornerSubPix's window, as a fraction of the marker's side (the corners
 #: of a marker found in a window are refined on the frame).
@@ -238,18 +239,18 @@ def _look_in_window(grey, board, homography, marker_id, detector):
     x1, y1 = np.minimum(np.ceil(kept.max(axis=0)).astype(int) + 3, (width, height))
     window = grey[y0:y1, x0:x1]
     offset = np.float32([x0, y0])
-    mask = np.zeros(window.shape, np.uint8)
-    cv2.fillConvexPoly(mask, np.round((kept - offset) * 16).astype(np.int32), 255, cv2.LINE_8, shift=4)
     picture = next(name for name, ids in marker_board.PICTURES.items() if marker_id in ids)
     slot = board.picture_slot(picture)
-    slot = slot + np.sign(slot - slot.mean(axis=0)) * PICTURE_OVERLAP
-    cv2.fillConvexPoly(mask, np.round((_project(homography, slot) - offset) * 16).astype(np.int32), 0,
-                       cv2.LINE_8, shift=4)
-    paper = float(np.percentile(window[mask > 0], 90))  # the marker's white cells and its paper
     pad = 8  # paper around the window, so that the detector's border rule keeps the marker
-    clean = cv2.copyMakeBorder(np.where(mask > 0, window, np.uint8(paper)), pad, pad, pad, pad,
-                               cv2.BORDER_CONSTANT, value=paper)
-    for scale, kernel in WINDOW_LOOKS:
+    for overlap, (scale, kernel) in ((o, look) for o in PICTURE_OVERLAPS for look in WINDOW_LOOKS):
+        if (scale, kernel) == WINDOW_LOOKS[0]:  # a new overlap: paint the window again
+            mask = np.zeros(window.shape, np.uint8)
+            cv2.fillConvexPoly(mask, np.round((kept - offset) * 16).astype(np.int32), 255, cv2.LINE_8, shift=4)
+            painted = _project(homography, slot + np.sign(slot - slot.mean(axis=0)) * overlap)
+            cv2.fillConvexPoly(mask, np.round((painted - offset) * 16).astype(np.int32), 0, cv2.LINE_8, shift=4)
+            paper = float(np.percentile(window[mask > 0], 90))  # the marker's white cells and its paper
+            clean = cv2.copyMakeBorder(np.where(mask > 0, window, np.uint8(paper)), pad, pad, pad, pad,
+                                       cv2.BORDER_CONSTANT, value=paper)
         corners = thinned_markers(clean, scale, kernel, detector).get(marker_id)
         if corners is None:
             continue
