@@ -3,8 +3,8 @@
 The marker convention (dictionary, marker ids per picture, which marker corner touches the
 picture, crop corners) is course_lib.marker_board's; this module only applies it:
 
-1. detect the ArUco markers in the frame, and look again for board markers that merged with a
-   dark picture corner (find_board_markers);
+1. detect the ArUco markers in the frame, and look again, where the board's layout puts them,
+   for board markers that merged with a dark picture corner (find_board_markers);
 2. for each picture whose four markers were all found, take the picture's four corners from
    the markers (marker_board.picture_corners);
 3. warp that quadrilateral onto a width x height crop (marker_board.crop_corners).
@@ -64,75 +64,205 @@ def find_markers(frame, detector=None):
 
 _BOARD_IDS = tuple(i for ids in marker_board.PICTURES.values() for i in ids)
 
-#: (scale, kernel) of the second looks: lighten the frame with a kernel x kernel maximum filter
+#: (scale, kernel) of the thinned looks: lighten the image with a kernel x kernel maximum filter
 #: at that scale, which thins every dark area by kernel // 2 / scale pixels.
 ERODE_PASSES = ((1, 3), (2, 5))
 
+#: Board units of paper kept around a predicted marker (its quiet zone is 24 units wide).
+KEPT_PAPER = 16
 
-def find_board_markers(frame, detector=None, erode_passes=ERODE_PASSES, paint_pictures=True):
-    """find_markers, then a second look for board markers that merged with a dark picture.
+#: Board units by which the painted-out picture reaches into the predicted marker, tried in
+#: order: a prediction a pixel or two off leaves no sliver of a dark picture touching the
+#: marker at the larger overlap, while the smaller one notches a small marker's corner less.
+PICTURE_OVERLAPS = (2, 5)
 
-    A marker touches its picture with one corner. Where the picture's corner is dark, the
-    thresholded marker and the dark picture are one blob, whose outline is no square, and the
-    detector misses the marker. Two second looks separate them:
+#: Half the side of cv2.cornerSubPix's window, as a fraction of the marker's side (the corners
+#: of a marker found in a window are refined on the frame).
+CORNER_WINDOW = 1 / 8
 
-    1. thin every dark area by a pixel or so (a maximum filter) and detect again: the one-point
-       contact breaks while the marker's cells survive; the corners found are moved back out by
-       the amount thinned;
-    2. when at least two board markers are known, they give the board's homography; paint the
-       pictures white where it puts them and detect again, then refine the corners on the frame.
+#: Pixels a marker found where it was predicted must lie inside the frame: it is cut by the
+#: frame edge otherwise (the detector itself keeps 3 pixels).
+FRAME_INSET = 2
+
+
+def find_board_markers(frame, detector=None, erode_passes=ERODE_PASSES, predict=True):
+    """find_markers, then a second look for board markers that merged with what they touch.
+
+    A marker touches its picture with one corner. Where the picture's corner is dark (black,
+    brown, navy, a dark texture), the thresholded marker and the picture are one blob, whose
+    outline is no square, and the detector misses the marker. Two second looks separate them:
+
+    1. the board's layout is known: the markers found give the board's homography, which
+       predicts where each missing marker is; there, in a small window with everything but the
+       marker and its paper painted over (look_where_predicted), the detector looks again;
+    2. when fewer than two board markers are known: thin every dark area by a pixel or so (a
+       maximum filter) and detect again on the whole frame: the one-point contact breaks while
+       the marker's cells survive; the corners found are moved back out by the amount thinned.
+       Then step 1 again with the markers found.
 
     Args:
         frame, detector: as for find_markers.
-        erode_passes: (scale, kernel) pairs of step 1, tried in order until no board marker is
-            missing; () skips step 1.
-        paint_pictures: run step 2.
+        erode_passes: (scale, kernel) pairs of step 2, tried in order; () skips step 2.
+        predict: run step 1.
 
     Returns:
         dict marker id -> float32 (4, 2) corners, as find_markers.
     """
     ### BEGIN SOLUTION
     found = find_markers(frame, detector)
-    if all(i in found for i in _BOARD_IDS):
-        return found
     grey = frame if frame.ndim == 2 else cv2.cvtColor(frame, cv2.COLOR_BGR2GRAY)
+    if predict:
+        found.update(look_where_predicted(grey, found, detector))
     for scale, kernel in erode_passes:
-        bigger = grey if scale == 1 else cv2.resize(grey, None, fx=scale, fy=scale, interpolation=cv2.INTER_LINEAR)
-        lighter = cv2.dilate(bigger, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (kernel, kernel)))
-        thinned = kernel // 2 / scale
-        for marker_id, corners in find_markers(lighter, detector).items():
-            if marker_id in _BOARD_IDS and marker_id not in found:
-                corners = (corners + 0.5) / scale - 0.5
-                outward = corners - corners.mean(axis=0)
-                outward /= np.linalg.norm(outward, axis=1, keepdims=True)
-                found[marker_id] = (corners + outward * thinned * np.sqrt(2)).astype(np.float32)
-        if all(i in found for i in _BOARD_IDS):
-            return found
-    known = [i for i in _BOARD_IDS if i in found]
-    if paint_pictures and len(known) >= 2:
-        found.update(_markers_beside_painted_pictures(grey, found, known, detector))
+        if sum(i in found for i in _BOARD_IDS) >= 2:
+            break
+        new = {i: c for i, c in thinned_markers(grey, scale, kernel, detector).items()
+               if i in _BOARD_IDS and i not in found}
+        found.update(new)
+        if new and predict:
+            found.update(look_where_predicted(grey, found, detector))
     return found
     ### END SOLUTION
 
 
-def _markers_beside_painted_pictures(grey, found, known, detector):
+def thinned_markers(grey, scale, kernel, detector=None):
+    """find_markers on `grey` enlarged `scale` times and thinned by a kernel x kernel maximum
+    filter (kernel 1: not thinned), with the corners moved back to `grey`'s pixels and out by
+    the amount thinned."""
+    ### BEGIN SOLUTION
+    image = grey if scale == 1 else cv2.resize(grey, None, fx=scale, fy=scale, interpolation=cv2.INTER_LINEAR)
+    if kernel > 1:
+        image = cv2.dilate(image, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (kernel, kernel)))
+    thinned = kernel // 2 / scale
+    markers = {}
+    for marker_id, corners in find_markers(image, detector).items():
+        corners = (corners + 0.5) / scale - 0.5
+        outward = corners - corners.mean(axis=0)
+        outward /= np.linalg.norm(outward, axis=1, keepdims=True)
+        markers[marker_id] = (corners + outward * thinned * np.sqrt(2)).astype(np.float32)
+    return markers
+    ### END SOLUTION
+
+
+#: (scale, kernel) of the looks in a predicted marker's window, tried in order: as it is, then
+#: thinned (ERODE_PASSES) for a sliver of picture left by a prediction a pixel off.
+WINDOW_LOOKS = ((1, 1), *ERODE_PASSES)
+
+
+def look_where_predicted(grey, found, detector=None):
+    """Board markers missing from `found`, looked for where the found ones predict them.
+
+    The board's homography (board units -> frame pixels) is fitted to the corners of every
+    board marker found; it puts each missing marker at a quadrilateral of the frame. A small
+    window around it keeps the marker and KEPT_PAPER units of paper around it and paints the
+    rest, the picture it touches included, with the paper's grey: nothing dark touches the
+    marker any more, whatever the colour of the picture's corner. The detector looks in that
+    window (WINDOW_LOOKS); a marker counts when it has the predicted id and lies where it was
+    predicted. Markers found refine the homography for another round.
+
+    Args:
+        grey: the frame, grey uint8 (height, width).
+        found: marker id -> corners (4, 2) found so far, as find_markers returns them.
+        detector: as for find_markers.
+
+    Returns:
+        dict marker id -> float32 (4, 2) corners of the board markers found in this look only.
+    """
     ### BEGIN SOLUTION
     board = boards.default_board()  # only its geometry (board units) is used, the same for any pictures
-    square = np.concatenate([board.marker_square(i) for i in known])
-    seen = np.concatenate([found[i] for i in known])
-    homography, _ = cv2.findHomography(square.astype(np.float32), seen.astype(np.float32))
-    if homography is None:
-        return {}
-    painted = grey.copy()
-    for name in marker_board.PICTURES:
-        slot = cv2.perspectiveTransform(board.picture_slot(name)[None].astype(np.float32), homography)[0]
-        cv2.fillConvexPoly(painted, np.round(slot * 16).astype(np.int32), 255, cv2.LINE_AA, shift=4)
-    new = {i: c for i, c in find_markers(painted, detector).items() if i in _BOARD_IDS and i not in found}
-    if not new:
-        return {}
-    points = np.concatenate(list(new.values())).reshape(-1, 1, 2).astype(np.float32)
-    cv2.cornerSubPix(grey, points, (3, 3), (-1, -1), (cv2.TERM_CRITERIA_EPS + cv2.TERM_CRITERIA_COUNT, 30, 0.01))
-    return {marker_id: points[4 * k:4 * k + 4].reshape(4, 2) for k, marker_id in enumerate(new)}
+    new = {}
+    while True:
+        known = [i for i in _BOARD_IDS if i in found or i in new]
+        missing = [i for i in _BOARD_IDS if i not in known]
+        if not known or not missing:
+            return new
+        homography = board_homography(board, {i: new[i] if i in new else found[i] for i in known})
+        if homography is None:
+            return new
+        more = {}
+        for marker_id in missing:
+            corners = _look_in_window(grey, board, homography, marker_id, detector)
+            if corners is not None:
+                more[marker_id] = corners
+        if not more:
+            return new
+        new.update(more)
+    ### END SOLUTION
+
+
+def board_homography(board, markers):
+    """The homography from board units to frame pixels that the corners of `markers` (board id ->
+    corners) give, fitted by least squares; a marker it does not fit within a fifth of the
+    marker's side (misread, or a spare one chosen) is left out and the rest fitted again. None
+    when no homography fits."""
+    ### BEGIN SOLUTION
+    ids = list(markers)
+    while ids:
+        square = np.concatenate([board.marker_square(i) for i in ids]).astype(np.float32)
+        seen = np.concatenate([markers[i] for i in ids]).astype(np.float32).reshape(-1, 2)
+        homography, _ = cv2.findHomography(square, seen, 0)
+        if homography is None or len(ids) == 1:
+            return homography
+        errors = np.linalg.norm(_project(homography, square) - seen, axis=1).reshape(-1, 4).max(axis=1)
+        sides = np.array([np.linalg.norm(markers[i] - np.roll(markers[i], 1, axis=0), axis=1).min() for i in ids])
+        worst = int(np.argmax(errors / sides))
+        if errors[worst] <= 0.2 * sides[worst]:
+            return homography
+        ids.pop(worst)
+    return None
+    ### END SOLUTION
+
+
+def _project(homography, points):
+    return cv2.perspectiveTransform(np.asarray(points, np.float32)[None], homography)[0]
+
+
+def _inside(points, shape):
+    """True when every point lies FRAME_INSET pixels or more inside a frame of this shape."""
+    height, width = shape[:2]
+    return bool(points.min() >= FRAME_INSET and points[:, 0].max() <= width - 1 - FRAME_INSET
+                and points[:, 1].max() <= height - 1 - FRAME_INSET)
+
+
+def _look_in_window(grey, board, homography, marker_id, detector):
+    """The corners of board marker `marker_id` found in the window where `homography` puts it, or None."""
+    ### BEGIN SOLUTION
+    square = board.marker_square(marker_id)
+    predicted = _project(homography, square)
+    side = float(np.linalg.norm(predicted - np.roll(predicted, 1, axis=0), axis=1).min())
+    height, width = grey.shape
+    if side < 10 or not _inside(predicted, grey.shape):
+        return None  # too small to read, or cut by the frame edge
+    centre = square.mean(axis=0)
+    kept = _project(homography, centre + (square - centre) * (1 + 2 * KEPT_PAPER / board.MARKER))
+    x0, y0 = np.maximum(np.floor(kept.min(axis=0)).astype(int) - 2, 0)
+    x1, y1 = np.minimum(np.ceil(kept.max(axis=0)).astype(int) + 3, (width, height))
+    window = grey[y0:y1, x0:x1]
+    offset = np.float32([x0, y0])
+    picture = next(name for name, ids in marker_board.PICTURES.items() if marker_id in ids)
+    slot = board.picture_slot(picture)
+    pad = 8  # paper around the window, so that the detector's border rule keeps the marker
+    for overlap, (scale, kernel) in ((o, look) for o in PICTURE_OVERLAPS for look in WINDOW_LOOKS):
+        if (scale, kernel) == WINDOW_LOOKS[0]:  # a new overlap: paint the window again
+            mask = np.zeros(window.shape, np.uint8)
+            cv2.fillConvexPoly(mask, np.round((kept - offset) * 16).astype(np.int32), 255, cv2.LINE_8, shift=4)
+            painted = _project(homography, slot + np.sign(slot - slot.mean(axis=0)) * overlap)
+            cv2.fillConvexPoly(mask, np.round((painted - offset) * 16).astype(np.int32), 0, cv2.LINE_8, shift=4)
+            paper = float(np.percentile(window[mask > 0], 90))  # the marker's white cells and its paper
+            clean = cv2.copyMakeBorder(np.where(mask > 0, window, np.uint8(paper)), pad, pad, pad, pad,
+                                       cv2.BORDER_CONSTANT, value=paper)
+        corners = thinned_markers(clean, scale, kernel, detector).get(marker_id)
+        if corners is None:
+            continue
+        corners = corners + offset - pad
+        if _inside(corners, grey.shape) and np.abs(corners - predicted).max() < max(3.0, 0.25 * side):
+            # The painted-out picture notched the corner it touches: refine all four on the frame.
+            points = corners.reshape(-1, 1, 2).astype(np.float32)
+            half = max(2, round(side * CORNER_WINDOW))
+            cv2.cornerSubPix(grey, points, (half, half), (-1, -1),
+                             (cv2.TERM_CRITERIA_EPS + cv2.TERM_CRITERIA_COUNT, 30, 0.01))
+            return points.reshape(4, 2)
+    return None
     ### END SOLUTION
 
 
