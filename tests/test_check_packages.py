@@ -23,6 +23,7 @@ class Recorder:
         self.items.append({"ok": bool(ok), "message": message, "weight": weight})
         return bool(ok)
 
+    workspace_dir = context.Context.workspace_dir
     package_dir = context.Context.package_dir
 
 

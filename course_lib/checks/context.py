@@ -185,11 +185,15 @@ class Context:
 
         return self.package_dir(assignments.spec(self.spec.assignment).functions[0])
 
-    def package_dir(self, package: str) -> Path:
-        """A package's source folder beside the notebook, ros2_ws/src/<package>."""
+    def workspace_dir(self) -> Path:
+        """The assignment's workspace beside the notebook, ros2_ws."""
         from course_lib.checks import assignments
 
-        return Path(self.workdir) / assignments.WORKSPACE / "src" / package
+        return Path(self.workdir) / assignments.WORKSPACE
+
+    def package_dir(self, package: str) -> Path:
+        """A package's source folder beside the notebook, ros2_ws/src/<package>."""
+        return self.workspace_dir() / "src" / package
 
     def require_module(self) -> None:
         """Raise StudentError with the fix when the student's module file does not exist."""

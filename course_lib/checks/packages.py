@@ -35,13 +35,9 @@ from course_lib.checks.student_processes import student_env as _student_env
 _NOT_ROS = {"course_lib", "numpy", "cv2"}
 
 
-def workspace_dir(ctx) -> Path:
-    return Path(ctx.workdir) / WORKSPACE
-
-
 def require_build(ctx) -> Path:
     """The built workspace; raises StudentError with the reason when it is not built."""
-    ws = workspace_dir(ctx)
+    ws = ctx.workspace_dir()
     report = os.environ.get(contract.BUILD_REPORT_ENV)
     if report:
         data = json.loads(Path(report).read_text())
@@ -109,7 +105,7 @@ def ros_packages(ctx) -> set[str]:
     from course_lib import ament
 
     names = set(ament.packages())
-    src = workspace_dir(ctx) / "src"
+    src = ctx.workspace_dir() / "src"
     names.update(p.parent.name for p in src.glob("*/package.xml"))
     return names
 
