@@ -4,6 +4,7 @@ cannot see, without a notebook or nbgrader (the grading runs cover those end to 
 from __future__ import annotations
 
 import os
+import signal
 import subprocess
 import sys
 from pathlib import Path
@@ -111,3 +112,69 @@ def test_a_limit_holds_inside_the_sandbox(tmp_path):
     proc = sandbox.run_sandboxed([sys.executable, "-c", code], [], "memory hog", None, {}, tmp_path,
                                  processes.Limits(memory_mb=256, wall_seconds=60))
     assert proc.returncode != 0 and "MemoryError" in proc.log, proc.log
+
+
+#: Left behind by a sandboxed command: a daemon (its own session, re-parented) that sleeps.
+DAEMON = ("import os, sys, time\n"
+          "if os.fork() == 0:\n"
+          "    os.setsid()\n"
+          "    if os.fork() == 0:\n"
+          "        time.sleep(600)\n"
+          "    os._exit(0)\n"
+          "os.wait()\n"
+          "print('pid', os.getpid())\n"
+          "sys.exit(5)\n")
+
+
+@needs_namespaces
+def test_nothing_the_command_started_outlives_it():
+    """A daemon the command leaves (setsid, double fork) ends with it: the command is pid 2 of a
+    process-id namespace whose pid 1 ends with it. Its exit code comes through unchanged."""
+    token = f"sandbox-daemon-{os.getpid()}"
+    done = _inside(DAEMON + f"# {token}")
+    assert (done.returncode, done.stdout) == (5, "pid 2\n"), done.stderr
+    left = [pid for pid in os.listdir("/proc") if pid.isdigit() and _has_token(pid, token)]
+    assert left == []
+
+
+def _has_token(pid: str, token: str) -> bool:
+    try:
+        with open(f"/proc/{pid}/cmdline", "rb") as handle:
+            return token.encode() in handle.read()
+    except OSError:
+        return False
+
+
+@needs_namespaces
+def test_a_stop_reaches_the_command_once_and_its_signal_comes_through():
+    """SIGINT to the caller's process group (as NodeProcess.stop sends it) reaches the command,
+    and only through the sandbox's outer process, the group's one member (so exactly once); a
+    command killed by a signal looks killed by that signal from outside."""
+    code = ("import signal, sys, time\n"
+            "got = []\n"
+            "signal.signal(signal.SIGINT, lambda n, f: got.append(n))\n"
+            "print('ready', flush=True)\n"
+            "while not got:\n"
+            "    time.sleep(0.05)\n"
+            "print('got', got, flush=True)\n"
+            "signal.signal(signal.SIGTERM, signal.SIG_DFL)\n"
+            "import os; os.kill(os.getpid(), signal.SIGTERM)\n")
+    command = sandbox.sandbox_command([sys.executable, "-c", code], [])
+    proc = subprocess.Popen(command, stdout=subprocess.PIPE, text=True, start_new_session=True)
+    try:
+        assert proc.stdout.readline() == "ready\n"
+        assert [p for p in os.listdir("/proc") if p.isdigit() and _group_of(p) == proc.pid] == [str(proc.pid)]
+        os.killpg(proc.pid, signal.SIGINT)
+        assert proc.stdout.readline() == f"got [{int(signal.SIGINT)}]\n"
+        assert proc.wait(60) == -signal.SIGTERM
+    finally:
+        proc.kill()
+        proc.wait()
+
+
+def _group_of(pid: str) -> int | None:
+    try:
+        with open(f"/proc/{pid}/stat") as handle:
+            return int(handle.read().rsplit(")", 1)[1].split()[2])
+    except (OSError, IndexError, ValueError):
+        return None
