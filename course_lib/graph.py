@@ -136,8 +136,10 @@ def _topic_class(node, topic: str, msg_type, timeout: float | None):
     return message_class(kinds[0])
 
 
-def _matching_qos(node, topic: str, depth: int = 10):
-    """A subscription QoS every current publisher can serve, chosen as ``ros2 topic echo`` does."""
+def matching_qos(node, topic: str, depth: int = 10):
+    """A subscription QoS every current publisher can serve, chosen as ``ros2 topic echo`` and
+    rosbag2's recorder (Rosbag2QoS::adapt_request_to_offers) choose it: reliable only if every
+    publisher is, transient local only if every publisher is, the history ``depth`` given."""
     from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 
     publishers = node.get_publishers_info_by_topic(topic)
@@ -181,7 +183,7 @@ def subscription(topic: str, callback, msg_type=None, timeout: float | None = 5.
     name = node.resolve_topic_name(topic)
     cls = _topic_class(node, name, msg_type, timeout)
     handle = node.create_subscription(cls, name, callback,
-                                      _matching_qos(node, name) if qos is None else qos, raw=raw)
+                                      matching_qos(node, name) if qos is None else qos, raw=raw)
     try:
         yield name
     finally:
@@ -227,7 +229,7 @@ def topic_echo(topic: str, count: int = 1, timeout: float = 5.0, msg_type=None) 
     node = _graph_node()
     name = node.resolve_topic_name(topic)
     cls = _topic_class(node, name, msg_type, timeout)
-    with subscription(name, keep, cls, qos=_matching_qos(node, name, depth=max(10, count))):
+    with subscription(name, keep, cls, qos=matching_qos(node, name, depth=max(10, count))):
         arrived = _wait_until(lambda: len(received) >= count,
                               max(0.0, deadline - time.monotonic()))
     if not arrived:

@@ -310,7 +310,7 @@ class PlotView(_View):
             readers = [(series, getter) for series, name, _, getter in fields if name == topic]
             cls = next(cls for _, name, cls, _ in fields if name == topic)
             self.node.create_subscription(cls, topic, self._receiver(readers),
-                                          graph._matching_qos(tool, topic, depth=100))
+                                          graph.matching_qos(tool, topic, depth=100))
 
     @property
     def data(self) -> dict[str, tuple[list[float], list[float]]]:
