@@ -112,7 +112,7 @@ def test_help_lists_the_supported_commands_and_verbs():
 
 
 @pytest.mark.parametrize("args, names", [
-    (["bag", "record", "-a"], "ros2 bag is not supported"),
+    (["bag", "record", "-s", "sqlite3", "-a"], "ros2 bag record -s sqlite3 is not supported"),
     (["service", "echo", "/x"], "ros2 service echo is not supported"),
     (["topic", "echo", "/x", "--csv"], "ros2 topic echo: --csv is not supported"),
     (["topic", "echo", "/x", "--times", "3"], "ros2 topic echo: --times is not supported"),

@@ -12,6 +12,7 @@ real tool's verbs, options and output for what it supports, each a thin layer ov
 ``ros2 topic type|find|bw|delay``              :mod:`.topic` (course_lib.graph)
 ``ros2 service list|type|find|call``           :mod:`.service` (the tool node's clients)
 ``ros2 action list|info|type|send_goal``       :mod:`.action` (rclpy.action)
+``ros2 bag record|info|play``                  :mod:`.bag` (course_lib.bag_files)
 ``ros2 param list|get|set|dump|load``          :mod:`.param` (course_lib.parameters)
 ``ros2 interface show|list|package|packages``  :mod:`.interface` (course_lib.interfaces)
 ``ros2 pkg create|list|executables|prefix``    :mod:`.pkg` (course_lib.workspace, ament)

@@ -14,6 +14,7 @@ from course_lib.ros2cli.common import FULL_INSTALL, Unsupported, unsupported
 #: The commands the course's ros2 has, with ros2cli's help line for each.
 COMMANDS = {
     "action": "Various action related sub-commands",
+    "bag": "Various rosbag related sub-commands",
     "interface": "Show information about ROS interfaces",
     "launch": "Run a launch file",
     "node": "Various node related sub-commands",
@@ -25,7 +26,7 @@ COMMANDS = {
 }
 
 #: Commands of a full ros2cli install that the course's ros2 leaves out (named in --help).
-LEFT_OUT = ("bag", "component", "daemon", "doctor", "lifecycle", "multicast", "wtf")
+LEFT_OUT = ("component", "daemon", "doctor", "lifecycle", "multicast", "wtf")
 
 
 #: ros2cli's one option before the command (Jazzy), with its help text.

@@ -4,7 +4,10 @@ supported in one line, ros2cli's discovery options, QoS options, and waiting unt
 from __future__ import annotations
 
 import argparse
+import contextlib
+import signal
 import sys
+import threading
 import typing
 
 #: The end of every "not supported" line.
@@ -226,6 +229,26 @@ def wait_until(done: typing.Callable[[], bool], seconds: float | None = None) ->
     from course_lib import session
 
     return session.wait_for(done, timeout=loop_limit(seconds), poll=0.02)
+
+
+@contextlib.contextmanager
+def signals_received(numbers=(signal.SIGINT, signal.SIGTERM)):
+    """While the block runs, the signals ``numbers`` are noted, not raised: the block yields the
+    list they are appended to, and a verb polls it to end cleanly (close a bag) the way rosbag2
+    defers Ctrl-C and SIGTERM. Whatever this process inherited: started with ``&`` from a script
+    it has SIGINT ignored, and the verb must stop all the same. The previous handlers come back
+    at the end (nothing is handled outside the main thread, where Python cannot)."""
+    received: list[int] = []
+    if threading.current_thread() is not threading.main_thread():
+        yield received
+        return
+    previous = {number: signal.signal(number, lambda number, _frame: received.append(number))
+                for number in numbers}
+    try:
+        yield received
+    finally:
+        for number, handler in previous.items():
+            signal.signal(number, handler)
 
 
 def say(text: str = "", error: bool = False) -> None:
