@@ -343,66 +343,79 @@ def play_messages(messages, bag_start: int, rate: float, publish, clock, wait) -
     return False
 
 
-def _await_subscribers(node, publishers: dict) -> None:
+def _await_subscribers(node, publishers: dict, received: list) -> None:
     """Before the first message: until discovery has settled and each publisher has matched the
     subscriptions the graph shows on its topic, so that a running echo hears the bag from its
-    start (the real player starts at once; a new process may take a second to be discovered)."""
-    from course_lib import discovery
+    start (the real player starts at once; a new process may take a second to be discovered).
+    A signal ends the wait."""
+    from course_lib import discovery, session
     from course_lib.ros2cli.common import COMPLETE_SECONDS, DISCOVERY_BACKSTOP, QUIET_SECONDS
 
-    discovery.wait_for_discovery(minimum=0.0, quiet=QUIET_SECONDS, complete_within=COMPLETE_SECONDS)
-    from course_lib import session
+    discovery.wait_for_discovery(minimum=0.0, quiet=QUIET_SECONDS, complete_within=COMPLETE_SECONDS,
+                                 until=lambda: bool(received))
+    session.wait_for(lambda: bool(received) or all(publisher.get_subscription_count() >= node.count_subscribers(name)
+                                                   for name, publisher in publishers.items()),
+                     timeout=DISCOVERY_BACKSTOP)
 
-    session.wait_for(lambda: all(publisher.get_subscription_count() >= node.count_subscribers(name)
-                                 for name, publisher in publishers.items()), timeout=DISCOVERY_BACKSTOP)
 
-
-def _play(args) -> str | None:
-    from rclpy.duration import Duration
-
+def _publishers(node, metadata: bag_metadata.BagMetadata, topics: list[str]) -> dict:
+    """A publisher for each topic of the bag to play (of ``topics``, if given) whose type is
+    installed, with the QoS its recorded publishers offered; player.cpp's warning for the others."""
     from course_lib import message_yaml
+
+    publishers = {}
+    for topic in metadata.topics:
+        if topics and topic.name not in topics:
+            continue
+        try:
+            message_class = message_yaml.message_class(topic.type)
+        except ValueError as error:
+            node.get_logger().warning(f"Ignoring a topic '{topic.name}', reason: {error}.")
+            continue
+        publishers[topic.name] = node.create_publisher(
+            message_class, topic.name, playback_qos(topic.name, topic.offered_qos_profiles))
+    return publishers
+
+
+def _play(args) -> None:
+    from rclpy.duration import Duration
 
     try:
         files = bag_files.storage_files(args.bag_path)
         metadata = bag_files.read_metadata(args.bag_path)
     except bag_files.BagError as error:
         raise RuntimeError(str(error)) from None
-    node, executor = _node("rosbag2_player")
-    try:
-        node.get_logger().info(f"Set rate to {args.rate:g}")
-        publishers = {}
-        for topic in metadata.topics:
-            if args.topics and topic.name not in args.topics:
-                continue
-            try:
-                message_class = message_yaml.message_class(topic.type)
-            except ValueError as error:
-                node.get_logger().warning(f"Ignoring a topic '{topic.name}', reason: {error}.")
-                continue
-            publishers[topic.name] = node.create_publisher(
-                message_class, topic.name, playback_qos(topic.name, topic.offered_qos_profiles))
-        _await_subscribers(node, publishers)
-        node.get_logger().info("Playback until timestamp: -1")
-        limit = loop_limit(None)
-        began = time.monotonic()
-        with signals_received() as received:
+    with signals_received() as received:  # from here on, Ctrl-C ends playback (exit code 0)
+        node, executor = _node("rosbag2_player")
+        try:
+            node.get_logger().info(f"Set rate to {args.rate:g}")
+            publishers = _publishers(node, metadata, args.topics)
+            _await_subscribers(node, publishers, received)
+            node.get_logger().info("Playback until timestamp: -1")
+            limit = loop_limit(None)
+            began = time.monotonic()
+            published = [0]
+
+            def publish(name: str, data: bytes) -> None:
+                publishers[name].publish(data)
+                published[0] += 1
+
             def wait(seconds: float) -> bool:
                 executor.spin_once(timeout_sec=seconds)
                 return bool(received) or (limit is not None and time.monotonic() - began > limit)
 
-            while True:
+            while not received:
                 stopped = play_messages(bag_files.read_messages(files, list(publishers)), metadata.starting_time,
-                                        args.rate, lambda name, data: publishers[name].publish(data),
-                                        time.monotonic, wait)
-                if stopped or not args.loop or wait(0.0):
+                                        args.rate, publish, time.monotonic, wait)
+                # --loop starts again at once (a bag with nothing to play: after a moment)
+                if stopped or not args.loop or wait(0.0 if published[0] else 0.05):
                     break
             if not received:  # reliable subscribers get the last messages before the publishers go
                 for publisher in publishers.values():
                     publisher.wait_for_all_acked(Duration(seconds=ACK_SECONDS))
-    finally:
-        executor.shutdown(timeout_sec=0)
-        node.destroy_node()
-    return None
+        finally:
+            executor.shutdown(timeout_sec=0)
+            node.destroy_node()
 
 
 VERBS = {
