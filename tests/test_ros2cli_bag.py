@@ -232,3 +232,33 @@ def test_older_metadata_versions_are_read():
     assert (profile["history"], profile["reliability"], profile["durability"], profile["liveliness"]) == (
         "unknown", "reliable", "volatile", "automatic")
     assert bag_metadata.offered_profiles([offered("best_effort", "volatile")]) == [offered("best_effort", "volatile")]
+
+
+def test_service_event_topics_are_counted_apart():
+    """format_bag_metadata.cpp, as rosbag2's test_rosbag2_info_end_to_end.cpp reads it for its bag
+    bag_with_topics_and_service_events (metadata version 8): 'Messages:          2' (service events
+    left out), 'Service:           2', each service once as 'Service: ... | Type: ... | Event Count:
+    ... | Serialization Format: cdr' aligned at column 21, 'ROS Distro:        unknown' when empty."""
+    def topic(name, kind, count):
+        return {"topic_metadata": {"name": name, "type": kind, "serialization_format": "cdr",
+                                   "offered_qos_profiles": "", "type_description_hash": ""}, "message_count": count}
+
+    metadata = bag_metadata.from_dict({
+        "version": 8, "storage_identifier": "mcap", "duration": {"nanoseconds": 70653944},
+        "starting_time": {"nanoseconds_since_epoch": 1699345836270074454}, "message_count": 10,
+        "relative_file_paths": ["bag_with_topics_and_service_events.mcap"], "ros_distro": "",
+        "topics_with_message_count": [
+            topic("/test_service1/_service_event", "test_msgs/srv/BasicTypes_Event", 4),
+            topic("/test_topic1", "test_msgs/msg/Strings", 1),
+            topic("/test_service2/_service_event", "test_msgs/srv/BasicTypes_Event", 4),
+            topic("/test_topic2", "test_msgs/msg/Strings", 1)]})
+    lines = bag_metadata.format_info(metadata).splitlines()
+    assert lines[4:5] == ["ROS Distro:        unknown"] and lines[8:9] == ["Messages:          2"]
+    assert lines[9:] == [
+        "Topic information: Topic: /test_topic1 | Type: test_msgs/msg/Strings | Count: 1 | Serialization Format: cdr",
+        "                   Topic: /test_topic2 | Type: test_msgs/msg/Strings | Count: 1 | Serialization Format: cdr",
+        "Service:           2",
+        "Service information: Service: /test_service1 | Type: test_msgs/srv/BasicTypes | Event Count: 4 | "
+        "Serialization Format: cdr",
+        "                     Service: /test_service2 | Type: test_msgs/srv/BasicTypes | Event Count: 4 | "
+        "Serialization Format: cdr"]
