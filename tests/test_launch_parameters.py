@@ -32,7 +32,7 @@ def test_xml_param_values_are_typed_by_yaml_rules(tmp_path, demo_prefix):
             <param name="text_with_arg" value="n$(var count)"/>
           </node>
         </launch>""", "")
-    node, = run_launch_file(path).nodes
+    node, = run_launch_file(path).processes
     files = params_of(node.command)
     assert all(list(file) == ["/robot/talker"] for file in files)  # one file per tag, keyed by full name
     values = {name: value for file in files for name, value in file["/robot/talker"]["ros__parameters"].items()}
@@ -55,7 +55,7 @@ def test_yaml_param_values_keep_their_yaml_types(tmp_path, demo_prefix):
             - {name: floats, value: [1.5, 2.5]}
             - {name: from_arg, value: $(var count)}
         """)
-    node, = run_launch_file(path).nodes
+    node, = run_launch_file(path).processes
     files = params_of(node.command)
     assert all(list(file) == ["/**"] for file in files)  # no name given: every node's parameters
     values = {name: value for file in files for name, value in file["/**"]["ros__parameters"].items()}
@@ -84,7 +84,7 @@ def test_nested_params_get_dotted_names(tmp_path, demo_prefix, form):
               - {name: size, param: [{name: width, value: 640}]}
               - {name: name, value: front}
         """)
-    node, = run_launch_file(path).nodes
+    node, = run_launch_file(path).processes
     assert params_of(node.command) == [{"/**": {"ros__parameters": {"camera.size.width": 640,
                                                                    "camera.name": "front"}}}]
 
@@ -106,7 +106,7 @@ def test_param_from_a_file_is_passed_as_it_is(tmp_path, demo_prefix, form):
             - {from: $(find-pkg-share demo)/config/params.yaml}
             - {name: gain, value: 3}
         """)
-    node, = run_launch_file(path).nodes
+    node, = run_launch_file(path).processes
     first = node.command.index("--params-file")
     assert node.command[first + 1] == str(demo_prefix / "share" / "demo" / "config" / "params.yaml")
     assert params_of(node.command)[-1] == {"/**": {"ros__parameters": {"gain": 3}}}  # later files win
@@ -117,7 +117,7 @@ def test_a_missing_parameter_file_is_warned_about_and_skipped(tmp_path, demo_pre
     path = write(tmp_path, "xml", '<launch><node pkg="demo" exec="talker"><param from="nope.yaml"/></node></launch>',
                  "")
     context = run_launch_file(path)
-    assert "--params-file" not in context.nodes[0].command
+    assert "--params-file" not in context.processes[0].command
     assert context.warnings == [("launch_ros.actions.node",
                                  f"Parameter file path is not a file: {os.path.abspath('nope.yaml')}")]
 
@@ -129,5 +129,5 @@ def test_allow_substs_performs_substitutions_in_the_parameter_file(tmp_path, dem
           <arg name="who" default="me"/>
           <node pkg="demo" exec="talker"><param from="$(dirname)/p.yaml" allow_substs="true"/></node>
         </launch>""", "")
-    assert params_of(run_launch_file(path).nodes[0].command) == [{"/**": {"ros__parameters": {"who": "me"}}}]
+    assert params_of(run_launch_file(path).processes[0].command) == [{"/**": {"ros__parameters": {"who": "me"}}}]
 

@@ -46,7 +46,7 @@ def test_node_gets_the_command_line_launch_ros_builds(tmp_path, demo_prefix, for
             - {from: chatter, to: talk}
             - {from: /image, to: /camera/image_raw}
         """)
-    node, = run_launch_file(path).nodes
+    node, = run_launch_file(path).processes
     assert node.command == [str(demo_prefix / "lib" / "demo" / "talker"), "first", "two words",
                             "--ros-args", "--log-level", "debug",
                             "--ros-args", "-r", "__node:=talker", "-r", "__ns:=/robot",
@@ -60,14 +60,14 @@ def test_node_without_name_or_namespace_keeps_its_own(tmp_path, demo_prefix, for
     """No __node or __ns rule; output defaults to log; exec_name sets the process label."""
     path = write(tmp_path, form, '<launch><node pkg="demo" exec="listener" exec_name="ears"/></launch>',
                  "launch:\n- node: {pkg: demo, exec: listener, exec_name: ears}")
-    node, = run_launch_file(path).nodes
+    node, = run_launch_file(path).processes
     assert node.command == [str(demo_prefix / "lib" / "demo" / "listener"), "--ros-args"]
     assert (node.label, node.output, node.node_name, node.namespace) == ("ears", "log", None, None)
 
 
 def test_node_without_pkg_runs_exec_as_a_command(tmp_path):
     path = write(tmp_path, "xml", '<launch><node exec="sleep" args="5"/></launch>', "")
-    node, = run_launch_file(path).nodes
+    node, = run_launch_file(path).processes
     assert node.command == ["sleep", "5", "--ros-args"] and node.label == "sleep"
 
 
@@ -87,7 +87,7 @@ def test_node_environment_has_set_env_and_its_own_env_tags(tmp_path, demo_prefix
             env: [{name: COURSE_B, value: $(env COURSE_A)b}]
         - node: {pkg: demo, exec: listener}
         """)
-    talker, listener = run_launch_file(path, environment={"PATH": "/bin"}).nodes
+    talker, listener = run_launch_file(path, environment={"PATH": "/bin"}).processes
     assert talker.environment == {"PATH": "/bin", "COURSE_A": "a", "COURSE_B": "ab"}
     assert listener.environment == {"PATH": "/bin", "COURSE_A": "a"}
     assert "COURSE_A" not in os.environ  # the launch never changes this process's environment
@@ -130,7 +130,7 @@ def test_arguments_take_defaults_command_line_values_and_let(tmp_path, demo_pref
         """)
     context = run_launch_file(path, {"robot": "r2"})
     assert context.configurations == {"robot": "r2", "rate": "5", "topic": "r2/chatter"}
-    assert context.nodes[0].command[1:] == ["5", "fallback", "--ros-args", "-r", "__node:=r2_talker",
+    assert context.processes[0].command[1:] == ["5", "fallback", "--ros-args", "-r", "__node:=r2_talker",
                                             "-r", "chatter:=r2/chatter"]
 
 
@@ -170,7 +170,7 @@ def test_include_passes_its_args_and_what_it_sets_stays_set(tmp_path, demo_prefi
             arg: [{{name: who, value: alice}}]
         - node: {{pkg: demo, exec: listener, name: after_$(var set_inside)}}
         """)
-    assert [node.node_name for node in run_launch_file(path).nodes] == ["alice", "after_yes"]
+    assert [node.node_name for node in run_launch_file(path).processes] == ["alice", "after_yes"]
 
 
 def test_an_include_without_a_required_argument_names_the_include(tmp_path, demo_prefix):
@@ -219,9 +219,9 @@ def test_a_scoped_group_undoes_namespace_configurations_and_environment(tmp_path
         - node: {pkg: demo, exec: listener, name: c, namespace: rel}
         """)
     context = run_launch_file(path, environment={})
-    assert [(node.node_name, node.namespace) for node in context.nodes] == [
+    assert [(node.node_name, node.namespace) for node in context.processes] == [
         ("a", "/robot/arm"), ("b", "/absolute"), ("c", "/leaks/rel")]
-    assert context.nodes[0].environment == {"COURSE_INSIDE": "1"} and context.nodes[2].environment == {}
+    assert context.processes[0].environment == {"COURSE_INSIDE": "1"} and context.processes[2].environment == {}
     assert context.configurations == {"ros_namespace": "/leaks"}
 
 
@@ -238,8 +238,8 @@ def test_if_and_unless_choose_what_runs(tmp_path, demo_prefix, form):
         - node: {pkg: demo, exec: talker, unless: $(var with_listener)}
         - node: {pkg: demo, exec: listener, if: $(var with_listener)}
         """)
-    assert [node.label for node in run_launch_file(path).nodes] == ["talker"]
-    assert [node.label for node in run_launch_file(path, {"with_listener": "True"}).nodes] == ["listener"]
+    assert [node.label for node in run_launch_file(path).processes] == ["talker"]
+    assert [node.label for node in run_launch_file(path, {"with_listener": "True"}).processes] == ["listener"]
     with pytest.raises(LaunchFileError, match="a condition must be true, false, 1 or 0"):
         run_launch_file(path, {"with_listener": "maybe"})
 
@@ -331,7 +331,7 @@ def test_python_launch_files_are_explained_not_run(tmp_path):
 
 def test_a_file_with_another_ending_is_read_as_xml_or_yaml(tmp_path, demo_prefix):
     (tmp_path / "demo.launch").write_text("launch:\n- node: {pkg: demo, exec: talker}\n")
-    assert [node.label for node in run_launch_file(tmp_path / "demo.launch").nodes] == ["talker"]
+    assert [node.label for node in run_launch_file(tmp_path / "demo.launch").processes] == ["talker"]
 
 
 # --- the command line without running nodes -----------------------------------------------------

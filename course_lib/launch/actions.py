@@ -5,7 +5,7 @@ Running a description visits its actions one after the other in a LaunchContext:
 the environment of the nodes started after it, ``<group>`` (scoped by default) undoes both at
 its end, ``<push_ros_namespace>`` prefixes the namespace of later nodes (it is a launch
 configuration too, so a scoped group undoes it), ``<include>`` runs another launch file in the
-same scope (as in ROS 2 Jazzy: what it sets stays set), and ``<node>`` becomes a NodeToStart:
+same scope (as in ROS 2 Jazzy: what it sets stays set), and ``<node>`` becomes a ProcessToStart:
 the command line launch_ros would run.
 """
 
@@ -31,7 +31,7 @@ class LaunchContext:
         configurations: launch configurations by name (arguments, ``<let>``, "ros_namespace").
         environment: the environment for the nodes (a copy; os.environ is never changed).
         current_file: the launch file whose actions run now (``$(dirname)``).
-        nodes: the nodes to start, in order.
+        processes: the processes to start (ProcessToStart), in order.
         warnings: (logger, message) pairs the real tool logs as warnings.
     """
 
@@ -40,7 +40,7 @@ class LaunchContext:
         self.configurations = dict(configurations or {})
         self.environment = dict(os.environ if environment is None else environment)
         self.current_file = current_file or Path.cwd() / "launch"
-        self.nodes: list[NodeToStart] = []
+        self.processes: list[ProcessToStart] = []
         self.warnings: list[tuple[str, str]] = []
         self._scopes: list[tuple[dict, dict]] = []
         self._temp_dir: Path | None = None
@@ -66,16 +66,18 @@ class LaunchContext:
 
 
 @dataclass
-class NodeToStart:
-    """A node as the launch will start it.
+class ProcessToStart:
+    """A process as the launch will start it (a node, or any other program).
 
     Attributes:
-        command: the full command line (executable, arguments, ``--ros-args ...``).
+        command: the full command line (executable, arguments; a node's ``--ros-args ...``).
         environment: its complete environment.
         label: the process name the launch prints (``talker`` becomes ``[talker-1]``).
         output: "screen", "log" or "both".
-        node_name, namespace: what the launch sets (None where the node's own code decides).
-        file, line: where the <node> tag is.
+        node_name, namespace: what the launch sets (None where the node's own code decides, and
+            for a process that is no node).
+        file, line: where its tag is.
+        cwd: the folder it starts in (None: the launch's own).
     """
 
     command: list[str]
@@ -86,6 +88,7 @@ class NodeToStart:
     namespace: str | None
     file: Path
     line: int
+    cwd: str | None = None
 
 
 # --- actions ----------------------------------------------------------------------------------
@@ -293,7 +296,7 @@ class Node(Action):
             if count > 1:
                 context.warnings.append((label, f"there are now at least {count} nodes with the name {full_name} "
                                                 "created within this launch context"))
-        context.nodes.append(NodeToStart(command, environment, label, output, name, namespace, self.file, self.line))
+        context.processes.append(ProcessToStart(command, environment, label, output, name, namespace, self.file, self.line))
 
 
 def run_launch_file(path, arguments: dict | None = None, environment: dict | None = None) -> LaunchContext:
