@@ -284,7 +284,7 @@ def test_args_split_like_launch_splits_command_lines(text, expected):
     ("xml", "<launch>\n  <arg name='a'>\n    <choice value='x'/>\n  </arg>\n</launch>",
      3, r"<choice> is not supported inside <arg>"),
     ("xml", "<launch>\n  <group forwarding='false'/>\n</launch>", 2, "'forwarding' is not supported here"),
-    ("xml", "<launch>\n  <arg name='a' default='$(eval 1)'/>\n</launch>", 2, r"\$\(eval\) is not supported here"),
+    ("xml", "<launch>\n  <arg name='a' default='$(command ls)'/>\n</launch>", 2, r"\$\(command\) is not supported here"),
     ("xml", "<launch>\n  <node pkg='demo'/>\n</launch>", 2, "<node> needs the attribute 'exec'"),
     ("xml", "<launch>\n  <node pkg='demo' exec='talker'\n</launch>", 3, "not well-formed XML"),
     ("yaml", "launch:\n- node: {pkg: demo, exec: [talker\n", 3, "not valid YAML"),

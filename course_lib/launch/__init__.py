@@ -17,11 +17,12 @@ Supported, with the semantics of ros2/launch and launch_ros on Jazzy: ``<launch>
 file), ``<arg>``, ``<let>``, ``<include>`` (with ``<arg>``), ``<group>`` (scoped),
 ``<push_ros_namespace>``, ``<set_env>``, ``if``/``unless`` on every tag, and the
 substitutions ``$(var)``, ``$(env)``, ``$(find-pkg-share)``, ``$(find-pkg-prefix)``,
-``$(dirname)``, ``$(filename)``. Anything else is an error naming the file and line. Python
-launch files are not run here (a full ROS 2 install runs them).
+``$(dirname)``, ``$(filename)``, ``$(eval)``, ``$(not)``, ``$(and)``, ``$(or)``, ``$(any)``,
+``$(all)``, ``$(equals)``, ``$(not-equals)``, ``$(if)``. Anything else is an error naming the
+file and line. Python launch files are not run here (a full ROS 2 install runs them).
 
 The parts: entities.py reads XML/YAML into tags with line numbers, substitutions.py the
-``$(...)`` grammar, parser.py turns tags into actions, actions.py runs them into the nodes to
+``$(...)`` grammar, coercion.py launch's rules for typing text, parser.py turns tags into actions, actions.py runs them into the nodes to
 start (parameters.py types and writes their parameters), runner.py starts and stops the
 processes, cli.py is ``ros2 launch``.
 """
