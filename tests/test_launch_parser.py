@@ -294,8 +294,6 @@ def test_args_split_like_launch_splits_command_lines(text, expected):
      2, "<param> has both name and from"),
     ("xml", "<launch>\n<node pkg='demo' exec='talker'><param name='a' value='1'><param name='b' value='2'/>"
             "</param></node></launch>", 2, "both value= and nested <param> tags"),
-    ("xml", "<launch>\n<node pkg='demo' exec='talker'><param name='a' value='[1, 2.5]'/></node></launch>",
-     2, "mixes types"),
     ("xml", "<launch>\n<node pkg='demo' exec='talker' if='1' unless='0'/></launch>", 2, "both if and unless"),
     ("xml", "<group/>", 1, "the root tag must be <launch>"),
 ])

@@ -200,13 +200,15 @@ def _parameter(tag: Entity):
     nested = tag.nested("param")
     if tag.has("value") and nested:
         raise tag.error("<param> has both value= and nested <param> tags; use one")
+    if tag.has("type") and nested:  # launch_ros's words
+        raise tag.error("nested parameters and type attributes are mutually exclusive", "type")
     if tag.has("value"):
         value = parameters.value_of(tag)
     elif nested:
         value = parameters.ParamGroup([_parameter(inner) for inner in nested], tag.file, tag.line)
     else:
         raise tag.error("<param> needs value= or nested <param> tags")
-    tag.check_all_read("name, value, nested <param>", KNOWN["param"])
+    tag.check_all_read("name, value, value-sep, type, nested <param>", KNOWN["param"])
     return name, value
 
 
