@@ -226,6 +226,101 @@ def test_a_scoped_group_undoes_namespace_configurations_and_environment(tmp_path
 
 
 @BOTH
+def test_a_group_that_does_not_forward_keeps_only_what_it_keeps(tmp_path, demo_prefix, form):
+    """launch_xml's and launch_yaml's test_group.py: inside <group scoped="True" forwarding="False">
+    with <keep name="bar" value="$(var bar)"/> and <keep name="baz" value="BAZ"/>, 'foo' is gone,
+    bar is 'BAR' and baz 'BAZ'. As GroupAction resets them, the pushed namespace and <set_env>
+    do not reach inside either; after the group all is as before."""
+    path = write(tmp_path, form, """
+        <launch>
+          <let name="foo" value="FOO"/>
+          <let name="bar" value="BAR"/>
+          <set_env name="COURSE_OUTSIDE" value="1"/>
+          <push_ros_namespace namespace="robot"/>
+          <group scoped="True" forwarding="False">
+            <keep name="bar" value="$(var bar)"/>
+            <keep name="baz" value="BAZ"/>
+            <node pkg="demo" exec="talker" name="inside" args="$(var foo none) $(var bar) $(var baz)"/>
+          </group>
+          <group forwarding="true">
+            <keep name="foo" value="kept_$(var foo)"/>
+            <node pkg="demo" exec="talker" name="forwarded" args="$(var foo) $(var bar)"/>
+          </group>
+          <node pkg="demo" exec="talker" name="after" args="$(var foo) $(var baz none)"/>
+        </launch>""", """
+        launch:
+        - let: {name: foo, value: FOO}
+        - let: {name: bar, value: BAR}
+        - set_env: {name: COURSE_OUTSIDE, value: "1"}
+        - push_ros_namespace: {namespace: robot}
+        - group:
+            scoped: True
+            forwarding: False
+            keep:
+            - {name: bar, value: $(var bar)}
+            - {name: baz, value: BAZ}
+            children:
+            - node: {pkg: demo, exec: talker, name: inside, args: $(var foo none) $(var bar) $(var baz)}
+        - group:
+            forwarding: true
+            keep: [{name: foo, value: kept_$(var foo)}]
+            children:
+            - node: {pkg: demo, exec: talker, name: forwarded, args: $(var foo) $(var bar)}
+        - node: {pkg: demo, exec: talker, name: after, args: $(var foo) $(var baz none)}
+        """)
+    inside, forwarded, after = run_launch_file(path, environment={}).processes
+    assert (inside.command[1:4], inside.namespace, inside.environment) == (["none", "BAR", "BAZ"], None, {})
+    assert (forwarded.command[1:3], forwarded.namespace) == (["kept_FOO", "BAR"], "/robot")
+    assert (after.command[1:3], after.namespace, after.environment) == (["FOO", "none"], "/robot", {"COURSE_OUTSIDE": "1"})
+
+
+@BOTH
+def test_arg_choices_describe_and_check_the_value_as_launch_does(tmp_path, demo_prefix, form, capsys):
+    """launch_xml's test_arg.py (test_arg_with_choices): the description becomes "something. Valid
+    choices are: ['asd', 'bsd']"; launch's DeclareLaunchArgument refuses another value in its words
+    (test_declare_launch_argument.py: 'Valid options are'), whether it is given or the default."""
+    path = write(tmp_path, form, """
+        <launch>
+          <arg name="my_arg" default="asd" description="something">
+            <choice value="asd"/>
+            <choice value="bsd"/>
+          </arg>
+          <arg name="mode" default="fast">
+            <choice value="slow"/>
+          </arg>
+        </launch>""", """
+        launch:
+        - arg:
+            name: my_arg
+            default: asd
+            description: something
+            choice: [{value: asd}, {value: bsd}]
+        - arg:
+            name: mode
+            default: fast
+            choice: [{value: slow}]
+        """)
+    assert run_launch_file(path, {"my_arg": "bsd", "mode": "slow"}).configurations == {"my_arg": "bsd", "mode": "slow"}
+    with pytest.raises(LaunchFileError) as error:
+        run_launch_file(path, {"my_arg": "csd", "mode": "slow"})
+    assert (error.value.message, error.value.line) == (
+        """Argument "my_arg" provided value "csd" is not valid. Valid options are: ['asd', 'bsd']""", 2)
+    with pytest.raises(LaunchFileError, match=r"""Argument "mode" provided value "fast" is not valid. Valid options """
+                                              r"""are: \['slow'\]$"""):
+        run_launch_file(path)
+    assert cli.main(["-s", str(path)]) == 0
+    assert "        something. Valid choices are: ['asd', 'bsd']" in capsys.readouterr().out.splitlines()
+    assert actions_description(path, "mode") == "One of: ['slow']"
+
+
+def actions_description(path, name: str) -> str:
+    from course_lib.launch import actions, parser
+
+    declared = actions.declared_arguments(parser.load_description(path), None, path)
+    return next(argument.description for argument, _, _ in declared if argument.name == name)
+
+
+@BOTH
 def test_if_and_unless_choose_what_runs(tmp_path, demo_prefix, form):
     path = write(tmp_path, form, """
         <launch>
@@ -281,9 +376,9 @@ def test_args_split_like_launch_splits_command_lines(text, expected):
      5, r"Unexpected key\(s\) found in `node`: \{'namepsace'\} \(did you mean 'namespace'\?\)$"),
     ("xml", "<launch>\n  <node pkg='demo' exec='talker'>\n    <parameter name='a' value='1'/>\n  </node>\n</launch>",
      3, r"Unexpected nested tag\(s\) found in `node`: \{'parameter'\} \(did you mean 'param'\?\)$"),
-    ("xml", "<launch>\n  <arg name='a'>\n    <choice value='x'/>\n  </arg>\n</launch>",
-     3, r"<choice> is not supported inside <arg>"),
-    ("xml", "<launch>\n  <group forwarding='false'/>\n</launch>", 2, "'forwarding' is not supported here"),
+    ("xml", "<launch>\n  <arg name='a'>\n    <choice value='x' valeu='y'/>\n  </arg>\n</launch>",
+     3, r"Unexpected attribute\(s\) found in `choice`: \{'valeu'\} \(did you mean 'value'\?\)$"),
+    ("xml", "<launch>\n  <group>\n    <keep name='a'/>\n  </group>\n</launch>", 3, "<keep> needs the attribute 'value'"),
     ("xml", "<launch>\n  <arg name='a' default='$(command ls)'/>\n</launch>", 2, r"\$\(command\) is not supported here"),
     ("xml", "<launch>\n  <node pkg='demo'/>\n</launch>", 2, "<node> needs the attribute 'exec'"),
     ("xml", "<launch>\n  <node pkg='demo' exec='talker'\n</launch>", 3, "not well-formed XML"),

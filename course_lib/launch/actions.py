@@ -30,6 +30,8 @@ class LaunchContext:
     Attributes:
         configurations: launch configurations by name (arguments, ``<let>``, "ros_namespace").
         environment: the environment for the nodes (a copy; os.environ is never changed).
+        initial_environment: the environment the launch started with (a group that does not
+            forward starts from it).
         current_file: the launch file whose actions run now (``$(dirname)``).
         processes: the processes to start (ProcessToStart), in order.
         warnings: (logger, message) pairs the real tool logs as warnings.
@@ -39,6 +41,7 @@ class LaunchContext:
                  current_file: Path | None = None):
         self.configurations = dict(configurations or {})
         self.environment = dict(os.environ if environment is None else environment)
+        self.initial_environment = dict(self.environment)
         self.current_file = current_file or Path.cwd() / "launch"
         self.processes: list[ProcessToStart] = []
         self.warnings: list[tuple[str, str]] = []
@@ -122,18 +125,38 @@ class Action:
 
 @dataclass
 class DeclareArgument(Action):
-    """``<arg name= default= description=/>``: a launch argument, set from ``name:=value``."""
+    """``<arg name= default= description=>`` with optional ``<choice value=/>`` tags: a launch
+    argument, set from ``name:=value``, whose value must be one of the choices when there are any.
+
+    Attributes:
+        description: as launch's DeclareLaunchArgument words it: the one given, or "no description
+            given"; with choices, "One of: [...]", or the one given and ". Valid choices are: [...]".
+    """
 
     name: str
     default: list | None
-    description: str | None
+    description: str | None  # as given; __post_init__ makes it launch's
+    choices: list[str] | None = None
+
+    def __post_init__(self):
+        given = self.description
+        if self.choices is None:
+            self.description = "no description given" if given is None else given
+        elif given is None:
+            self.description = f"One of: {self.choices}"
+        else:
+            self.description = f"{given if given.endswith('.') else given + '.'} Valid choices are: {self.choices}"
 
     def execute(self, context: LaunchContext) -> None:
-        if self.name in context.configurations:
-            return
-        if self.default is None:
-            raise self.error(f'Required launch argument "{self.name}" was not provided: pass {self.name}:=VALUE')
-        context.configurations[self.name] = substitutions.perform(self.default, context)
+        if self.name not in context.configurations:
+            if self.default is None:
+                raise self.error(f'Required launch argument "{self.name}" was not provided: pass '
+                                 f'{self.name}:=VALUE')
+            context.configurations[self.name] = substitutions.perform(self.default, context)
+        value = context.configurations[self.name]
+        if self.choices is not None and value not in self.choices:  # launch's words
+            raise self.error(f'Argument "{self.name}" provided value "{value}" is not valid. Valid options '
+                             f'are: {self.choices}')
 
 
 @dataclass
@@ -175,14 +198,30 @@ class PushRosNamespace(Action):
 
 @dataclass
 class Group(Action):
-    """``<group scoped="true">``: its actions; scoped, what they set ends with the group."""
+    """``<group scoped= forwarding=>`` with ``<keep name= value=/>`` tags, as launch's GroupAction.
+
+    Scoped (the default), what its actions set ends with the group. Not forwarding (scoped only),
+    the group starts from no launch configurations (so no pushed namespace either) and the
+    environment the launch started with, except the kept configurations, whose values are
+    performed before that. Forwarding, or not scoped, the kept ones are simply set.
+    """
 
     actions: list
     scoped: bool = True
+    forwarding: bool = True
+    keep: list = field(default_factory=list)  # [(name parts, value parts)]
 
     def execute(self, context: LaunchContext) -> None:
         if self.scoped:
             context.push()
+        if self.scoped and not self.forwarding:
+            kept = {substitutions.perform(name, context): substitutions.perform(value, context)
+                    for name, value in self.keep}
+            context.configurations = kept
+            context.environment = dict(context.initial_environment)
+        else:
+            for name, value in self.keep:
+                context.configurations[substitutions.perform(name, context)] = substitutions.perform(value, context)
         for action in self.actions:
             action.run(context)
         if self.scoped:
@@ -211,7 +250,7 @@ class IncludeLaunchDescription(Action):
             if argument.default is None and not conditional and argument.name not in given + passed_below:
                 raise LaunchFileError(
                     f"Included launch description missing required argument '{argument.name}' "
-                    f"(description: '{argument.description or 'no description given'}'), given: "
+                    f"(description: '{argument.description}'), given: "
                     f"[{', '.join(given)}]; " + (f"pass it as {argument.name}:=VALUE" if self.from_command_line
                                                  else f"add <arg name=\"{argument.name}\" value=\"...\"/> to the "
                                                  f"<include> at {self.file}:{self.line}"),

@@ -42,6 +42,8 @@ KNOWN = {
     "remap": {"from", "to"},
     "env": {"name", "value"},
     "include/arg": {"name", "value"},
+    "arg/choice": {"value"},
+    "group/keep": {"name", "value"},
 }
 
 
@@ -103,10 +105,20 @@ def _arg(entity: Entity):
     if not isinstance(raw_name, str):
         raise entity.error("<arg> name must be text", "name")
     description = entity.get("description")
+    choices = None
+    if entity.nested("choice"):
+        choices = []
+        for tag in entity.nested("choice"):
+            value = tag.get("value", required=True)
+            if not isinstance(value, str):  # launch_yaml's words
+                raise tag.error(f"Attribute 'value' of Entity 'choice' expected to be of type '{str}', got "
+                                f"'{type(value)}'", "value")
+            choices.append(substitutions.unescape(value))
+            tag.check_all_read("value", KNOWN["arg/choice"])
     return (DeclareArgument(name=substitutions.unescape(raw_name), default=_text(entity, "default"),
                             description=None if description is None else substitutions.unescape(str(description)),
-                            **_where(entity)),
-            f"name, default, description, {_CONDITION}")
+                            choices=choices, **_where(entity)),
+            f"name, default, description, {_CONDITION}, nested <choice value=>")
 
 
 def _let(entity: Entity):
@@ -127,11 +139,13 @@ def _push_ros_namespace(entity: Entity):
 
 
 def _group(entity: Entity):
-    scoped = entity.get_bool("scoped")
+    scoped, forwarding = entity.get_bool("scoped"), entity.get_bool("forwarding")
     where = _where(entity)
-    actions = [parse_action(child) for child in entity.children()]
-    return (Group(actions=actions, scoped=True if scoped is None else scoped, **where),
-            f"scoped, {_CONDITION}, and tags inside it")
+    keep = _pairs(entity, "keep", "name", "value")
+    actions = [parse_action(child) for child in entity.children() if child.kind != "keep"]
+    return (Group(actions=actions, scoped=True if scoped is None else scoped,
+                  forwarding=True if forwarding is None else forwarding, keep=keep, **where),
+            f"scoped, forwarding, {_CONDITION}, nested <keep name= value=>, and tags inside it")
 
 
 def _pairs(entity: Entity, kind: str, first: str, second: str) -> list[tuple[list, list]]:
