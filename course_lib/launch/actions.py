@@ -5,8 +5,8 @@ Running a description visits its actions one after the other in a LaunchContext:
 the environment of the nodes started after it, ``<group>`` (scoped by default) undoes both at
 its end, ``<push_ros_namespace>`` prefixes the namespace of later nodes (it is a launch
 configuration too, so a scoped group undoes it), ``<include>`` runs another launch file in the
-same scope (as in ROS 2 Jazzy: what it sets stays set), and ``<node>`` becomes a ProcessToStart:
-the command line launch_ros would run.
+same scope (as in ROS 2 Jazzy: what it sets stays set). ``<node>`` and ``<executable>``
+(executables.py) become the processes to start.
 """
 
 from __future__ import annotations
@@ -18,10 +18,11 @@ import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from course_lib.launch import parameters, substitutions
+from course_lib.launch import substitutions
 from course_lib.launch.entities import LaunchFileError
 
-_NAME_TOKEN = re.compile(r"[A-Za-z_][A-Za-z0-9_]*$")
+#: A name token of ROS names (node names, namespace parts).
+NAME_TOKEN = re.compile(r"[A-Za-z_][A-Za-z0-9_]*$")
 
 
 class LaunchContext:
@@ -43,7 +44,7 @@ class LaunchContext:
         self.environment = dict(os.environ if environment is None else environment)
         self.initial_environment = dict(self.environment)
         self.current_file = current_file or Path.cwd() / "launch"
-        self.processes: list[ProcessToStart] = []
+        self.processes: list = []  # executables.ProcessToStart
         self.warnings: list[tuple[str, str]] = []
         self._scopes: list[tuple[dict, dict]] = []
         self._temp_dir: Path | None = None
@@ -66,32 +67,6 @@ class LaunchContext:
         if self._temp_dir is not None:
             shutil.rmtree(self._temp_dir, ignore_errors=True)
             self._temp_dir = None
-
-
-@dataclass
-class ProcessToStart:
-    """A process as the launch will start it (a node, or any other program).
-
-    Attributes:
-        command: the full command line (executable, arguments; a node's ``--ros-args ...``).
-        environment: its complete environment.
-        label: the process name the launch prints (``talker`` becomes ``[talker-1]``).
-        output: "screen", "log" or "both".
-        node_name, namespace: what the launch sets (None where the node's own code decides, and
-            for a process that is no node).
-        file, line: where its tag is.
-        cwd: the folder it starts in (None: the launch's own).
-    """
-
-    command: list[str]
-    environment: dict
-    label: str
-    output: str
-    node_name: str | None
-    namespace: str | None
-    file: Path
-    line: int
-    cwd: str | None = None
 
 
 # --- actions ----------------------------------------------------------------------------------
@@ -265,79 +240,6 @@ class IncludeLaunchDescription(Action):
             context.current_file = including
 
 
-@dataclass
-class Node(Action):
-    """``<node pkg= exec= name= namespace= output= args= ros_args=>`` with param, remap, env."""
-
-    package: list | None
-    executable: list
-    name: list | None = None
-    namespace: list | None = None
-    exec_name: list | None = None
-    output: list | None = None
-    arguments: list = field(default_factory=list)  # [parts] per command-line argument
-    ros_arguments: list | None = None
-    parameters: list = field(default_factory=list)  # ParamGroup | ParamFile
-    remappings: list = field(default_factory=list)  # [(from parts, to parts)]
-    environment: list = field(default_factory=list)  # [(name parts, value parts)]
-
-    def execute(self, context: LaunchContext) -> None:
-        from course_lib import ament
-
-        def text(parts):
-            return substitutions.perform(parts, context)
-
-        executable = text(self.executable)
-        if self.package is not None:
-            try:
-                executable = str(ament.executable(text(self.package), executable))
-            except LookupError as error:
-                raise self.error(str(error)) from None
-        command = [executable] + [text(argument) for argument in self.arguments]
-        if self.ros_arguments is not None:
-            command += ["--ros-args"] + [text(argument) for argument in self.ros_arguments]
-        command.append("--ros-args")
-        name = None if self.name is None else text(self.name)
-        if name is not None:
-            if not _NAME_TOKEN.match(name):
-                raise self.error(f"the node name '{name}' is invalid: use letters, digits and underscores, "
-                                 "not starting with a digit")
-            command += ["-r", f"__node:={name}"]
-        namespace = absolute_namespace(prefix_namespace(
-            context.configurations.get("ros_namespace"), None if self.namespace is None else text(self.namespace)))
-        if namespace is not None:
-            problem = namespace_problem(namespace)
-            if problem:
-                raise self.error(f"the namespace '{namespace}' of this node is invalid: {problem}")
-            command += ["-r", f"__ns:={namespace}"]
-        full_name = f"{namespace.rstrip('/')}/{name}" if name is not None and namespace is not None else None
-        for parameter in self.parameters:
-            if isinstance(parameter, parameters.ParamFile):
-                path = parameters.resolve_file(parameter, context, context.temp_dir())
-                if path is None:
-                    context.warnings.append(("launch_ros.actions.node", "Parameter file path is not a file: "
-                                             f"{os.path.abspath(text(parameter.path))}"))
-                    continue
-            else:
-                values = parameters.evaluate_group(parameter, context)
-                path = parameters.write_params_file(values, full_name or "/**", context.temp_dir())
-            command += ["--params-file", str(path)]
-        for source, target in self.remappings:
-            command += ["-r", f"{text(source)}:={text(target)}"]
-        environment = dict(context.environment)
-        environment.update({text(key): text(value) for key, value in self.environment})
-        output = "log" if self.output is None else text(self.output)
-        if output not in ("screen", "log", "both"):
-            raise self.error(f"output=\"{output}\" is not supported here; use screen, log or both")
-        label = os.path.basename(executable) if self.exec_name is None else text(self.exec_name)
-        if full_name is not None:
-            count = context._node_names[full_name] = context._node_names.get(full_name, 0) + 1
-            if count > 1:
-                context.warnings.append((label, f"there are now at least {count} nodes with the name {full_name} "
-                                                "created within this launch context"))
-        context.processes.append(ProcessToStart(command, environment, label, output, name, namespace, self.file, self.line))
-
-
 def run_launch_file(path, arguments: dict | None = None, environment: dict | None = None) -> LaunchContext:
     """Run a launch file's actions, as ``ros2 launch`` does before its processes start.
 
@@ -390,7 +292,7 @@ def namespace_problem(namespace: str) -> str | None:
     if namespace == "/":
         return None
     tokens = namespace[1:].split("/")
-    bad = [token for token in tokens if not _NAME_TOKEN.match(token)]
+    bad = [token for token in tokens if not NAME_TOKEN.match(token)]
     if bad:
         return (f"'{bad[0]}' is not a name: namespaces are names (letters, digits, underscores, "
                 "not starting with a digit) separated by single '/'")

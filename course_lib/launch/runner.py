@@ -33,7 +33,8 @@ from pathlib import Path
 from typing import Callable
 
 from course_lib import processes
-from course_lib.launch.actions import LaunchContext, ProcessToStart, run_launch_file
+from course_lib.launch.actions import LaunchContext, run_launch_file
+from course_lib.launch.executables import ProcessToStart
 from course_lib.launch.entities import LaunchFileError
 
 #: How a launch stops a process that still runs, as ros2/launch's ExecuteLocal does: SIGINT, then
