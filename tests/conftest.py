@@ -1,10 +1,14 @@
-"""Fixtures shared by the test modules: a browser, a marker for a test's own processes."""
+"""Fixtures shared by the test modules: a browser, a marker for a test's own processes, a
+package for launch files."""
 
 import contextlib
+import os
+import tempfile
 
 import pytest
 
 from browser_support import ChromiumUnavailable, launched_chromium
+from launch_demo import make_prefix
 from process_support import marker, processes_with
 
 
@@ -26,3 +30,22 @@ def token():
     yield value
     for leftover in processes_with(value):
         leftover.kill()
+
+
+@pytest.fixture(scope="module")
+def demo_prefix(tmp_path_factory):
+    """A prefix with package demo (executables talker and listener, share/demo/config/params.yaml),
+    on AMENT_PREFIX_PATH for the module."""
+    prefix = make_prefix(tmp_path_factory.mktemp("prefix"), "demo",
+                         {"talker": "#!/bin/sh\n", "listener": "#!/bin/sh\n"},
+                         {"config/params.yaml": "/**:\n  ros__parameters:\n    gain: 2\n"})
+    saved = os.environ.get("AMENT_PREFIX_PATH")
+    os.environ["AMENT_PREFIX_PATH"] = f"{prefix}{os.pathsep}{saved or ''}"
+    yield prefix
+    os.environ["AMENT_PREFIX_PATH"] = saved or ""
+
+
+@pytest.fixture
+def launch_files_in_tmp_path(tmp_path, monkeypatch):
+    """The parameter files a launch writes go to the test's own folder."""
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))

@@ -8,7 +8,11 @@ and ``$(find-pkg-share)`` look at; put the prefix on AMENT_PREFIX_PATH to use it
 from __future__ import annotations
 
 import sys
+import textwrap
 from pathlib import Path
+
+import pytest
+import yaml
 
 #: An rclpy node (a module with main(), as setup.py's entry points want) named after its
 #: executable: it publishes "Hello World: N" on chatter at 10 Hz, listens on heard, declares
@@ -76,3 +80,20 @@ def make_prefix(prefix: Path, package: str, executables: dict[str, str], share: 
         (lib / name).write_text(text)
         (lib / name).chmod(0o755)
     return prefix
+
+
+#: Runs a test once with each launch file format.
+BOTH = pytest.mark.parametrize("form", ["xml", "yaml"])
+
+
+def write(folder: Path, form: str, xml: str, yaml_text: str, name: str = "test") -> Path:
+    """Write the XML or the YAML form of a launch file and return its path."""
+    path = folder / (f"{name}.launch.xml" if form == "xml" else f"{name}.launch.yaml")
+    path.write_text(textwrap.dedent(xml if form == "xml" else yaml_text).strip() + "\n")
+    return path
+
+
+def params_of(command: list[str]) -> list[dict]:
+    """The parameter files a command line passes, read back."""
+    return [yaml.safe_load(Path(command[i + 1]).read_text())
+            for i, part in enumerate(command) if part == "--params-file"]

@@ -67,6 +67,10 @@ ENDINGS = """\
 <launch>
   <node pkg="course_demo" exec="crasher"/>
   <node pkg="course_demo" exec="quitter"/>
+  <executable cmd="sh -c 'pwd; echo $COURSE_WORD; exit 3'" cwd="$(dirname)" name="job" output="screen">
+    <env name="COURSE_WORD" value="hello"/>
+  </executable>
+  <executable cmd="sh -c 'echo hidden'"/>
 </launch>
 """
 
@@ -205,6 +209,8 @@ def test_every_tag_brings_up_the_expected_graph_and_ctrl_c_ends_it(prefix, ros_d
 
 
 def test_processes_that_end_are_reported_and_then_the_launch_ends(prefix, ros_domain):
+    """Nodes and <executable> programs alike: launch's process names ([job-3]; an executable
+    without a name takes its program's, [sh-4]), output, cwd and env, and its end-of-process lines."""
     process = ros2_launch("course_demo", "endings.launch.xml", domain_id=ros_domain)
     output, _ = process.communicate(timeout=30)
     assert process.returncode == 0, output
@@ -215,6 +221,15 @@ def test_processes_that_end_are_reported_and_then_the_launch_ends(prefix, ros_do
     assert (f"[ERROR] [{name}]: process has died [pid {pid}, exit code 1, "
             f"cmd '{prefix}/lib/course_demo/crasher --ros-args'].") in lines
     assert any("[quitter-" in line and "process has finished cleanly" in line for line in lines)
+    job = next(line for line in lines if line.startswith("[INFO] [job-") and "process started with pid" in line)
+    job_name, job_pid = job.split("] [")[1].split("]")[0], job.rsplit("[", 1)[1].rstrip("]")
+    assert [line for line in lines if line.startswith(f"[{job_name}] ")] == [
+        f"[{job_name}] {prefix}/share/course_demo/launch", f"[{job_name}] hello"]  # cwd, env; output="screen"
+    assert (f"[ERROR] [{job_name}]: process has died [pid {job_pid}, exit code 3, cmd 'sh -c pwd; echo "
+            "$COURSE_WORD; exit 3'].") in lines
+    sh = next(line.split("] [")[1].split("]")[0] for line in lines if line.startswith("[INFO] [sh-"))
+    assert f"[INFO] [{sh}]: process has finished cleanly" in "\n".join(lines)
+    assert f"[{sh}] hidden" not in lines  # output="log" by default: stdout only in launch.log
     # The catdog check's launch item stops waiting on these lines (a marker_reader that died at start
     # kept it waiting for its whole backstop while the launch's camera went on).
     from course_lib.checks.catdog_warp import _ended

@@ -12,18 +12,22 @@ From a notebook::
     demo.wait_for_nodes(); print(demo.log); demo.stop()
 
 Supported, with the semantics of ros2/launch and launch_ros on Jazzy: ``<launch>``, ``<node>``
-(pkg, exec, name, namespace, exec_name, output, args, ros_args; nested ``<param>``, ``<remap>``,
-``<env>``), ``<param>`` (name/value typed by YAML's rules, nested names, ``from=`` a YAML
-file), ``<arg>``, ``<let>``, ``<include>`` (with ``<arg>``), ``<group>`` (scoped),
+(pkg, exec, name, namespace, exec_name, output, args, ros_args, cwd, launch-prefix; nested
+``<param>``, ``<remap>``, ``<env>``), ``<executable>`` (cmd, name, cwd, output, launch-prefix;
+nested ``<env>``), ``<param>`` (name/value typed by YAML's rules or by ``type=``, ``value-sep``
+lists, nested names, ``from=`` a YAML file), ``<arg>`` (with ``<choice>``), ``<let>``,
+``<include>`` (with ``<arg>``), ``<group>`` (scoped, forwarding, with ``<keep>``),
 ``<push_ros_namespace>``, ``<set_env>``, ``if``/``unless`` on every tag, and the
 substitutions ``$(var)``, ``$(env)``, ``$(find-pkg-share)``, ``$(find-pkg-prefix)``,
-``$(dirname)``, ``$(filename)``. Anything else is an error naming the file and line. Python
-launch files are not run here (a full ROS 2 install runs them).
+``$(dirname)``, ``$(filename)``, ``$(eval)``, ``$(not)``, ``$(and)``, ``$(or)``, ``$(any)``,
+``$(all)``, ``$(equals)``, ``$(not-equals)``, ``$(if)``. Anything else is an error naming the
+file and line. Python launch files are not run here (a full ROS 2 install runs them).
 
 The parts: entities.py reads XML/YAML into tags with line numbers, substitutions.py the
-``$(...)`` grammar, parser.py turns tags into actions, actions.py runs them into the nodes to
-start (parameters.py types and writes their parameters), runner.py starts and stops the
-processes, cli.py is ``ros2 launch``.
+``$(...)`` grammar, coercion.py launch's rules for typing text, parser.py turns tags into
+actions, actions.py runs them (executables.py makes ``<node>`` and ``<executable>`` the
+processes to start; parameters.py types and writes a node's parameters), runner.py starts and
+stops the processes, cli.py is ``ros2 launch``.
 """
 
 from course_lib.launch.cli import main

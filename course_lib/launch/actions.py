@@ -5,8 +5,8 @@ Running a description visits its actions one after the other in a LaunchContext:
 the environment of the nodes started after it, ``<group>`` (scoped by default) undoes both at
 its end, ``<push_ros_namespace>`` prefixes the namespace of later nodes (it is a launch
 configuration too, so a scoped group undoes it), ``<include>`` runs another launch file in the
-same scope (as in ROS 2 Jazzy: what it sets stays set), and ``<node>`` becomes a NodeToStart:
-the command line launch_ros would run.
+same scope (as in ROS 2 Jazzy: what it sets stays set). ``<node>`` and ``<executable>``
+(executables.py) become the processes to start.
 """
 
 from __future__ import annotations
@@ -18,10 +18,11 @@ import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from course_lib.launch import parameters, substitutions
+from course_lib.launch import substitutions
 from course_lib.launch.entities import LaunchFileError
 
-_NAME_TOKEN = re.compile(r"[A-Za-z_][A-Za-z0-9_]*$")
+#: A name token of ROS names (node names, namespace parts).
+NAME_TOKEN = re.compile(r"[A-Za-z_][A-Za-z0-9_]*$")
 
 
 class LaunchContext:
@@ -30,8 +31,10 @@ class LaunchContext:
     Attributes:
         configurations: launch configurations by name (arguments, ``<let>``, "ros_namespace").
         environment: the environment for the nodes (a copy; os.environ is never changed).
+        initial_environment: the environment the launch started with (a group that does not
+            forward starts from it).
         current_file: the launch file whose actions run now (``$(dirname)``).
-        nodes: the nodes to start, in order.
+        processes: the processes to start (ProcessToStart), in order.
         warnings: (logger, message) pairs the real tool logs as warnings.
     """
 
@@ -39,8 +42,9 @@ class LaunchContext:
                  current_file: Path | None = None):
         self.configurations = dict(configurations or {})
         self.environment = dict(os.environ if environment is None else environment)
+        self.initial_environment = dict(self.environment)
         self.current_file = current_file or Path.cwd() / "launch"
-        self.nodes: list[NodeToStart] = []
+        self.processes: list = []  # executables.ProcessToStart
         self.warnings: list[tuple[str, str]] = []
         self._scopes: list[tuple[dict, dict]] = []
         self._temp_dir: Path | None = None
@@ -63,29 +67,6 @@ class LaunchContext:
         if self._temp_dir is not None:
             shutil.rmtree(self._temp_dir, ignore_errors=True)
             self._temp_dir = None
-
-
-@dataclass
-class NodeToStart:
-    """A node as the launch will start it.
-
-    Attributes:
-        command: the full command line (executable, arguments, ``--ros-args ...``).
-        environment: its complete environment.
-        label: the process name the launch prints (``talker`` becomes ``[talker-1]``).
-        output: "screen", "log" or "both".
-        node_name, namespace: what the launch sets (None where the node's own code decides).
-        file, line: where the <node> tag is.
-    """
-
-    command: list[str]
-    environment: dict
-    label: str
-    output: str
-    node_name: str | None
-    namespace: str | None
-    file: Path
-    line: int
 
 
 # --- actions ----------------------------------------------------------------------------------
@@ -119,18 +100,38 @@ class Action:
 
 @dataclass
 class DeclareArgument(Action):
-    """``<arg name= default= description=/>``: a launch argument, set from ``name:=value``."""
+    """``<arg name= default= description=>`` with optional ``<choice value=/>`` tags: a launch
+    argument, set from ``name:=value``, whose value must be one of the choices when there are any.
+
+    Attributes:
+        description: as launch's DeclareLaunchArgument words it: the one given, or "no description
+            given"; with choices, "One of: [...]", or the one given and ". Valid choices are: [...]".
+    """
 
     name: str
     default: list | None
-    description: str | None
+    description: str | None  # as given; __post_init__ makes it launch's
+    choices: list[str] | None = None
+
+    def __post_init__(self):
+        given = self.description
+        if self.choices is None:
+            self.description = "no description given" if given is None else given
+        elif given is None:
+            self.description = f"One of: {self.choices}"
+        else:
+            self.description = f"{given if given.endswith('.') else given + '.'} Valid choices are: {self.choices}"
 
     def execute(self, context: LaunchContext) -> None:
-        if self.name in context.configurations:
-            return
-        if self.default is None:
-            raise self.error(f'Required launch argument "{self.name}" was not provided: pass {self.name}:=VALUE')
-        context.configurations[self.name] = substitutions.perform(self.default, context)
+        if self.name not in context.configurations:
+            if self.default is None:
+                raise self.error(f'Required launch argument "{self.name}" was not provided: pass '
+                                 f'{self.name}:=VALUE')
+            context.configurations[self.name] = substitutions.perform(self.default, context)
+        value = context.configurations[self.name]
+        if self.choices is not None and value not in self.choices:  # launch's words
+            raise self.error(f'Argument "{self.name}" provided value "{value}" is not valid. Valid options '
+                             f'are: {self.choices}')
 
 
 @dataclass
@@ -172,14 +173,30 @@ class PushRosNamespace(Action):
 
 @dataclass
 class Group(Action):
-    """``<group scoped="true">``: its actions; scoped, what they set ends with the group."""
+    """``<group scoped= forwarding=>`` with ``<keep name= value=/>`` tags, as launch's GroupAction.
+
+    Scoped (the default), what its actions set ends with the group. Not forwarding (scoped only),
+    the group starts from no launch configurations (so no pushed namespace either) and the
+    environment the launch started with, except the kept configurations, whose values are
+    performed before that. Forwarding, or not scoped, the kept ones are simply set.
+    """
 
     actions: list
     scoped: bool = True
+    forwarding: bool = True
+    keep: list = field(default_factory=list)  # [(name parts, value parts)]
 
     def execute(self, context: LaunchContext) -> None:
         if self.scoped:
             context.push()
+        if self.scoped and not self.forwarding:
+            kept = {substitutions.perform(name, context): substitutions.perform(value, context)
+                    for name, value in self.keep}
+            context.configurations = kept
+            context.environment = dict(context.initial_environment)
+        else:
+            for name, value in self.keep:
+                context.configurations[substitutions.perform(name, context)] = substitutions.perform(value, context)
         for action in self.actions:
             action.run(context)
         if self.scoped:
@@ -208,7 +225,7 @@ class IncludeLaunchDescription(Action):
             if argument.default is None and not conditional and argument.name not in given + passed_below:
                 raise LaunchFileError(
                     f"Included launch description missing required argument '{argument.name}' "
-                    f"(description: '{argument.description or 'no description given'}'), given: "
+                    f"(description: '{argument.description}'), given: "
                     f"[{', '.join(given)}]; " + (f"pass it as {argument.name}:=VALUE" if self.from_command_line
                                                  else f"add <arg name=\"{argument.name}\" value=\"...\"/> to the "
                                                  f"<include> at {self.file}:{self.line}"),
@@ -221,79 +238,6 @@ class IncludeLaunchDescription(Action):
                 action.run(context)
         finally:
             context.current_file = including
-
-
-@dataclass
-class Node(Action):
-    """``<node pkg= exec= name= namespace= output= args= ros_args=>`` with param, remap, env."""
-
-    package: list | None
-    executable: list
-    name: list | None = None
-    namespace: list | None = None
-    exec_name: list | None = None
-    output: list | None = None
-    arguments: list = field(default_factory=list)  # [parts] per command-line argument
-    ros_arguments: list | None = None
-    parameters: list = field(default_factory=list)  # ParamGroup | ParamFile
-    remappings: list = field(default_factory=list)  # [(from parts, to parts)]
-    environment: list = field(default_factory=list)  # [(name parts, value parts)]
-
-    def execute(self, context: LaunchContext) -> None:
-        from course_lib import ament
-
-        def text(parts):
-            return substitutions.perform(parts, context)
-
-        executable = text(self.executable)
-        if self.package is not None:
-            try:
-                executable = str(ament.executable(text(self.package), executable))
-            except LookupError as error:
-                raise self.error(str(error)) from None
-        command = [executable] + [text(argument) for argument in self.arguments]
-        if self.ros_arguments is not None:
-            command += ["--ros-args"] + [text(argument) for argument in self.ros_arguments]
-        command.append("--ros-args")
-        name = None if self.name is None else text(self.name)
-        if name is not None:
-            if not _NAME_TOKEN.match(name):
-                raise self.error(f"the node name '{name}' is invalid: use letters, digits and underscores, "
-                                 "not starting with a digit")
-            command += ["-r", f"__node:={name}"]
-        namespace = absolute_namespace(prefix_namespace(
-            context.configurations.get("ros_namespace"), None if self.namespace is None else text(self.namespace)))
-        if namespace is not None:
-            problem = namespace_problem(namespace)
-            if problem:
-                raise self.error(f"the namespace '{namespace}' of this node is invalid: {problem}")
-            command += ["-r", f"__ns:={namespace}"]
-        full_name = f"{namespace.rstrip('/')}/{name}" if name is not None and namespace is not None else None
-        for parameter in self.parameters:
-            if isinstance(parameter, parameters.ParamFile):
-                path = parameters.resolve_file(parameter, context, context.temp_dir())
-                if path is None:
-                    context.warnings.append(("launch_ros.actions.node", "Parameter file path is not a file: "
-                                             f"{os.path.abspath(text(parameter.path))}"))
-                    continue
-            else:
-                values = parameters.evaluate_group(parameter, context)
-                path = parameters.write_params_file(values, full_name or "/**", context.temp_dir())
-            command += ["--params-file", str(path)]
-        for source, target in self.remappings:
-            command += ["-r", f"{text(source)}:={text(target)}"]
-        environment = dict(context.environment)
-        environment.update({text(key): text(value) for key, value in self.environment})
-        output = "log" if self.output is None else text(self.output)
-        if output not in ("screen", "log", "both"):
-            raise self.error(f"output=\"{output}\" is not supported here; use screen, log or both")
-        label = os.path.basename(executable) if self.exec_name is None else text(self.exec_name)
-        if full_name is not None:
-            count = context._node_names[full_name] = context._node_names.get(full_name, 0) + 1
-            if count > 1:
-                context.warnings.append((label, f"there are now at least {count} nodes with the name {full_name} "
-                                                "created within this launch context"))
-        context.nodes.append(NodeToStart(command, environment, label, output, name, namespace, self.file, self.line))
 
 
 def run_launch_file(path, arguments: dict | None = None, environment: dict | None = None) -> LaunchContext:
@@ -348,7 +292,7 @@ def namespace_problem(namespace: str) -> str | None:
     if namespace == "/":
         return None
     tokens = namespace[1:].split("/")
-    bad = [token for token in tokens if not _NAME_TOKEN.match(token)]
+    bad = [token for token in tokens if not NAME_TOKEN.match(token)]
     if bad:
         return (f"'{bad[0]}' is not a name: namespaces are names (letters, digits, underscores, "
                 "not starting with a digit) separated by single '/'")

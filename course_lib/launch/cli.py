@@ -77,7 +77,7 @@ def print_arguments(path) -> None:
     print("Arguments (pass arguments as '<name>:=<value>'):")
     for argument, _passed, conditional in declared:
         text = f"\n    '{argument.name}':{'*' if conditional else ''}\n        "
-        text += argument.description if argument.description is not None else "no description given"
+        text += argument.description
         if argument.default is not None:
             text += f"\n        (default: {substitutions.describe(argument.default)})"
         print(text)

@@ -1,13 +1,15 @@
 """Node parameters in launch files: their types, nested names, and the files a node reads them from.
 
-As in launch_ros, a ``<param name=... value=.../>`` value gets its type by YAML's rules: "5" is
-an integer, "5.0" a float, "true" a boolean, "[1, 2]" a list of integers, anything else text.
-In a YAML launch file the value keeps the type YAML gave it (``value: "5"`` stays text). A value
-with substitutions is typed the same way once they are performed. Nested ``<param>`` tags make
-dotted names (``camera.width``). Each ``<param>`` tag reaches the node as a parameter file of
-its own (``--params-file``), written when the node starts; ``<param from="file.yaml"/>`` passes
-that file as it is.
-"""
+As in launch_ros, a ``<param name=... value=.../>`` value in XML gets its type by YAML's rules:
+"5" is an integer, "5.0" a float, "true" a boolean, "[1, 2]" a list of integers, anything else
+text; ``value-sep=","`` splits the text into a list first (``value="1,2,3" value-sep=","`` is
+[1, 2, 3]), and ``type=`` (str, int, float, bool, list_of_int, ..., yaml) names the type to
+take instead (coercion.py has launch's rules). In a YAML launch file the value keeps the type
+YAML gave it (``value: "5"`` stays text) and ``type:`` only checks it. A value with
+substitutions is typed once they are performed. Nested ``<param>`` tags make dotted names
+(``camera.width``). Each ``<param>`` tag reaches the node as a parameter file of its own
+(``--params-file``), written when the node starts; ``<param from="file.yaml"/>`` passes that
+file as it is."""
 
 from __future__ import annotations
 
@@ -18,17 +20,17 @@ from pathlib import Path
 
 import yaml
 
-from course_lib.launch import substitutions
+from course_lib.launch import coercion, substitutions
 from course_lib.launch.entities import LaunchFileError
-
-_SCALARS = (bool, int, float, str)
 
 
 @dataclass
 class Deferred:
-    """A parameter value with substitutions: performed, then typed by YAML's rules, at run time."""
+    """A parameter value with substitutions: performed, then typed (by YAML's rules when
+    data_type is None) when the node starts."""
 
     parts: list
+    data_type: coercion.DataType | None = None
 
 
 @dataclass
@@ -51,78 +53,112 @@ class ParamGroup:
     line: int
 
 
-def _uniform(items: list) -> bool:
-    """True for a list whose items share one type (text items with substitutions aside)."""
-    kinds = {type(item) for item in items if not isinstance(item, (str, Deferred))}
-    return len(kinds) <= 1 and all(isinstance(item, _SCALARS + (Deferred,)) for item in items)
-
-
-def _with_substitutions(text: str, file, line):
-    parts = substitutions.parse(text, file, line)
-    return Deferred(parts) if substitutions.has_substitutions(parts) else "".join(parts)
-
-
-def typed_by_yaml(text: str):
-    """A text typed by YAML's rules, as launch does for XML attributes (None if YAML cannot
-    read it, which keeps it text)."""
-    if not text:
-        return text
-    try:
-        return yaml.safe_load(text)
-    except yaml.YAMLError:
-        return None
-
-
 def value_of(entity):
-    """The value of a ``<param>`` tag's value attribute, typed as launch_xml / launch_yaml type it.
+    """The value of a ``<param>`` tag's value attribute, read as launch_ros reads it.
+
+    XML text is typed by YAML's rules, or as ``type=`` says; ``value-sep=","`` splits it into a
+    list first. YAML values keep their YAML types and must already be of ``type=``. Text with
+    substitutions is typed when the node starts (see evaluate_group).
 
     Raises:
-        LaunchFileError: a value that is not a number, boolean, text, or a list of one of those.
+        LaunchFileError: a value that is not of its type, or a list of mixed types (launch's words).
     """
-    raw = entity.get("value")
-    if not entity.typed:
-        items = raw if isinstance(raw, list) else [raw]
-        typed = []
-        for item in items:
-            value = typed_by_yaml(item)
-            typed.append(item if value is None else value)
-        raw = typed if isinstance(raw, list) else typed[0]
-    if isinstance(raw, list):
-        value = [_with_substitutions(item, entity.file, entity.line) if isinstance(item, str) else item
-                 for item in raw]
-        if not _uniform(value):
-            raise entity.error(f"<param> value {raw!r} mixes types; a list parameter holds items of one "
-                               "type (all integers, all floats, all booleans or all text)", "value")
+    type_name = entity.get("type")
+    try:
+        data_type = None if type_name is None else coercion.data_type_named(str(type_name))
+        if not entity.typed:
+            raw = _read_text(entity.get("value"), data_type)
+        else:
+            if entity.has("value-sep"):  # launch_yaml never reads it, so launch reports it so
+                raise ValueError("Unexpected key(s) found in `param`: {'value-sep'}")
+            raw = entity.get("value")
+            if not coercion.is_instance(raw, data_type, can_be_str=True):
+                raise ValueError(f"Attribute 'value' of Entity 'param' expected to be of type '{data_type}', "
+                                 f"got '{type(raw)}'")
+        return _normalized(_with_substitutions(raw, entity), data_type)
+    except (TypeError, ValueError) as error:
+        raise entity.error(str(error), "value") from None
+
+
+def _read_text(raw, data_type):
+    """An XML value (a text, or a list of texts with value-sep) typed as launch_xml's get_attr
+    types it: text that cannot be converted stays text (it may hold substitutions)."""
+    try:
+        if not isinstance(raw, list):
+            return coercion.coerce(raw, data_type, can_be_str=True)
+        if data_type is not None and not data_type.is_list:
+            raise TypeError(f"Cannot convert input '{raw}' of type '{type(raw)}' to '{data_type.scalar}'")
+        item_type = None if data_type is None else coercion.DataType(data_type.scalar)
+        items = [coercion.coerce(item, item_type, can_be_str=True) for item in raw]
+        if not coercion.is_valid_value(items, can_be_str=True):
+            raise ValueError(f"cannot convert value to {item_type}. Got value=`{raw}`")
+        return items
+    except ValueError:
+        raise ValueError(f"Attribute 'value' of Entity 'param' expected to be of type '{data_type}'."
+                         f"'{raw}' can not be converted to one of those types") from None
+
+
+def _with_substitutions(raw, entity):
+    """Text with substitutions becomes Deferred, other text stays text (launch's
+    parse_if_substitutions); a list must not mix types."""
+    def parsed(value):
+        if not isinstance(value, str):
+            return value
+        parts = substitutions.parse(value, entity.file, entity.line)
+        return Deferred(parts) if substitutions.has_substitutions(parts) else "".join(parts)
+
+    if not isinstance(raw, list):
+        return parsed(raw)
+    items = [parsed(item) for item in raw]
+    if len({type(item) for item in items if not isinstance(item, Deferred)}) > 1:
+        raise ValueError("The result is a non-uniform list")
+    return items
+
+
+def _normalized(value, data_type):
+    """A value checked against its type, as launch_ros's ParameterValue does before the launch
+    runs (launch's normalize_typed_substitution); Deferred parts learn the type to take."""
+    if isinstance(value, Deferred):
+        return Deferred(value.parts, data_type)
+    if not isinstance(value, list):
+        if not coercion.is_instance(value, data_type):
+            raise TypeError(f"value='{value}' is not an instance of {_scalar_text(data_type)}")
         return value
-    if isinstance(raw, str):
-        return _with_substitutions(raw, entity.file, entity.line)
-    if isinstance(raw, _SCALARS):
-        return raw
-    raise entity.error(f"<param> value {raw!r} is not a parameter value: use a number, true/false, text or "
-                       "a list of one of those", "value")
+    if data_type is not None and not data_type.is_list:
+        raise TypeError("The provided value resolves to a list, though the required type is a scalar. "
+                        f"Got value='{value}', data_type='{data_type.scalar}'.")
+    scalar = None if data_type is None else data_type.scalar
+    kinds = {type(item) for item in value if not isinstance(item, Deferred)}
+    for allowed, wanted in (({str}, str), ({bool}, bool), ({int}, int), ({int, float}, float)):
+        if kinds <= allowed:
+            if scalar not in (None, wanted) and kinds:
+                raise TypeError(f"Got a list of '{wanted}', expected a list of '{scalar}'. value='{value}'")
+            item_type = None if scalar is None else coercion.DataType(scalar)
+            return [Deferred(item.parts, item_type) if isinstance(item, Deferred)
+                    else float(item) if wanted is float else item for item in value]
+    raise TypeError(f"Input value is not an acceptable 'SomeValueType'.Got value='{value}'")
 
 
-def _evaluate(value, context, name: str, file, line):
+def _scalar_text(data_type) -> str:
+    if data_type is None:
+        return "None"
+    return str(data_type) if data_type.is_list else str(data_type.scalar)
+
+
+def _evaluate(value, context, file, line):
+    """A parameter's value with its substitutions performed and typed (launch's
+    perform_typed_substitution)."""
     if isinstance(value, list):
-        items = [_evaluate(item, context, name, file, line) for item in value]
-        if len({type(item) for item in items}) > 1:
-            raise LaunchFileError(f"parameter '{name}' became the list {items!r}, which mixes types; "
-                                  "a list parameter holds items of one type", file, line)
+        items = [_evaluate(item, context, file, line) for item in value]
+        if not coercion.is_valid_value(items):
+            raise LaunchFileError("The output list is not uniform", file, line)
         return items
     if not isinstance(value, Deferred):
         return value
-    text = substitutions.perform(value.parts, context)
-    if not text:
-        return text
     try:
-        typed = yaml.safe_load(text)
-    except yaml.YAMLError:
-        raise LaunchFileError(f"parameter '{name}' is {text!r} after substitution, which YAML cannot read; "
-                              "quote it to make it text", file, line) from None
-    if isinstance(typed, _SCALARS) or (isinstance(typed, list) and typed and _uniform(typed)):
-        return typed
-    raise LaunchFileError(f"parameter '{name}' is {text!r} after substitution: not a number, boolean, text "
-                          "or list of one type", file, line)
+        return coercion.coerce(substitutions.perform(value.parts, context), value.data_type)
+    except ValueError as error:
+        raise LaunchFileError(str(error), file, line) from None
 
 
 def evaluate_group(group: ParamGroup, context, prefix: str = "") -> dict:
@@ -133,7 +169,7 @@ def evaluate_group(group: ParamGroup, context, prefix: str = "") -> dict:
         if isinstance(value, ParamGroup):
             values.update(evaluate_group(value, context, prefix=name + "."))
         else:
-            values[name] = _evaluate(value, context, name, group.file, group.line)
+            values[name] = _evaluate(value, context, group.file, group.line)
     return values
 
 

@@ -12,12 +12,12 @@ from pathlib import Path
 
 from course_lib.launch import entities, parameters, substitutions
 from course_lib.launch.actions import (
-    DeclareArgument, Group, IncludeLaunchDescription, Node, PushRosNamespace, SetEnvironmentVariable,
-    SetLaunchConfiguration)
+    DeclareArgument, Group, IncludeLaunchDescription, PushRosNamespace, SetEnvironmentVariable, SetLaunchConfiguration)
 from course_lib.launch.entities import Entity, did_you_mean
+from course_lib.launch.executables import ExecuteProcess, Node
 
 #: Tags of the full ROS 2 launch that this one does not run.
-NOT_SUPPORTED = ("executable", "timer", "log", "shutdown", "append_env", "unset_env", "reset", "reset_env",
+NOT_SUPPORTED = ("timer", "log", "shutdown", "append_env", "unset_env", "reset", "reset_env",
                  "node_container", "load_composable_node", "set_parameter", "set_parameters_from_file",
                  "set_remap", "set_use_sim_time", "ros_timer", "set_ros_log_dir", "lifecycle_node")
 
@@ -37,11 +37,14 @@ KNOWN = {
     "push-ros-namespace": _ACTION | {"namespace"},
     "group": _ACTION | {"scoped", "forwarding", "keep"},
     "include": _ACTION | {"file", "arg"},
+    "executable": _ACTION | _EXECUTE,
     "node": _ACTION | _EXECUTE | {"pkg", "exec", "namespace", "exec_name", "args", "ros_args", "param", "remap"},
     "param": {"name", "value", "from", "allow_substs", "value-sep", "type", "param"},
     "remap": {"from", "to"},
     "env": {"name", "value"},
     "include/arg": {"name", "value"},
+    "arg/choice": {"value"},
+    "group/keep": {"name", "value"},
 }
 
 
@@ -103,10 +106,20 @@ def _arg(entity: Entity):
     if not isinstance(raw_name, str):
         raise entity.error("<arg> name must be text", "name")
     description = entity.get("description")
+    choices = None
+    if entity.nested("choice"):
+        choices = []
+        for tag in entity.nested("choice"):
+            value = tag.get("value", required=True)
+            if not isinstance(value, str):  # launch_yaml's words
+                raise tag.error(f"Attribute 'value' of Entity 'choice' expected to be of type '{str}', got "
+                                f"'{type(value)}'", "value")
+            choices.append(substitutions.unescape(value))
+            tag.check_all_read("value", KNOWN["arg/choice"])
     return (DeclareArgument(name=substitutions.unescape(raw_name), default=_text(entity, "default"),
                             description=None if description is None else substitutions.unescape(str(description)),
-                            **_where(entity)),
-            f"name, default, description, {_CONDITION}")
+                            choices=choices, **_where(entity)),
+            f"name, default, description, {_CONDITION}, nested <choice value=>")
 
 
 def _let(entity: Entity):
@@ -127,11 +140,13 @@ def _push_ros_namespace(entity: Entity):
 
 
 def _group(entity: Entity):
-    scoped = entity.get_bool("scoped")
+    scoped, forwarding = entity.get_bool("scoped"), entity.get_bool("forwarding")
     where = _where(entity)
-    actions = [parse_action(child) for child in entity.children()]
-    return (Group(actions=actions, scoped=True if scoped is None else scoped, **where),
-            f"scoped, {_CONDITION}, and tags inside it")
+    keep = _pairs(entity, "keep", "name", "value")
+    actions = [parse_action(child) for child in entity.children() if child.kind != "keep"]
+    return (Group(actions=actions, scoped=True if scoped is None else scoped,
+                  forwarding=True if forwarding is None else forwarding, keep=keep, **where),
+            f"scoped, forwarding, {_CONDITION}, nested <keep name= value=>, and tags inside it")
 
 
 def _pairs(entity: Entity, kind: str, first: str, second: str) -> list[tuple[list, list]]:
@@ -149,25 +164,39 @@ def _include(entity: Entity):
             f"file, {_CONDITION}, nested <arg name= value=>")
 
 
+def _process(entity: Entity) -> dict:
+    """What <executable> and <node> share (launch's ExecuteProcess.parse)."""
+    return {"cwd": _text(entity, "cwd"), "output": _text(entity, "output"), "prefix": _text(entity, "launch-prefix"),
+            "environment": _pairs(entity, "env", "name", "value"), **_where(entity)}
+
+
+_PROCESS = f"cwd, output, launch-prefix, {_CONDITION}, nested <env>"
+
+
+def _executable(entity: Entity):
+    executable = ExecuteProcess(command=split_command_line(_text(entity, "cmd", required=True)),
+                                name=_text(entity, "name"), **_process(entity))
+    return executable, f"cmd, name, {_PROCESS}"
+
+
 def _node(entity: Entity):
     arguments = _text(entity, "args")
     ros_arguments = _text(entity, "ros_args")
     node = Node(package=_text(entity, "pkg"), executable=_text(entity, "exec", required=True),
                 name=_text(entity, "name"), namespace=_text(entity, "namespace"),
-                exec_name=_text(entity, "exec_name"), output=_text(entity, "output"),
+                exec_name=_text(entity, "exec_name"),
                 arguments=[] if arguments is None else split_command_line(arguments),
                 ros_arguments=None if ros_arguments is None else split_command_line(ros_arguments),
                 parameters=_parameters(entity.nested("param")),
-                remappings=_pairs(entity, "remap", "from", "to"),
-                environment=_pairs(entity, "env", "name", "value"), **_where(entity))
-    return node, (f"pkg, exec, name, namespace, exec_name, output, args, ros_args, {_CONDITION}, "
-                  "nested <param>, <remap>, <env>")
+                remappings=_pairs(entity, "remap", "from", "to"), **_process(entity))
+    return node, f"pkg, exec, name, namespace, exec_name, args, ros_args, {_PROCESS}, nested <param>, <remap>"
 
 
 _ACTIONS = {"arg": _arg, "let": _let, "set_env": _set_env, "push_ros_namespace": _push_ros_namespace,
-            "push-ros-namespace": _push_ros_namespace, "group": _group, "include": _include, "node": _node}
-_SUPPORTED_TAGS = ("node (with param, remap, env)", "arg", "let", "include (with arg)", "group",
-                   "push_ros_namespace", "set_env")
+            "push-ros-namespace": _push_ros_namespace, "group": _group, "include": _include, "node": _node,
+            "executable": _executable}
+_SUPPORTED_TAGS = ("node (with param, remap, env)", "executable (with env)", "arg (with choice)", "let",
+                   "include (with arg)", "group (with keep)", "push_ros_namespace", "set_env")
 
 
 # --- parameters -------------------------------------------------------------------------------
@@ -200,13 +229,15 @@ def _parameter(tag: Entity):
     nested = tag.nested("param")
     if tag.has("value") and nested:
         raise tag.error("<param> has both value= and nested <param> tags; use one")
+    if tag.has("type") and nested:  # launch_ros's words
+        raise tag.error("nested parameters and type attributes are mutually exclusive", "type")
     if tag.has("value"):
         value = parameters.value_of(tag)
     elif nested:
         value = parameters.ParamGroup([_parameter(inner) for inner in nested], tag.file, tag.line)
     else:
         raise tag.error("<param> needs value= or nested <param> tags")
-    tag.check_all_read("name, value, nested <param>", KNOWN["param"])
+    tag.check_all_read("name, value, value-sep, type, nested <param>", KNOWN["param"])
     return name, value
 
 

@@ -1,7 +1,8 @@
-"""Run a launch file: start its nodes, show their output like ``ros2 launch``, stop them all.
+"""Run a launch file: start its processes, show their output like ``ros2 launch``, stop them all.
 
-Each node runs as a course_lib.processes.NodeProcess (own process group, bounded log, never an
-orphan). What the real tool prints, this prints the same way::
+Each node, and each other program (``<executable>``), runs as a course_lib.processes.NodeProcess
+(own process group, bounded log, never an orphan). What the real tool prints, this prints the
+same way::
 
     [INFO] [launch]: All log files can be found below /home/student/.ros/log/2025-...
     [INFO] [talker-1]: process started with pid [4242]
@@ -32,7 +33,8 @@ from pathlib import Path
 from typing import Callable
 
 from course_lib import processes
-from course_lib.launch.actions import LaunchContext, NodeToStart, run_launch_file
+from course_lib.launch.actions import LaunchContext, run_launch_file
+from course_lib.launch.executables import ProcessToStart
 from course_lib.launch.entities import LaunchFileError
 
 #: How a launch stops a process that still runs, as ros2/launch's ExecuteLocal does: SIGINT, then
@@ -95,7 +97,7 @@ class Launch:
 
     Attributes:
         path: the launch file.
-        processes: the NodeProcess of every node started, in order.
+        processes: the NodeProcess of every process started (nodes and others), in order.
         names: their process names (``talker-1``), in the same order.
         log_dir: the folder of this launch's ``launch.log``.
     """
@@ -111,7 +113,7 @@ class Launch:
         self._lines: deque[str] = deque(maxlen=KEPT_LINES)
         self._lock = threading.RLock()  # the Ctrl-C handler may log while a line is written
         self._pending: dict[tuple[int, str], bytes] = {}
-        self._nodes: list[NodeToStart] = []
+        self._to_start: list[ProcessToStart] = []
         self._context: LaunchContext | None = None
         self._done = threading.Event()
         self._monitor: threading.Thread | None = None
@@ -172,14 +174,14 @@ class Launch:
 
     # -- running ------------------------------------------------------------------------------
 
-    def prepare(self) -> list[NodeToStart]:
-        """Run the launch file's actions (arguments, includes, groups...) into the nodes to start.
+    def prepare(self) -> list[ProcessToStart]:
+        """Run the launch file's actions (arguments, includes, groups...) into the processes to start.
 
         Raises:
             LaunchFileError: the file cannot run as written (the message has its line).
         """
         context = run_launch_file(self.path, self.arguments)
-        self._context, self._nodes = context, context.nodes
+        self._context, self._to_start = context, context.processes
         try:
             self.stop_timeouts()  # a bad one shows now, not when the launch stops
         except LaunchFileError:
@@ -187,25 +189,25 @@ class Launch:
             raise
         for logger, message in context.warnings:
             self.warning(logger, message)
-        return self._nodes
+        return self._to_start
 
     def start(self) -> "Launch":
-        """Start every node (prepare() first if it was not called) and return self."""
+        """Start every process (prepare() first if it was not called) and return self."""
         if self._context is None:
             self.prepare()
-        for node in self._nodes:
-            self._start_node(node)
+        for to_start in self._to_start:
+            self._start_process(to_start)
         self._monitor = threading.Thread(target=self._watch, name=f"course_lib-launch-{self.path.name}",
                                          daemon=True)
         self._monitor.start()
         return self
 
-    def _start_node(self, node: NodeToStart) -> None:
+    def _start_process(self, to_start: ProcessToStart) -> None:
         index = len(self.processes)
-        name = f"{node.label}-{next(_PROCESS_NUMBERS)}"
+        name = f"{to_start.label}-{next(_PROCESS_NUMBERS)}"
         process = processes.NodeProcess(
-            node.command, name=name, env=node.environment,
-            on_output=lambda stream, data: self._output(index, node.output, stream, data))
+            to_start.command, name=name, env=to_start.environment, cwd=to_start.cwd,
+            on_output=lambda stream, data: self._output(index, to_start.output, stream, data))
         self.names.append(name)
         self.processes.append(process)
         try:
@@ -230,7 +232,7 @@ class Launch:
         for stream in ("stdout", "stderr"):
             rest = self._pending.pop((index, stream), None)
             if rest:
-                self._node_line(index, self._nodes[index].output, stream, rest)
+                self._node_line(index, self._to_start[index].output, stream, rest)
         name, code = self.names[index], process.returncode
         if process.pid is None:
             return  # it never started; that was reported already
@@ -264,7 +266,7 @@ class Launch:
             TimeoutError, RuntimeError: as NodeProcess.wait_for_node (with the node's log tail).
         """
         deadline = time.monotonic() + timeout
-        for node, process in zip(self._nodes, self.processes):
+        for node, process in zip(self._to_start, self.processes):
             if node.node_name is not None and process.pid is not None:
                 process.wait_for_node(node.node_name, timeout=max(0.1, deadline - time.monotonic()),
                                       namespace=node.namespace)

@@ -6,17 +6,27 @@ separated by one space; an argument may hold further substitutions, or be quoted
 "...") to contain spaces; a backslash makes the next character literal (``\\$(`` is text).
 Substitutions are performed when their action runs, against the launch context (its
 arguments, environment and current file).
-"""
+
+Besides the values (var, env, find-pkg-share, find-pkg-prefix, dirname, filename) there are
+launch's logic ones, as Jazzy has them: ``$(not X)``, ``$(and X Y)``, ``$(or X Y)``,
+``$(any X ...)``, ``$(all X ...)`` read "true"/"false"/"1"/"0" (coercion.to_bool) and give
+"true" or "false"; ``$(equals X Y)`` and ``$(not-equals X Y)`` compare booleans as booleans and
+numbers as numbers; ``$(if C A [B])`` chooses; ``$(eval 'EXPR' [MODULES])`` is a Python
+expression with the math module (its functions also without ``math.``), as PythonExpression."""
 
 from __future__ import annotations
 
+import importlib
+import math
 import re
 from dataclasses import dataclass
 from pathlib import Path
 
+from course_lib.launch import coercion
 from course_lib.launch.entities import LaunchFileError, did_you_mean
 
-#: The substitutions supported here: name -> (fewest arguments, most arguments, how to write it).
+#: The substitutions supported here: name -> (fewest arguments, most arguments (None: any number),
+#: how to write it). launch's Jazzy front end exposes each under the same name.
 SUPPORTED = {
     "var": (1, 2, "$(var NAME [DEFAULT])"),
     "env": (1, 2, "$(env NAME [DEFAULT])"),
@@ -24,11 +34,20 @@ SUPPORTED = {
     "find-pkg-prefix": (1, 1, "$(find-pkg-prefix PACKAGE)"),
     "dirname": (0, 0, "$(dirname)"),
     "filename": (0, 0, "$(filename)"),
+    "eval": (1, 2, "$(eval 'PYTHON EXPRESSION' [MODULE,MODULE...])"),
+    "not": (1, 1, "$(not VALUE)"),
+    "and": (2, 2, "$(and LEFT RIGHT)"),
+    "or": (2, 2, "$(or LEFT RIGHT)"),
+    "any": (0, None, "$(any VALUE ...)"),
+    "all": (0, None, "$(all VALUE ...)"),
+    "equals": (2, 2, "$(equals LEFT RIGHT)"),
+    "not-equals": (2, 2, "$(not-equals LEFT RIGHT)"),
+    "if": (2, 3, "$(if CONDITION IF_VALUE [ELSE_VALUE])"),
 }
 
 #: Substitutions of the full ROS 2 launch that this one does not do.
-NOT_SUPPORTED = ("eval", "command", "anon", "not", "and", "or", "any", "all", "equals", "not-equals",
-                 "if", "file-content", "find-exec", "exec-in-pkg", "param", "launch_log_dir", "log_dir")
+NOT_SUPPORTED = ("command", "anon", "file-content", "find-exec", "exec-in-pkg", "param", "launch_log_dir",
+                 "log_dir")
 
 #: What a missing launch configuration or environment variable is told, with the fix.
 _MISSING = {
@@ -43,6 +62,16 @@ _ESCAPED = re.compile(r"\\(.)")
 
 def supported_list() -> str:
     return ", ".join(form for _, _, form in SUPPORTED.values())
+
+
+def _count_words(name: str, fewest: int, most: int) -> str:
+    """launch's words for a wrong number of arguments (its substitutions' parse methods; for
+    or, equals and not-equals launch says "and substitution", a slip not copied here)."""
+    if most == 0:
+        return f"{name} substitution doesn't expect arguments"
+    if fewest == most:
+        return f"{name} substitution expects {fewest} argument{'' if fewest == 1 else 's'}"
+    return f"{name} substitution expects {fewest} or {most} arguments"
 
 
 @dataclass
@@ -84,15 +113,74 @@ class Substitution:
             return str(context.current_file.parent)
         if self.name == "filename":
             return str(context.current_file)
-        raise AssertionError(self.name)  # parse() only lets supported names through
+        if self.name == "eval":
+            return self._evaluate(first, context)
+        if self.name == "equals":
+            return _text_of(_equal(first, perform(self.args[1], context)))
+        if self.name == "not-equals":
+            return _text_of(not _equal(first, perform(self.args[1], context)))
+        if self.name == "if":
+            branch = self.args[1] if self._truth(first) else (self.args[2] if len(self.args) == 3 else [""])
+            return perform(branch, context)
+        # not, and, or, any, all: every argument is read as a boolean (none is skipped), as in launch
+        values = [self._truth(perform(arg, context)) for arg in self.args]
+        if self.name == "not":
+            return _text_of(not values[0])
+        return _text_of(any(values) if self.name in ("or", "any") else all(values))
+
+    def _truth(self, text: str) -> bool:
+        try:
+            return coercion.to_bool(text)
+        except ValueError as error:  # launch raises SubstitutionFailure with these words
+            raise self.error(str(error)) from None
+
+    def _evaluate(self, expression: str, context) -> str:
+        """``$(eval)``: a Python expression, as launch's PythonExpression: the modules named
+        (math when none are) are available by name, and math's functions also without it."""
+        modules = ["math"]
+        if len(self.args) == 2:
+            text = perform(self.args[1], context)
+            modules = [name.strip() for name in text.split(",")] if text else []
+        names = {}
+        try:
+            for module in map(importlib.import_module, modules):
+                if module.__name__ == "math":
+                    names.update(vars(module))
+                names[module.__name__] = module
+            return str(eval(expression, {}, names))  # noqa: S307 (what launch's PythonExpression does)
+        except Exception as error:  # launch reports what the expression raised, in its words
+            raise self.error(str(error)) from None
 
     def describe(self) -> str:
         """How ``ros2 launch --show-args`` prints it, like the real tool's describe()."""
         inner = [describe(arg) for arg in self.args]
+        if self.name == "eval":
+            modules = "'math'" if len(self.args) == 1 else inner[1]
+            return f"PythonExpr({inner[0]}, [{modules}])"
         names = {"var": "LaunchConfig({})", "env": "EnvVar({})", "find-pkg-share": "FindPackageShare(pkg={})",
                  "find-pkg-prefix": "FindPackagePrefix(pkg={})", "dirname": "ThisLaunchFileDir()",
                  "filename": "ThisLaunchFile()"}
-        return names[self.name].format(inner[0] if inner else "")
+        if self.name in names:
+            return names[self.name].format(inner[0] if inner else "")
+        kind = {"not": "Not", "and": "And", "or": "Or", "any": "Any", "all": "All", "equals": "Equals",
+                "not-equals": "NotEquals", "if": "IfElse"}[self.name]
+        return f"{kind}Substitution({', '.join(inner)})"
+
+
+def _text_of(value: bool) -> str:
+    return "true" if value else "false"
+
+
+def _equal(left: str, right: str) -> bool:
+    """launch's EqualsSubstitution: booleans as booleans ("1" is "true"), numbers as numbers
+    (math.isclose, so "nan" equals nothing), anything else as text."""
+    booleans = ("true", "false", "1", "0")
+    if left.lower() in booleans and right.lower() in booleans:
+        return (left.lower() in ("true", "1")) == (right.lower() in ("true", "1"))
+    try:
+        return math.isclose(float(left), float(right))
+    except ValueError:
+        return left == right
 
 
 def perform(parts, context) -> str:
@@ -171,13 +259,16 @@ class _Parser:
         if name not in SUPPORTED:
             kind = "is not supported here (a full ROS 2 install has it)" if name in NOT_SUPPORTED \
                 else "is not a launch substitution"
-            raise LaunchFileError(f"$({name}) {kind}{did_you_mean(name, SUPPORTED)}; supported: "
+            near = "" if name in NOT_SUPPORTED else did_you_mean(name, SUPPORTED)
+            raise LaunchFileError(f"$({name}) {kind}{near}; supported: "
                                   f"{supported_list()}", self.file, self.line)
         fewest, most, form = SUPPORTED[name]
-        if not fewest <= len(args) <= most:
-            raise LaunchFileError(f"$({name}) takes {fewest if fewest == most else f'{fewest} or {most}'} "
-                                  f"argument{'' if most == 1 else 's'}, got {len(args)} in {self.text!r}: "
+        if len(args) < fewest or (most is not None and len(args) > most):
+            raise LaunchFileError(f"{_count_words(name, fewest, most)} (got {len(args)} in {self.text!r}): "
                                   f"write {form}", self.file, self.line)
+        if name == "eval" and len(args) == 2 and has_substitutions(args[1]):
+            raise LaunchFileError(f"$(eval) takes its modules as plain text, like 'math, sys', not substitutions "
+                                  f"(in {self.text!r})", self.file, self.line)
         return Substitution(name, args, self.file, self.line)
 
     def argument(self, quote: str | None) -> list:

@@ -40,7 +40,7 @@ def _launch_nodes(path) -> tuple[list[dict], list[str]]:
     context = run_launch_file(path)
     try:
         nodes = []
-        for node in context.nodes:
+        for node in context.processes:
             command = list(node.command)
             ros_args = command[command.index("--ros-args") + 1:] if "--ros-args" in command else []
             remaps, params = [], []
