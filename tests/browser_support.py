@@ -474,13 +474,14 @@ _RUNNING_JS = """(notebookSelector) => {
   const panel = document.querySelector(notebookSelector);
   const indicator = panel.querySelector('.jp-Notebook-ExecutionIndicator');
   const busy = [...panel.querySelectorAll('.jp-CodeCell .jp-InputArea-prompt')]
-      .some(p => p.innerText.includes('*'));
+      .some(p => p.textContent.includes('*'));
   return !busy && indicator && indicator.dataset.status === 'idle';
 }
 """
 
 
-def run_notebook(page, path: str, code_cells: int, timeout: float, screenshot: Path | None = None) -> NotebookRun:
+def run_notebook(page, path: str, code_cells: int, timeout: float, screenshot: Path | None = None,
+                 screenshot_always: bool = True) -> NotebookRun:
     """Run > Run All Cells in the open notebook, wait until nothing runs, and report the result.
 
     Args:
@@ -489,6 +490,8 @@ def run_notebook(page, path: str, code_cells: int, timeout: float, screenshot: P
         code_cells: the number of code cells in the file, to check that the page shows them all.
         timeout: seconds to allow for the whole run.
         screenshot: where to save a full-page screenshot, or None.
+        screenshot_always: False: only when the run has problems (a full-page screenshot of a
+            long notebook costs Chromium about 8 s of processor time).
     """
     from playwright.sync_api import TimeoutError as PlaywrightTimeout
 
@@ -521,7 +524,7 @@ def run_notebook(page, path: str, code_cells: int, timeout: float, screenshot: P
         images=len(state["images"]), broken_images=[f"cell {i['cell']}" for i in state["images"] if not i["ok"]],
         image_outputs=state["imageOutputs"], stderr_outputs=state["stderr"], seconds=seconds,
         outputs=state["outputs"])
-    if screenshot is not None:
+    if screenshot is not None and (screenshot_always or run.problems()):
         save_full_notebook_screenshot(page, screenshot)
         run.screenshot = screenshot
     return run
@@ -581,11 +584,13 @@ def copy_lessons(root: Path) -> None:
                         ignore=shutil.ignore_patterns(".ipynb_checkpoints", "build", "install", "log"))
 
 
-def run_in_lab(context, lab: JupyterLab, path: str, screenshot: Path | None = None) -> NotebookRun:
+def run_in_lab(context, lab: JupyterLab, path: str, screenshot: Path | None = None,
+               screenshot_always: bool = True) -> NotebookRun:
     """Open path in JupyterLab, run all cells, shut its kernel down; return the NotebookRun."""
     page = open_notebook(context, lab, path)
     try:
-        run = run_notebook(page, path, code_cell_count(lab.root_dir / path), LESSON_RUN_TIMEOUT, screenshot)
+        run = run_notebook(page, path, code_cell_count(lab.root_dir / path), LESSON_RUN_TIMEOUT, screenshot,
+                           screenshot_always)
     finally:
         close_notebook(page, lab, path)
     print(f"\n{path}: Run All Cells took {run.seconds:.1f} s")
@@ -594,9 +599,11 @@ def run_in_lab(context, lab: JupyterLab, path: str, screenshot: Path | None = No
 
 def assert_lesson_runs_clean(context, lab: JupyterLab, notebook: str) -> None:
     """Run a lesson (its path under notebooks/) top to bottom in lab: every code cell ran, none
-    shows an error, every image renders (a screenshot goes to artifacts/browser/)."""
+    shows an error, every image renders. A run with problems leaves a screenshot in
+    artifacts/browser/ (every run does with COURSE_TEST_SCREENSHOTS=1)."""
     screenshot = SCREENSHOTS / (notebook.removesuffix(".ipynb").replace("/", "__") + ".png")
-    run = run_in_lab(context, lab, f"notebooks/{notebook}", screenshot)
+    run = run_in_lab(context, lab, f"notebooks/{notebook}", screenshot,
+                     screenshot_always=os.environ.get("COURSE_TEST_SCREENSHOTS") == "1")
     assert not run.problems(), f"{notebook} in JupyterLab (screenshot {screenshot}):\n" + "\n".join(run.problems())
 
 
