@@ -100,8 +100,9 @@ def values(ctx: Context) -> None:
 # -- the node ---------------------------------------------------------------------------------
 
 NODE_NAME = "brightness_node"
-#: Frames of the throughput test: bursts of 1920x1080 BGR at 30 Hz, this many seconds each.
-THROUGHPUT_SECONDS = 2.0
+#: Frames of the throughput test: bursts of 1920x1080 BGR at 30 Hz, this many seconds each (30 frames:
+#: a verdict needs THROUGHPUT_MIN_ANSWERS of them, and longer bursts cost every grading more time).
+THROUGHPUT_SECONDS = 1.0
 THROUGHPUT_RATE = 30.0
 #: The throughput verdict is on processor time, which the machine's load does not change: the
 #: student's node process may use at most this many times the processor time per frame answered
