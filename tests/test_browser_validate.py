@@ -17,8 +17,8 @@ from pathlib import Path
 
 import pytest
 
-from browser_support import (close_notebook, open_assignment_list, open_notebook, running_jupyterlab, validate,
-                             wait_for_assignment)
+from browser_nbgrader import open_assignment_list, validate, wait_for_assignment
+from browser_support import close_notebook, open_notebook, running_jupyterlab
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
