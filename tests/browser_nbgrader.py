@@ -1,14 +1,18 @@
 """nbgrader's student side in JupyterLab, driven as a student drives it: the notebook's Validate
 button (``validate``: press it, read the dialog) and the Nbgrader > Assignment List panel
-(``open_assignment_list``, ``assignment_lists``, ``wait_for_assignment``). The server, the browser
-and the notebook UI are browser_support's.
+(``open_assignment_list``, ``assignment_lists``, ``wait_for_assignment``), and the kernels a
+server runs (``kernel_processes``, ``kernels_left``: what a Validate leaves behind). The server, the
+browser and the notebook UI are browser_support's.
 """
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import time
 from pathlib import Path
+
+import psutil
 
 from browser_support import NOTEBOOK, JupyterLab, click_menu, click_toolbar_button
 
@@ -142,3 +146,26 @@ def wait_for_assignment(page, listed: str, assignment: str, timeout: float) -> s
         raise TimeoutError(f"no {assignment!r} among the {listed} assignments after {timeout:.0f} s; "
                            f"the panel shows {assignment_lists(page)}") from None
     return next(row for row in assignment_lists(page)[listed] if row.split(" | ")[0] == assignment)
+
+
+def kernel_processes(lab: JupyterLab) -> list[psutil.Process]:
+    """The kernels the server runs now: its descendant processes that run ipykernel."""
+    found = []
+    for process in lab.descendants():
+        with contextlib.suppress(psutil.Error):
+            if any("ipykernel" in part for part in process.cmdline()):
+                found.append(process)
+    return found
+
+
+def kernels_left(lab: JupyterLab, before: list[psutil.Process], grace: float = 60) -> list[str]:
+    """Kernels of the server that were not among `before` and have not ended within grace seconds
+    (a wall-clock backstop: a kernel that is being shut down ends long before), by pid and command."""
+    known = {process.pid for process in before}
+    new = [process for process in kernel_processes(lab) if process.pid not in known]
+    _, alive = psutil.wait_procs(new, timeout=grace)
+    left = []
+    for process in alive:
+        with contextlib.suppress(psutil.Error):
+            left.append(f"pid {process.pid}: {' '.join(process.cmdline())}")
+    return left

@@ -6,8 +6,9 @@ The brightness assignment is released into a fresh course directory and into a s
 each in a folder of their own under the lab's root (the notebook writes and builds its workspace
 ros2_ws next to itself): ``correct/`` holds the reference solution, ``incorrect/`` the reference with
 ``average_brightness`` returning 0. Each presses Validate; nbgrader saves the notebook, runs it
-top to bottom on the server and answers with a dialog, whose text the tests read. Screenshots go
-to artifacts/browser/validate_<student>.png and assignment_list.png.
+top to bottom on the server and answers with a dialog, whose text the tests read; no kernel it
+started may be left running. A lesson (lesson/, no graded cells) gets a short answer instead.
+Screenshots go to artifacts/browser/validate_<student>.png, validate_lesson.png and assignment_list.png.
 """
 
 import re
@@ -17,7 +18,7 @@ from pathlib import Path
 
 import pytest
 
-from browser_nbgrader import open_assignment_list, validate, wait_for_assignment
+from browser_nbgrader import kernel_processes, kernels_left, open_assignment_list, validate, wait_for_assignment
 from browser_support import close_notebook, open_notebook, running_jupyterlab
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -28,6 +29,8 @@ from zoo import brightness as brightness_zoo  # noqa: E402
 ROOT = Path(__file__).resolve().parents[1]
 SCREENSHOTS = ROOT / "artifacts" / "browser"
 ASSIGNMENT = "brightness"
+#: A lesson in the student's lab, where a student may press Validate too.
+LESSON = "lesson/00_setup_and_workspace.ipynb"
 # Validate runs the whole notebook on the server: ~30 s on an idle 2-core machine (the node
 # check alone ~20 s), several times that when the machine is busy.
 VALIDATE_TIMEOUT = 300
@@ -69,6 +72,8 @@ def lab(course, tmp_path_factory):
         submitted = zoo.submit(course, student, ASSIGNMENT, edits)
         (root / student).mkdir()
         shutil.copy(submitted, root / student / f"{ASSIGNMENT}.ipynb")
+    (root / LESSON).parent.mkdir()
+    shutil.copy(ROOT / "notebooks" / Path(LESSON).name, root / LESSON)
     cache = tmp_path_factory.mktemp("nbgrader-cache")
     (root / "nbgrader_config.py").write_text(
         STUDENT_NBGRADER_CONFIG.format(exchange=str(course / "exchange"), cache=str(cache)))
@@ -77,15 +82,18 @@ def lab(course, tmp_path_factory):
         yield server
 
 
-def validate_in_lab(browser, lab, student):
-    """Open the student's notebook, press Validate, close it again; return the Validation."""
-    path = f"{student}/{ASSIGNMENT}.ipynb"
+def validate_in_lab(browser, lab, path, screenshot):
+    """Open the notebook at path, press Validate, close it again; return the Validation, after
+    checking that no kernel Validate started is left running."""
     page = open_notebook(browser, lab, path)
     try:
-        result = validate(page, VALIDATE_TIMEOUT, SCREENSHOTS / f"validate_{student}.png")
+        before = kernel_processes(lab)
+        result = validate(page, VALIDATE_TIMEOUT, SCREENSHOTS / screenshot)
+        left = kernels_left(lab, before)
     finally:
         close_notebook(page, lab, path)
     print(f"\n{path}: Validate answered after {result.seconds:.1f} s: {result.title}\n{result.text}")
+    assert not left, f"Validate on {path} left kernels running:\n" + "\n".join(left)
     return result
 
 
@@ -95,7 +103,7 @@ def said(result, lab) -> str:
 
 @pytest.mark.timeout(VALIDATE_TIMEOUT + 300)
 def test_validate_says_success_for_the_reference_solution(browser, lab):
-    result = validate_in_lab(browser, lab, "correct")
+    result = validate_in_lab(browser, lab, f"correct/{ASSIGNMENT}.ipynb", "validate_correct.png")
     verdict = (result.title, result.outcome, result.error)
     assert verdict == ("Validation Results", "success", False), said(result, lab)
     assert result.text == "Success! Your notebook passes all the tests.", said(result, lab)
@@ -106,7 +114,7 @@ def test_validate_says_success_for_the_reference_solution(browser, lab):
 
 @pytest.mark.timeout(VALIDATE_TIMEOUT + 300)
 def test_validate_fails_a_wrong_average_and_shows_the_failing_checks(browser, lab):
-    result = validate_in_lab(browser, lab, "incorrect")
+    result = validate_in_lab(browser, lab, f"incorrect/{ASSIGNMENT}.ipynb", "validate_incorrect.png")
     verdict = (result.title, result.outcome, result.error)
     assert verdict == ("Validation Results", "failed", True), said(result, lab)
     # Every failed cell is shown by its source; the node publishes average_brightness's 0 as well.
@@ -117,6 +125,21 @@ def test_validate_fails_a_wrong_average_and_shows_the_failing_checks(browser, la
     assert result.text.count("[self-check · seed") == 2 and "✘" in result.text, said(result, lab)
     assert "Partial credit" not in result.text, said(result, lab)
     assert "Traceback" not in result.text and "CellTimeoutError" not in result.text, said(result, lab)
+
+
+@pytest.mark.timeout(300)
+def test_validate_on_a_lesson_points_at_its_self_checks_at_once_and_leaves_no_kernel(browser, lab):
+    """A lesson has no graded cells: Validate answers with the fix first, in a few short lines (no
+    traceback), without running the lesson in a kernel that outlives it (each press used to leave
+    one running)."""
+    from course_lib.student_lab.validate import LESSON_ANSWER
+
+    result = validate_in_lab(browser, lab, LESSON, "validate_lesson.png")
+    assert (result.title, result.error) == ("Validation Results", True), said(result, lab)
+    header, _, answer = result.text.partition("\n")
+    assert header == "There was an error running the validate command:", said(result, lab)
+    assert answer.strip() == LESSON_ANSWER and "Traceback" not in result.text, said(result, lab)
+    assert answer.strip().startswith("Use this lesson's self-check cells"), said(result, lab)
 
 
 @pytest.mark.timeout(300)

@@ -1,12 +1,12 @@
 """Tests for course_lib.student_lab: a student's lab shows nbgrader's student side, and Validate
-on a lesson does not say "Success". (tests/test_browser.py checks the running lab's extensions.)"""
+on a lesson does not say "Success". (tests/test_browser.py checks the running lab's extensions,
+tests/test_browser_validate.py its Validate.)"""
 
 import json
 import subprocess
 from pathlib import Path
 
 import nbformat
-import pytest
 
 from course_lib import student_lab
 
@@ -19,27 +19,34 @@ def test_make_lab_puts_the_student_config_on_the_jupyter_config_path():
     assert student_lab.CONFIG_DIR == ROOT / "course_lib" / "student_lab"
 
 
-def test_validate_on_a_lesson_points_at_its_self_checks(tmp_path):
-    """The lab's nbgrader_config.py, loaded as the Validate button's server handler loads it,
-    makes nbgrader's executor refuse a lesson (no nbgrader cells) with its task still a stub,
-    before any cell runs, instead of answering 'Success'."""
-    from nbgrader.apps import NbGrader
+def test_the_lab_serves_validate_with_the_course_handler_instead_of_nbgraders():
+    """nbgrader's validate extension is off and the course's, which serves the same URLs, is on
+    (tests/test_browser_validate.py presses Validate in the running lab)."""
+    from nbgrader.server_extensions.validate_assignment import handlers as nbgrader_handlers
 
-    app = NbGrader()
-    app.config_file_paths.append([str(ROOT)])  # the handler adds the lab's working directory
-    app.load_config_file()
-    hook = app.config.Execute.on_notebook_start
-    lesson = nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell("answer = None  # TODO")])
-    with pytest.raises(student_lab.NotAnAssignment, match="self-check cell"):
-        hook(notebook=lesson)
+    from course_lib.student_lab import validate
+
+    extensions = json.loads((student_lab.CONFIG_DIR / "jupyter_server_config.json").read_text())
+    enabled = extensions["ServerApp"]["jpserver_extensions"]
+    assert enabled["nbgrader.server_extensions.validate_assignment"] is False
+    assert enabled["course_lib.student_lab.validate"] is True
+    assert validate._jupyter_server_extension_points() == [{"module": "course_lib.student_lab.validate"}]
+    assert [p for p, _ in nbgrader_handlers.default_handlers] == ["/assignments/validate", "/nbgrader_version"]
+    assert issubclass(validate.ValidateHandler, nbgrader_handlers.ValidateAssignmentHandler)
 
 
-def test_assignments_are_told_from_lessons():
+def test_lessons_are_told_from_assignments(tmp_path):
+    from course_lib.student_lab.validate import is_assignment, is_lesson_file
+
     graded = nbformat.v4.new_code_cell("assert True")
     graded.metadata["nbgrader"] = {"grade": True, "grade_id": "t1", "points": 1, "solution": False,
                                    "locked": True, "schema_version": 3}
-    assert student_lab.is_assignment(nbformat.v4.new_notebook(cells=[graded]))
-    assert not student_lab.is_assignment(nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell("x = 1")]))
+    assert is_assignment(nbformat.v4.new_notebook(cells=[graded]))
+    assert not is_assignment(nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell("x = 1")]))
     for lesson in (ROOT / "notebooks").glob("*.ipynb"):
-        assert not student_lab.is_assignment(json.loads(lesson.read_text())), lesson
-    student_lab.refuse_lessons(notebook=nbformat.v4.new_notebook(cells=[graded]))  # no error
+        assert is_lesson_file(lesson), lesson
+    for assignment in (ROOT / "assignments" / "source").glob("*/*.ipynb"):
+        assert not is_lesson_file(assignment), assignment
+    # What is not a notebook is left to nbgrader, which says what is wrong with it.
+    (tmp_path / "broken.ipynb").write_text("{not json")
+    assert not is_lesson_file(tmp_path / "broken.ipynb") and not is_lesson_file(tmp_path / "missing.ipynb")
