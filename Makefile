@@ -1,6 +1,7 @@
 # One command to set up, one to start the lab, one to test. All are idempotent.
 #   make setup   create .venv/ from environment.txt and install course_lib into it
-#   make lab     set up, then start JupyterLab on the course (prints the URL; no browser needed)
+#   make lab     set up, release the assignments into the lab's own exchange (.lab/), then start
+#                JupyterLab on the course (prints the URL; no browser needed)
 #   make test    set up, lint (ruff, notebooks too), then run the whole test suite (unit tests,
 #                notebooks, browser tests)
 #   make check   the inner loop (under 2 minutes): set up, lint as make test does, then run the tests
@@ -72,7 +73,11 @@ ALLOW_ROOT := $(if $(filter 0,$(shell id -u)),--allow-root)
 # which sets PATH anew); bash reads ~/.bashrc and then local_setup.bash again
 # (course_lib/student_lab/terminal.py), in case ~/.bashrc puts pyenv or conda first.
 # JUPYTER_CONFIG_PATH: a student's lab shows nbgrader's student side only (course_lib/student_lab).
+# A student alone fetches the assignments in Nbgrader > Assignment List from the lab's own exchange
+# (.lab/, git-ignored), where the course's grader releases them, again when their source changed
+# (course_lib/student_lab/exchange.py).
 lab: setup
+	$(PY) -m autograder release-lab
 	eval "$$($(PY) -m course_lib env)" && . "$(CURDIR)/$(VENV)/local_setup.sh" && \
 	JUPYTER_CONFIG_PATH="$(CURDIR)/course_lib/student_lab$${JUPYTER_CONFIG_PATH:+:$$JUPYTER_CONFIG_PATH}" \
 	exec $(VENV)/bin/jupyter lab --no-browser --ip=127.0.0.1 --port=$(LAB_PORT) $(ALLOW_ROOT) \
@@ -128,4 +133,4 @@ check: setup
 	PATH="$(VENV)/bin:$$PATH" fastdds shm clean >/dev/null 2>&1; exit $$status
 
 clean:
-	rm -rf $(VENV) .pytest_cache artifacts
+	rm -rf $(VENV) .pytest_cache artifacts .lab

@@ -1,5 +1,5 @@
 """python -m autograder roster|release|collect|grade|feedback|export COURSE_DIR, record-answers: the
-instructor's commands."""
+instructor's commands; release-lab: the assignments for a student's `make lab`."""
 
 from __future__ import annotations
 
@@ -18,6 +18,9 @@ def _parser() -> argparse.ArgumentParser:
     rel.add_argument("course_dir", type=Path)
     rel.add_argument("--assignment", action="append", help="only this assignment (repeatable)")
     rel.add_argument("--duedate", help='due date of the assignment(s), e.g. "2025-03-14 23:59 Europe/Berlin"')
+    lab = sub.add_parser("release-lab", help="release the assignments into the exchange of `make lab` "
+                         "(.lab/ in LAB_ROOT, default this repository), where a student alone fetches them")
+    lab.add_argument("lab_root", type=Path, nargs="?", default=None)
     col = sub.add_parser("collect", help="an LMS download (zip) of an assignment into COURSE_DIR/submitted/")
     col.add_argument("course_dir", type=Path)
     col.add_argument("assignment")
@@ -68,6 +71,10 @@ def _run(parser, args) -> int:
     elif args.command == "release":
         for path in release.release(args.course_dir, args.assignment, duedate=args.duedate):
             print(path)
+    elif args.command == "release-lab":
+        released = release.release_for_lab(*([args.lab_root] if args.lab_root else []))
+        print(f"Released for Nbgrader > Assignment List: {', '.join(released)}" if released
+              else "The assignments in Nbgrader > Assignment List are up to date")
     elif args.command == "collect":
         from autograder import collect
 

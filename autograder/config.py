@@ -13,8 +13,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from course_lib.checks.validate import apply_student
-
-COURSE_ID = "ros2-jazzy-opencv"
+from course_lib.contract import COURSE_ID
 
 #: The stub ClearSolutions puts in place of a solution, at the solution's indentation.
 CODE_STUB = "# YOUR CODE HERE\nraise NotImplementedError(\"replace this line with your code\")"

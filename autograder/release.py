@@ -1,4 +1,5 @@
-"""The course root (config, source/) and the student versions in release/ (nbgrader generate_assignment)."""
+"""The course root (config, source/), the student versions in release/ (nbgrader generate_assignment),
+and their release into an exchange (nbgrader release_assignment), also a student's lab's own."""
 
 from __future__ import annotations
 
@@ -10,6 +11,8 @@ from autograder.nbgrader_cli import run_nbgrader
 
 REPO = Path(__file__).resolve().parent.parent
 REPO_SOURCE = REPO / "assignments" / "source"
+#: What of an assignment's source folder a course does not take.
+SOURCE_IGNORE = shutil.ignore_patterns(".ipynb_checkpoints", "__pycache__", "*.py")
 
 
 def assignments_in(course: Path) -> list[str]:
@@ -23,8 +26,7 @@ def prepare_course(course_dir) -> Path:
     course.mkdir(parents=True, exist_ok=True)
     config.write_config(course)
     if not (course / "source").is_dir():
-        shutil.copytree(REPO_SOURCE, course / "source",
-                        ignore=shutil.ignore_patterns(".ipynb_checkpoints", "__pycache__", "*.py"))
+        shutil.copytree(REPO_SOURCE, course / "source", ignore=SOURCE_IGNORE)
     return course
 
 
@@ -45,3 +47,44 @@ def release(course_dir, assignments: list[str] | None = None, duedate: str | Non
         written.append(course / "release" / name)
     return written
 
+
+
+def release_to_exchange(course_dir, exchange, assignments: list[str]) -> None:
+    """Put the course's student versions (release/) into an nbgrader exchange, which is made when
+    missing: students see them in Nbgrader > Assignment List (nbgrader release_assignment)."""
+    Path(exchange).mkdir(parents=True, exist_ok=True)
+    for name in assignments:
+        run_nbgrader(["release_assignment", name, "--force", f"--Exchange.root={exchange}"], Path(course_dir))
+
+
+def release_for_lab(lab_root=REPO, assignments: list[str] | None = None) -> list[str]:
+    """Release the repository's assignments into the exchange of the lab served from lab_root (what
+    ``make lab`` does for a student who works alone; course_lib.student_lab.exchange). An assignment
+    whose source is as at its last release, and which is in the exchange, is left as it is.
+
+    Returns:
+        the assignments released now.
+    """
+    from course_lib.student_lab.exchange import local_course, local_exchange
+
+    course, exchange = local_course(lab_root), local_exchange(lab_root)
+    names = assignments or [p.name for p in sorted(REPO_SOURCE.iterdir()) if any(p.glob("*.ipynb"))]
+    stale = [name for name in names if not _released_as_is(course, exchange, name)]
+    for name in stale:
+        shutil.rmtree(course / "source" / name, ignore_errors=True)
+        shutil.copytree(REPO_SOURCE / name, course / "source" / name, ignore=SOURCE_IGNORE)
+    if stale:
+        release(course, stale)
+        release_to_exchange(course, exchange, stale)
+    return stale
+
+
+def _released_as_is(course: Path, exchange: Path, name: str) -> bool:
+    """The course holds the repository's source notebooks of the assignment unchanged, and the
+    exchange its release."""
+    notebooks = sorted(p.name for p in (REPO_SOURCE / name).glob("*.ipynb"))
+    copies = sorted(p.name for p in (course / "source" / name).glob("*.ipynb"))
+    return (notebooks == copies
+            and all((REPO_SOURCE / name / n).read_bytes() == (course / "source" / name / n).read_bytes()
+                    for n in notebooks)
+            and all((exchange / config.COURSE_ID / "outbound" / name / n).is_file() for n in notebooks))

@@ -9,6 +9,9 @@ student's package holds this module, and the answer keys stay on the instructor'
 
 from __future__ import annotations
 
+#: nbgrader's course id: the course's assignments in an exchange, on a hub and in a student's lab alike.
+COURSE_ID = "ros2-jazzy-opencv"
+
 # --- who runs: grading, the test suite ---------------------------------------------------------
 
 #: "1" in every process of a grading run (course_lib.rosenv.under_grading).

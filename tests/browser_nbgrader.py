@@ -1,6 +1,6 @@
 """nbgrader's student side in JupyterLab, driven as a student drives it: the notebook's Validate
 button (``validate``: press it, read the dialog) and the Nbgrader > Assignment List panel
-(``open_assignment_list``, ``assignment_lists``, ``wait_for_assignment``), and the kernels a
+(``open_assignment_list``, ``assignment_lists``, ``chosen_course``, ``wait_for_assignment``), and the kernels a
 server runs (``kernel_processes``, ``kernels_left``: what a Validate leaves behind). The server, the
 browser and the notebook UI are browser_support's.
 """
@@ -127,6 +127,12 @@ def assignment_lists(page) -> dict[str, list[str]]:
         ["(loading)"] or ["(error) <nbgrader's message>"] while it loads or when it failed.
     """
     return page.evaluate(_ASSIGNMENT_LISTS_JS, list(ASSIGNMENT_LISTS))
+
+
+def chosen_course(page) -> str:
+    """What the Assignments panel's course button says: the course shown, "Error fetching courses!"
+    when nbgrader could not list them, "No courses found." when the exchange has none."""
+    return page.locator("#course_list_default").inner_text().strip()
 
 
 def wait_for_assignment(page, listed: str, assignment: str, timeout: float) -> str:

@@ -1,8 +1,9 @@
 """nbgrader in JupyterLab for the released brightness assignment: the Validate button and the
 Assignments panel, used as a student uses them.
 
-The brightness assignment is released into a fresh course directory and into a scratch exchange
-(the real nbgrader CLI, as the instructor runs it). Two students work on the released notebook,
+The brightness assignment is released as `make lab` releases the assignments for a student who
+works alone (the real nbgrader CLI): into the lab's own course folder and exchange, .lab/ under the
+lab's root, which the repository's nbgrader_config.py, copied there unchanged, names. Two students work on the released notebook,
 each in a folder of their own under the lab's root (the notebook writes and builds its workspace
 ros2_ws next to itself): ``correct/`` holds the reference solution, ``incorrect/`` the reference with
 ``average_brightness`` returning 0. Each presses Validate; nbgrader saves the notebook, runs it
@@ -18,7 +19,8 @@ from pathlib import Path
 
 import pytest
 
-from browser_nbgrader import kernel_processes, kernels_left, open_assignment_list, validate, wait_for_assignment
+from browser_nbgrader import (assignment_lists, chosen_course, kernel_processes, kernels_left, open_assignment_list,
+                              validate, wait_for_assignment)
 from browser_support import close_notebook, open_notebook, running_jupyterlab
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -40,11 +42,11 @@ STUDENTS = {
     "incorrect": [(brightness_zoo.SUM, "return 0")],
 }
 
-# The student's nbgrader settings, as the repository's nbgrader_config.py gives them to `make lab`
-# (nbgrader's lab handlers read nbgrader_config.py from the server's working directory, here the
-# lab's root, never from a course directory), plus a scratch exchange for the Assignments panel.
+# The student's nbgrader settings as `make lab` has them: the repository's nbgrader_config.py,
+# unchanged (nbgrader's lab handlers read nbgrader_config.py from the server's working directory,
+# here the lab's root, never from a course directory), which names the lab's own exchange under the
+# root; and a scratch cache for nbgrader's records of fetches and submissions, instead of the user's.
 STUDENT_NBGRADER_CONFIG = (ROOT / "nbgrader_config.py").read_text() + """
-c.Exchange.root = {exchange!r}
 c.Exchange.cache = {cache!r}
 """
 
@@ -52,20 +54,26 @@ pytestmark = pytest.mark.browser
 
 
 @pytest.fixture(scope="module")
-def course(tmp_path_factory):
-    """A course directory with brightness released, to release/brightness/ and to an exchange in exchange/."""
-    from autograder import nbgrader_cli, release
-
-    course = tmp_path_factory.mktemp("validate-course")
-    release.release(course, [ASSIGNMENT])
-    nbgrader_cli.run_nbgrader(["release_assignment", ASSIGNMENT, f"--Exchange.root={course / 'exchange'}"], course)
-    return course
+def lab_root(tmp_path_factory):
+    return tmp_path_factory.mktemp("validate-lab-root")
 
 
 @pytest.fixture(scope="module")
-def lab(course, tmp_path_factory):
-    """JupyterLab on a student's root: <student>/brightness.ipynb for each of STUDENTS, nbgrader_config.py."""
-    root = tmp_path_factory.mktemp("validate-lab-root")
+def course(lab_root):
+    """The lab's own course folder, brightness released from it into the lab's exchange, as `make
+    lab` releases the assignments (python -m autograder release-lab)."""
+    from autograder import release
+    from course_lib.student_lab.exchange import local_course
+
+    assert release.release_for_lab(lab_root, [ASSIGNMENT]) == [ASSIGNMENT]
+    return local_course(lab_root)
+
+
+@pytest.fixture(scope="module")
+def lab(course, lab_root, tmp_path_factory):
+    """JupyterLab on a student's root: <student>/brightness.ipynb for each of STUDENTS, a lesson,
+    nbgrader_config.py, and the lab's exchange in .lab/."""
+    root = lab_root
     for student, edits in STUDENTS.items():
         # The zoo makes the submission (released notebook, reference solution, edits) in the
         # course's submitted/ folder; the student's working copy is that notebook.
@@ -75,8 +83,7 @@ def lab(course, tmp_path_factory):
     (root / LESSON).parent.mkdir()
     shutil.copy(ROOT / "notebooks" / Path(LESSON).name, root / LESSON)
     cache = tmp_path_factory.mktemp("nbgrader-cache")
-    (root / "nbgrader_config.py").write_text(
-        STUDENT_NBGRADER_CONFIG.format(exchange=str(course / "exchange"), cache=str(cache)))
+    (root / "nbgrader_config.py").write_text(STUDENT_NBGRADER_CONFIG.format(cache=str(cache)))
     with running_jupyterlab(root, tmp_path_factory.mktemp("validate-lab-state")) as server:
         print(f"\nJupyterLab answered after {server.startup_seconds:.1f} s")
         yield server
@@ -142,13 +149,29 @@ def test_validate_on_a_lesson_points_at_its_self_checks_at_once_and_leaves_no_ke
     assert answer.strip().startswith("Use this lesson's self-check cells"), said(result, lab)
 
 
+def test_make_lab_releases_into_the_labs_exchange_once_per_source(course, lab_root):
+    """An assignment released from its unchanged source is not released again (`make lab` starts at
+    once the second time); the release is in the exchange the lab's nbgrader_config.py names."""
+    from autograder import release
+    from course_lib.contract import COURSE_ID
+    from course_lib.student_lab.exchange import local_exchange
+
+    assert release.release_for_lab(lab_root, [ASSIGNMENT]) == []
+    assert (local_exchange(lab_root) / COURSE_ID / "outbound" / ASSIGNMENT / f"{ASSIGNMENT}.ipynb").is_file()
+
+
 @pytest.mark.timeout(300)
 def test_assignments_panel_lists_the_released_assignment_and_fetches_it(browser, lab, course):
-    from autograder.config import COURSE_ID
+    """Under `make lab` (one student, no hub) Nbgrader > Assignment List shows the course and what
+    `make lab` released into the lab's exchange, without an error; Fetch copies it into the lab."""
+    from course_lib.contract import COURSE_ID
 
     page = open_assignment_list(browser, lab)
     try:
         assert wait_for_assignment(page, "released", ASSIGNMENT, 60) == f"{ASSIGNMENT} | {COURSE_ID} | Fetch"
+        shown = assignment_lists(page)
+        assert not any(row.startswith("(error)") for rows in shown.values() for row in rows), shown
+        assert chosen_course(page) == COURSE_ID
         page.locator("#released_assignments_list > .list_item", has_text=ASSIGNMENT).get_by_role(
             "button", name="Fetch").click()
         assert wait_for_assignment(page, "fetched", ASSIGNMENT, 60) == f"{ASSIGNMENT} | {COURSE_ID} | Submit"

@@ -16,6 +16,7 @@ ROOT = Path(__file__).resolve().parents[1]
 def test_make_lab_puts_the_student_config_on_the_jupyter_config_path():
     commands = subprocess.run(["make", "-n", "lab"], cwd=ROOT, capture_output=True, text=True, timeout=60).stdout
     assert f'JUPYTER_CONFIG_PATH="{ROOT}/course_lib/student_lab' in commands
+    assert ".venv/bin/python -m autograder release-lab" in commands  # the assignments in its Assignments panel
     assert student_lab.CONFIG_DIR == ROOT / "course_lib" / "student_lab"
 
 
