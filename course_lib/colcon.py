@@ -17,7 +17,7 @@ import threading
 import time
 from pathlib import Path
 
-from course_lib import process_tree, rosenv, wheelfix
+from course_lib import process_tree, progress, rosenv, wheelfix
 
 
 class BuildError(RuntimeError):
@@ -64,6 +64,10 @@ def package_log_path(ws_dir, package: str) -> Path:
     return Path(ws_dir) / "log" / "latest_build" / package / "stdout_stderr.log"
 
 
+#: colcon's line for a package that starts, finishes, fails or is aborted.
+PACKAGE_LINE = re.compile(r"^(Starting >>>|Finished <<<|Failed\s+<<<|Aborted\s+<<<) ")
+
+
 def failed_packages(output: str) -> list[str]:
     """The packages colcon's output reports as failed ("Failed   <<< name"), in its order."""
     return re.findall(r"^Failed\s+<<< (\S+)", output, re.MULTILINE)
@@ -98,7 +102,8 @@ def build(ws_dir, packages=None, *, extra_args=(), timeout: float = 600,
         packages: names for ``--packages-select``; None builds all.
         extra_args: more colcon build arguments, e.g. ["--symlink-install"].
         timeout: seconds before the build is stopped.
-        echo: called with each output line as it arrives (e.g. print) to show progress live.
+        echo: called with each output line as it arrives (e.g. print) to show progress live. In a
+            notebook a progress line follows the packages in any case (course_lib.progress).
 
     Returns:
         A BuildResult (``finished`` lists the built packages).
@@ -117,6 +122,20 @@ def build(ws_dir, packages=None, *, extra_args=(), timeout: float = 600,
         command += ["--packages-select", *([packages] if isinstance(packages, str) else packages)]
     command += [str(arg) for arg in extra_args]
     env = build_environment()
+    # In a notebook a line under the cell follows colcon's package lines ("Starting >>> name").
+    with progress.Progress(f"colcon build in {ws_dir.name}") as shown:
+        result = _run(command, ws_dir, env, timeout, echo, shown)
+        if result.returncode is None:
+            raise BuildError(f"colcon build in {ws_dir} did not finish within {timeout:g} s and was stopped; "
+                             f"pass a larger timeout or build fewer packages.\n{_tail(result.output)}", result)
+        if result.returncode != 0:
+            raise BuildError(_failure_message(result), result)
+    return result
+
+
+def _run(command: list[str], ws_dir: Path, env: dict[str, str], timeout: float, echo, shown) -> BuildResult:
+    """Run colcon, pass each output line to echo and its package lines to shown.step; stop it after
+    timeout seconds (returncode None)."""
     started = time.monotonic()
     process = subprocess.Popen(command, cwd=ws_dir, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                                stdin=subprocess.DEVNULL, text=True, errors="replace", start_new_session=True)
@@ -127,6 +146,8 @@ def build(ws_dir, packages=None, *, extra_args=(), timeout: float = 600,
             lines.append(line)
             if echo is not None:
                 echo(line.rstrip("\n"))
+            if PACKAGE_LINE.match(line):
+                shown.step(line)
 
     reader = threading.Thread(target=pump, daemon=True)
     reader.start()
@@ -141,16 +162,9 @@ def build(ws_dir, packages=None, *, extra_args=(), timeout: float = 600,
         raise
     reader.join(timeout=10)
     output = "".join(lines)
-    result = BuildResult(ws_dir, command, None if timed_out else process.returncode, output,
-                         time.monotonic() - started,
-                         re.findall(r"^Finished <<< (\S+)", output, re.MULTILINE),
-                         failed_packages(output))
-    if timed_out:
-        raise BuildError(f"colcon build in {ws_dir} did not finish within {timeout:g} s and was stopped; "
-                         f"pass a larger timeout or build fewer packages.\n{_tail(output)}", result)
-    if process.returncode != 0:
-        raise BuildError(_failure_message(result), result)
-    return result
+    return BuildResult(ws_dir, command, None if timed_out else process.returncode, output,
+                       time.monotonic() - started,
+                       re.findall(r"^Finished <<< (\S+)", output, re.MULTILINE), failed_packages(output))
 
 
 def _tail(text: str, lines: int = 30) -> str:

@@ -597,12 +597,13 @@ def run_in_lab(context, lab: JupyterLab, path: str, screenshot: Path | None = No
     return run
 
 
-def assert_lesson_runs_clean(context, lab: JupyterLab, notebook: str) -> None:
+def assert_lesson_runs_clean(context, lab: JupyterLab, notebook: str) -> NotebookRun:
     """Run a lesson (its path under notebooks/) top to bottom in lab: every code cell ran, none
     shows an error, every image renders. A run with problems leaves a screenshot in
-    artifacts/browser/ (every run does with COURSE_TEST_SCREENSHOTS=1)."""
+    artifacts/browser/ (every run does with COURSE_TEST_SCREENSHOTS=1). Returns the run."""
     screenshot = SCREENSHOTS / (notebook.removesuffix(".ipynb").replace("/", "__") + ".png")
     run = run_in_lab(context, lab, f"notebooks/{notebook}", screenshot,
                      screenshot_always=os.environ.get("COURSE_TEST_SCREENSHOTS") == "1")
     assert not run.problems(), f"{notebook} in JupyterLab (screenshot {screenshot}):\n" + "\n".join(run.problems())
+    return run
 

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from browser_support import (LESSON_RUN_TIMEOUT, NOTEBOOK, SCREENSHOTS, assert_lesson_runs_clean,
+from browser_support import (LESSON_RUN_TIMEOUT, NOTEBOOK, SCREENSHOTS, assert_lesson_runs_clean, click_menu,
                              click_toolbar_button, close_notebook, copy_lessons, course_lessons, open_notebook, run_in_lab,
                              run_notebook, running_jupyterlab, toolbar_labels, write_notebook)
 
@@ -32,6 +32,18 @@ CHECKER_NOTEBOOKS = {
     "raises.ipynb": ["x = 1", "1 / 0", "print('never reached')"],
     "broken_image.ipynb": ["from IPython.display import Image\nImage(data=b'these bytes are no PNG', format='png')"],
 }
+
+# A long call in a cell: it waits until the test makes the file `go` (course_lib.progress's line).
+PROGRESS_NOTEBOOK = ["""from pathlib import Path
+from course_lib import progress, waiting
+with progress.Progress("waiting for the test") as shown:
+    shown.step("until the file go exists")
+    waiting.spin_until(lambda: Path("go").exists(), timeout=600)"""]
+
+# What the lessons' long calls leave under their cells (course_lib.progress): the build of lesson
+# 00 and the publisher self-check of lesson 01 said what ran while it ran.
+PROGRESS_LINES = {"00_setup_and_workspace.ipynb": "colcon build in ros2_ws: finished after ",
+                  "01_publisher_subscriber.ipynb": "self-check: running your publisher: finished after "}
 
 # A node cell run three times in one kernel (a student re-running it), then the graph.
 NODE_CELL = "listener = session.add_node(Listener())"
@@ -71,6 +83,7 @@ def lab(tmp_path_factory):
     for name, sources in CHECKER_NOTEBOOKS.items():
         write_notebook(root / "checker" / name, sources)
     write_notebook(root / "checker" / "rerun_node.ipynb", RERUN_NOTEBOOK)
+    write_notebook(root / "checker" / "progress.ipynb", PROGRESS_NOTEBOOK)
     # Lesson 02's camera, started as lesson 02 starts it; and lesson 03's, as lesson 03 does.
     write_notebook(root / "checker" / "lesson02_left_running.ipynb", [
         "from course_lib import processes", lesson_line("02_images_and_brightness.ipynb", "CAMERA_ARGS = "),
@@ -87,8 +100,46 @@ def lab(tmp_path_factory):
 @pytest.mark.parametrize("notebook", COURSE_NOTEBOOKS or [
     pytest.param(None, marks=pytest.mark.skip(reason=f"no notebooks in {NOTEBOOKS} yet"))])
 def test_course_notebook_runs_clean_in_jupyterlab(notebook, browser, lab):
-    """After Run All Cells every code cell has run, none shows an error, every image renders."""
-    assert_lesson_runs_clean(browser, lab, notebook)
+    """After Run All Cells every code cell has run, none shows an error, every image renders; the
+    long calls said what they did."""
+    run = assert_lesson_runs_clean(browser, lab, notebook)
+    if notebook in PROGRESS_LINES:
+        assert any(PROGRESS_LINES[notebook] in output for output in run.outputs), run.outputs
+
+
+# The first code cell's output while its prompt shows "[*]" and the output holds `text`, else null.
+_RUNNING_OUTPUT_JS = """([notebook, text]) => {
+  const cell = document.querySelector(notebook + ' .jp-Notebook .jp-CodeCell');
+  const prompt = (cell.querySelector('.jp-InputArea-prompt') || {}).innerText || '';
+  const output = (cell.querySelector('.jp-Cell-outputArea') || {}).innerText || '';
+  return prompt.includes('*') && output.includes(text) ? output : null;
+}"""
+
+
+@pytest.mark.timeout(RUN_TIMEOUT)
+def test_a_long_call_shows_what_it_does_and_for_how_long_while_the_cell_runs(browser, lab):
+    """course_lib.progress: the line is under the cell while the cell still runs, its seconds count
+    up, and when the call ends it says how long it took."""
+    path = "checker/progress.ipynb"
+    running = "⏳ waiting for the test … until the file go exists ("
+    page = open_notebook(browser, lab, path)
+    try:
+        click_menu(page, "Run", "Run All Cells")
+        first = page.wait_for_function(_RUNNING_OUTPUT_JS, arg=[NOTEBOOK, running], timeout=120_000,
+                                       polling=100).json_value()
+        page.wait_for_function(f"([notebook, text, first]) => {{ const now = ({_RUNNING_OUTPUT_JS})([notebook, text]);"
+                               " return now !== null && now !== first; }", arg=[NOTEBOOK, running, first],
+                               timeout=120_000, polling=100)
+        (lab.root_dir / "checker" / "go").touch()
+        page.wait_for_function("""(notebook) => { const cell = document.querySelector(notebook + ' .jp-CodeCell');
+            return cell.querySelector('.jp-InputArea-prompt').innerText.trim() === '[1]:'
+              && cell.querySelector('.jp-Cell-outputArea').innerText.includes('waiting for the test: finished after'); }""",
+                               arg=NOTEBOOK, timeout=120_000, polling=100)
+        shown = page.locator(f"{NOTEBOOK} .jp-CodeCell .jp-Cell-outputArea").first.inner_text().strip()
+    finally:
+        close_notebook(page, lab, path)
+    assert first.strip().startswith(running), first
+    assert shown.startswith("waiting for the test: finished after ") and "⏳" not in shown, shown
 
 
 def test_the_students_lab_has_no_instructor_side(lab):

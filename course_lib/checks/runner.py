@@ -113,7 +113,7 @@ def execute(assignment: str, name: str, seed: int, workdir=None, mode: str = "se
     (recorded answers; only the self-check seed's inputs are recorded), "graded" (the grader's
     answer key) or "record" (graded, and the answers written to $AUTOGRADER_RECORD_TO).
     """
-    from course_lib import processes
+    from course_lib import processes, progress
 
     spec = get_check(assignment, name)
     workdir = Path(workdir or os.getcwd()).resolve()
@@ -128,12 +128,14 @@ def execute(assignment: str, name: str, seed: int, workdir=None, mode: str = "se
     proc = processes.NodeProcess(command, name=f"autograder-check-{name}", cwd=out, limits=limits,
                                  env={"PYTHONPATH": child_pythonpath(), contract.CHECK_SEED_ENV: str(seed), contract.ANSWERS_ENV: mode})
     try:
-        proc.start()
-        try:
-            proc.wait(spec.timeout + 20)
-        except TimeoutError:
-            pass
-        proc.stop(timeout=3)
+        with progress.Progress(f"check {name!r}") as shown:  # a line under the notebook's cell
+            shown.step(spec.description)
+            proc.start()
+            try:
+                proc.wait(spec.timeout + 20)
+            except TimeoutError:
+                pass
+            proc.stop(timeout=3)
         try:
             data = json.loads((out / "result.json").read_text())
             result = Result(**data)

@@ -5,6 +5,7 @@ are named before anything is started.
 
 from __future__ import annotations
 
+from course_lib import progress
 from course_lib.selfcheck.verdicts import Verdict, _verdict
 
 #: The package and executable of lesson 02's exercise (the brightness assignment asks for the
@@ -286,6 +287,7 @@ def _run_brightness_node(ws) -> Verdict:
                           "ready for the brightness assignment, which replaces centre_value with the average.")
 
 
+@progress.while_running("self-check: your brightness package")
 def brightness_package_exercise(ws_dir) -> Verdict:
     """Exercise (lesson 02): the brightness package, built, and its node run as `ros2 run brightness
     brightness_node --ros-args -r /image:=...`: package.xml declares what the node imports, setup.py has

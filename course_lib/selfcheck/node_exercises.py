@@ -4,6 +4,7 @@ and judged by what it is (its timers, publishers and subscriptions) and what it 
 
 from __future__ import annotations
 
+from course_lib import progress
 from course_lib.selfcheck.verdicts import Verdict, _not_done, _verdict
 
 def _exercise_node(node_or_class, class_name: str, hint: str):
@@ -67,6 +68,7 @@ def _depth_problem(endpoint, asked: int, what: str, call: str) -> Verdict | None
     return None
 
 
+@progress.while_running("self-check: running your publisher")
 def publisher_exercise(node_or_class, topic: str = "/announcements", prefix: str = "Announcement ",
                        period: float = 0.5, depth: int = 10) -> Verdict:
     """Exercise (lesson 01): a node that publishes std_msgs/String "Announcement N" (N = 0, 1, ...)
@@ -152,6 +154,7 @@ def _count_calls(timer) -> list:
     return calls
 
 
+@progress.while_running("self-check: running your subscriber")
 def subscriber_exercise(node_or_class, msg_type, topic: str = "/ros_tutorial_msg", depth: int = 100) -> Verdict:
     """Exercise (lesson 01b): a node subscribed to ros_tutorial_msg (MsgTutorial, depth 100) that
     appends (stamp in seconds, data) to self.received for every message. The check sends it three
