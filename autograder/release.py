@@ -69,7 +69,7 @@ def release_for_lab(lab_root=REPO, assignments: list[str] | None = None) -> list
 
     course, exchange = local_course(lab_root), local_exchange(lab_root)
     names = assignments or [p.name for p in sorted(REPO_SOURCE.iterdir()) if any(p.glob("*.ipynb"))]
-    stale = [name for name in names if not _released_as_is(course, exchange, name)]
+    stale = [name for name in names if not released_as_is(course, exchange, name)]
     for name in stale:
         shutil.rmtree(course / "source" / name, ignore_errors=True)
         shutil.copytree(REPO_SOURCE / name, course / "source" / name, ignore=SOURCE_IGNORE)
@@ -79,7 +79,7 @@ def release_for_lab(lab_root=REPO, assignments: list[str] | None = None) -> list
     return stale
 
 
-def _released_as_is(course: Path, exchange: Path, name: str) -> bool:
+def released_as_is(course: Path, exchange: Path, name: str) -> bool:
     """The course holds the repository's source notebooks of the assignment unchanged, and the
     exchange its release."""
     notebooks = sorted(p.name for p in (REPO_SOURCE / name).glob("*.ipynb"))

@@ -74,6 +74,20 @@ def released_course(tmp_path_factory, course: Path, assignments: list[str]) -> P
     return course.resolve()
 
 
+def seed_lab_exchange(tmp_path_factory, lab_root: Path) -> None:
+    """The lab served from lab_root (``make lab``) with every assignment released into its own
+    exchange, from this run's shared release, unless it already is: ``make lab``'s release-lab
+    then finds nothing to do (its own release is tested in tests/test_browser_validate.py)."""
+    from autograder import release
+    from course_lib.student_lab.exchange import local_course, local_exchange
+
+    course, exchange = local_course(lab_root), local_exchange(lab_root)
+    if all(release.released_as_is(course, exchange, name) for name in ASSIGNMENTS):
+        return
+    released_course(tmp_path_factory, course, list(ASSIGNMENTS))
+    release.release_to_exchange(course, exchange, list(ASSIGNMENTS))
+
+
 def seed_interface_cache(tmp_path_factory, course: Path, assignments: list[str]) -> None:
     """Put the assignments' reference interface packages, built once, into COURSE's interface cache."""
     from autograder import packages
