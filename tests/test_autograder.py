@@ -61,11 +61,21 @@ def test_build_script_reproduces_the_committed_notebooks(tmp_path, monkeypatch):
         assert path.read_text() == committed.read_text(), path.name
 
 
-def test_cell_timeouts_give_graded_cells_longer():
-    """Graded cells get the long timeout, every other cell the short one."""
+def test_cell_timeouts_give_graded_cells_longer_and_grow_with_the_load_factor(monkeypatch):
+    """Graded cells get the long timeout, every other cell the short one; both, and the kernel's
+    start-up timeout, times the grader's load factor (as the notebook's wall time): a busy machine
+    must not cut a cell that runs right (a clean-clone run at load 70 failed a submission whose
+    kernel took longer than nbclient's fixed 60 s to start)."""
+    from traitlets.config import Config
+
     graded = nbformat.v4.new_code_cell("x", metadata={"nbgrader": {"grade": True, "solution": False}})
-    assert validate.cell_timeout(graded) == validate.TEST_CELL_TIMEOUT
-    assert validate.cell_timeout(nbformat.v4.new_code_cell("x")) == validate.CELL_TIMEOUT
+    for factor in (1.0, 2.5):
+        monkeypatch.setenv(contract.LOAD_FACTOR_ENV, str(factor))
+        assert validate.cell_timeout(graded) == round(factor * validate.TEST_CELL_TIMEOUT)
+        assert validate.cell_timeout(nbformat.v4.new_code_cell("x")) == round(factor * validate.CELL_TIMEOUT)
+        c = Config()
+        validate.apply_student(c)
+        assert c.Execute.startup_timeout == round(factor * validate.STARTUP_TIMEOUT)
 
 
 def test_sandbox_hides_directories_and_keeps_the_command():

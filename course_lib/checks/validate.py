@@ -18,13 +18,27 @@ CELL_TIMEOUT = 30
 TEST_CELL_TIMEOUT = 150
 
 
+#: Seconds nbclient waits for the kernel to start (nbclient's own default).
+STARTUP_TIMEOUT = 60
+
+
+def scaled(seconds: float) -> int:
+    """`seconds` on an idle machine, times the load factor (course_lib.checks.context.scaled: the
+    grader's, or in a student's lab the machine's load now). The grader's wall time for the whole
+    notebook grows with the load, and so must these: a cell that runs right, or a kernel that
+    starts, must never be cut because the machine was busy."""
+    from course_lib.checks.context import scaled as backstop
+
+    return round(backstop(seconds))
+
+
 def cell_timeout(cell) -> int:
     """nbclient's timeout_func: graded cells and a workspace's build cell (a message package takes
-    tens of seconds to build) get TEST_CELL_TIMEOUT, all others CELL_TIMEOUT."""
+    tens of seconds to build) get TEST_CELL_TIMEOUT, all others CELL_TIMEOUT (both scaled)."""
     meta = cell.get("metadata", {}).get("nbgrader", {})
     if "course_lib build" in cell.get("source", ""):
-        return TEST_CELL_TIMEOUT
-    return TEST_CELL_TIMEOUT if meta.get("grade") and not meta.get("solution") else CELL_TIMEOUT
+        return scaled(TEST_CELL_TIMEOUT)
+    return scaled(TEST_CELL_TIMEOUT if meta.get("grade") and not meta.get("solution") else CELL_TIMEOUT)
 
 
 #: What nbgrader leaves out when it submits, collects or autogrades a folder: its defaults, and
@@ -36,6 +50,7 @@ def apply_student(c) -> None:
     """Give an nbgrader config object (``c = get_config()``) the course's cell timeouts and the
     files it leaves out (IGNORE)."""
     c.CourseDirectory.ignore = IGNORE
-    c.Execute.timeout = TEST_CELL_TIMEOUT
+    c.Execute.timeout = scaled(TEST_CELL_TIMEOUT)
     c.Execute.timeout_func = cell_timeout
+    c.Execute.startup_timeout = scaled(STARTUP_TIMEOUT)
     c.Execute.interrupt_on_timeout = True
