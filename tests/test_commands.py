@@ -36,7 +36,7 @@ def test_make_lab_serves_the_course_and_prints_its_url(tmp_path, tmp_path_factor
                                start_new_session=True, env={**os.environ, "JUPYTER_RUNTIME_DIR": str(tmp_path)})
     try:
         url = None
-        deadline = time.monotonic() + 90
+        deadline = time.monotonic() + 300  # a backstop: the loop ends when the URL shows or make lab ends
         while url is None and time.monotonic() < deadline and lab.poll() is None:
             found = re.search(rf"http://127\.0\.0\.1:{port}/lab\S*\?token=(\w+)", log.read_text())
             url = found and found.group(0)
