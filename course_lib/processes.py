@@ -44,16 +44,8 @@ class NodeProcess(SupervisedProcess):
         domain_id: ROS_DOMAIN_ID of the child; None keeps the caller's.
         env: variables to set for the child on top of the caller's environment (a value of
             None removes a variable).
-        cwd: working directory of the child.
-        limits: resource bounds (see Limits); None for none.
-        private_dirs: folders that belong to the child (a HOME made for it): removed when it has
-            ended, also when its caller dies first.
-        on_output: called as ``on_output(stream, data)`` with each piece of the child's output
-            as it arrives, stream being "stdout" or "stderr" (from a thread of its own; the
-            log keeps everything as well). By the time returncode is known, on_output has had
-            all of it (so on_output must not wait for this process). With it the child's stdout
-            and stderr are separate pipes, so their order in the log is only as exact as their
-            arrival.
+        cwd, limits, on_output, private_dirs: as SupervisedProcess (working directory, resource
+            bounds, a callback for each piece of output, folders removed when the child has ended).
 
     Attributes:
         pid: the child's process id (it also leads the child's process group) once started.
