@@ -21,11 +21,18 @@ import itertools
 import os
 import sys
 import time
-from typing import Callable
+from collections.abc import Callable
 
 from course_lib import rosenv, waiting
 from course_lib.supervised_process import (  # noqa: F401 (Limits, stop_all, ...: course_lib.processes' names)
-    START_TIMEOUT, Limits, SupervisedProcess, TreeMember, running_processes, stop_all, stop_together)
+    START_TIMEOUT,
+    Limits,
+    SupervisedProcess,
+    TreeMember,
+    running_processes,
+    stop_all,
+    stop_together,
+)
 
 _WATCHER_IDS = itertools.count()
 
@@ -189,7 +196,7 @@ def _rosout_publishers(node):
         yield endpoint, f"{endpoint.node_namespace.rstrip('/')}/{endpoint.node_name}"
 
 
-def _warn_if_still_running(earlier: dict[str, str], process: "NodeProcess") -> None:
+def _warn_if_still_running(earlier: dict[str, str], process: NodeProcess) -> None:
     """Print a plain warning when a node of the same name ran before this process started and
     still runs next to its node, e.g. a camera that the previous lesson's kernel left running:
     two cameras on one topic mix their frames."""

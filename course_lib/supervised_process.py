@@ -21,8 +21,8 @@ import sys
 import tempfile
 import threading
 import time
+from collections.abc import Callable
 from pathlib import Path
-from typing import Callable
 
 from course_lib import waiting
 from course_lib.bounded_log import LOG_HEAD_BYTES, LOG_TAIL_BYTES, read_log

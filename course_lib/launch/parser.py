@@ -12,8 +12,14 @@ from pathlib import Path
 
 from course_lib.launch import entities, parameters, substitutions
 from course_lib.launch.actions import (
-    DeclareArgument, Group, IncludeLaunchDescription, PushRosNamespace, SetEnvironmentVariable, SetLaunchConfiguration,
-    reads_launch_files)
+    DeclareArgument,
+    Group,
+    IncludeLaunchDescription,
+    PushRosNamespace,
+    SetEnvironmentVariable,
+    SetLaunchConfiguration,
+    reads_launch_files,
+)
 from course_lib.launch.entities import Entity, did_you_mean
 from course_lib.launch.executables import ExecuteProcess, Node
 
