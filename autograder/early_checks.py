@@ -49,7 +49,7 @@ class EarlyRun:
         self._lock = threading.Lock()
         self._thread = threading.Thread(target=self._run, name=f"early {g.sub.key}", daemon=True)
 
-    def start(self) -> "EarlyRun":
+    def start(self) -> EarlyRun:
         """Write the predicted folder (a copy of the submitted one with the notebook's predicted
         files) and start building and checking it."""
         g = self.g

@@ -6,8 +6,12 @@ display as images) to COURSE_DIR/feedback/<student>/<assignment>/<notebook>.html
 lines wrap there (:data:`WRAP_STYLE`) instead of running off the page. This module adds
 COURSE_DIR/feedback/<student>/index.html: for every assignment graded so far (also those not
 named in this run), the score per check, the due date, the submission time and the late
-penalty, and the reason when a notebook could not be graded at all. Students read only what is
-meant for them: the instructor's notes (nbgrader's log, the fix) stay in the grading report.
+penalty, and the reason when a notebook could not be graded at all. Every number on it comes
+from the course gradebook (autograder.gradebook.submission_scores), the record grades.csv is
+made from too, so a manual score given in the formgrader shows on the page as it counts there;
+the grader's own record (autograder.json) gives only which assignments were graded and the
+reason of a failed one. Students read only what is meant for them: the instructor's notes
+(nbgrader's log, the fix) stay in the grading report.
 """
 
 from __future__ import annotations
@@ -56,10 +60,12 @@ def _write_index(course: Path, student: str, results: list) -> Path:
     for r in results:
         links = " ".join(f"<a href='{html.escape(p.relative_to(folder).as_posix())}'>{html.escape(p.stem)}</a>"
                          for p in sorted((folder / r.assignment).glob("*.html")))
-        checks = "".join(f"<li>{html.escape(c['cell'])}: {points_text(c['auto_score'] or 0)} / {points_text(c['max_score'])}</li>"
-                         for c in r.cells)
+        scores = gradebook.submission_scores(course, student, r.assignment)
+        checks = "" if scores is None or r.status == "failed" else "".join(
+            f"<li>{html.escape(c['cell'])}: {points_text(c['score'] or 0)} / {points_text(c['max_score'])}</li>"
+            for c in scores["cells"])
         reason = f"<pre>{html.escape(r.reason.strip())}</pre>" if r.reason.strip() else ""
-        rows.append(f"<tr><td>{html.escape(r.assignment)}</td><td>{_score(gradebook.lateness(course, student, r.assignment), r)}</td>"
+        rows.append(f"<tr><td>{html.escape(r.assignment)}</td><td>{_score(scores)}</td>"
                     f"<td><ul>{checks}</ul>{reason}</td><td>{links or '(no notebook feedback)'}</td></tr>")
     page = folder / "index.html"
     page.write_text(
@@ -73,18 +79,18 @@ def _write_index(course: Path, student: str, results: list) -> Path:
     return page
 
 
-def _score(late: dict | None, result) -> str:
+def _score(scores: dict | None) -> str:
     """The score cell: the final score, and when there is a due date, the submission time and the penalty."""
-    if late is None:
-        return f"{points_text(result.score)} / {points_text(result.max_score)}"
-    text = f"{points_text(late['score'])} / {points_text(late['max_score'])}"
-    if late["duedate"] is not None:
-        text += f"<br><small>due {late['duedate']:%Y-%m-%d %H:%M} UTC"
-        if late["timestamp"] is not None:
-            text += f", submitted {late['timestamp']:%Y-%m-%d %H:%M} UTC"
-        if late["seconds_late"] > 0:
-            text += (f"<br>late by {_duration(late['seconds_late'])}: {points_text(late['raw_score'])} points "
-                     f"− late penalty {points_text(late['penalty'])}")
+    if scores is None:
+        return "no score recorded"
+    text = f"{points_text(scores['score'])} / {points_text(scores['max_score'])}"
+    if scores["duedate"] is not None:
+        text += f"<br><small>due {scores['duedate']:%Y-%m-%d %H:%M} UTC"
+        if scores["timestamp"] is not None:
+            text += f", submitted {scores['timestamp']:%Y-%m-%d %H:%M} UTC"
+        if scores["seconds_late"] > 0:
+            text += (f"<br>late by {_duration(scores['seconds_late'])}: {points_text(scores['raw_score'])} points "
+                     f"− late penalty {points_text(scores['penalty'])}")
         text += "</small>"
     return text
 

@@ -124,8 +124,10 @@ def assign_late_penalty(course: Path, student: str, assignment: str, notebook: s
     AssignLatePenalties(config=config).preprocess(nbformat.v4.new_notebook(), resources)
 
 
-def lateness(course: Path, student: str, assignment: str) -> dict | None:
-    """What the feedback says about a submission's time: due date, submission time, seconds late,
+def submission_scores(course: Path, student: str, assignment: str) -> dict | None:
+    """A submission's scores as the gradebook holds them, the one record that the feedback page and
+    grades.csv (autograder.export) read: each graded cell's score (a manual one where the
+    formgrader gave it, as nbgrader counts it), the due date, submission time, seconds late,
     penalty (points), raw and final score; None when the gradebook has no such submission."""
     from nbgrader.api import MissingEntry
 
@@ -137,7 +139,9 @@ def lateness(course: Path, student: str, assignment: str) -> dict | None:
         except MissingEntry:
             return None
         penalty = submission.late_submission_penalty or 0.0
-        return {"duedate": submission.duedate, "timestamp": submission.timestamp,
+        cells = [{"notebook": notebook.name, "cell": grade.name, "score": grade.score, "max_score": grade.max_score}
+                 for notebook in submission.notebooks for grade in notebook.grades]
+        return {"cells": cells, "duedate": submission.duedate, "timestamp": submission.timestamp,
                 "seconds_late": submission.total_seconds_late, "penalty": penalty,
                 "raw_score": submission.score, "score": max(0.0, submission.score - penalty),
                 "max_score": submission.max_score}

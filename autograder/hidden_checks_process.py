@@ -20,6 +20,7 @@ import threading
 import time
 from pathlib import Path
 
+from autograder import answers
 from autograder.student_uid import StudentUid
 from course_lib import contract
 from course_lib.checks.check_process import run_in_this_process, write_json
@@ -68,6 +69,7 @@ def run_outside(assignment: str, names: list[str], workdir, out: Path, budget: f
         budget: seconds for all checks together (default AUTOGRADER_CHECKS_SECONDS; None: no bound).
     """
     os.environ[contract.ANSWERS_ENV] = "graded"
+    os.environ.update(answers.environment())
     budget = budget if budget is not None else budget_from_environment()
     started = time.monotonic()
     deadline = None if budget is None else started + max(1.0, budget - MARGIN)

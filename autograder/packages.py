@@ -90,7 +90,7 @@ class BuildReport:
         return path
 
     @classmethod
-    def read(cls, path: Path) -> "BuildReport":
+    def read(cls, path: Path) -> BuildReport:
         return cls(**json.loads(Path(path).read_text()))
 
 

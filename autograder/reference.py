@@ -44,20 +44,29 @@ def write_files(nb: nbformat.NotebookNode, folder: Path, edits=()) -> Path:
 REFERENCE_SRC = SOURCE.parent / "reference_ws" / "src"
 
 
+def package_files(package: str) -> list[tuple[str, str]]:
+    """(path beside the notebook, ros2_ws/src/<package>/..., text with its solution markers) of
+    each file of a reference package, its tests and caches left out: what its source notebook's
+    cells write (assignments/build.py)."""
+    from course_lib.checks.assignments import WORKSPACE
+
+    folder = REFERENCE_SRC / package
+    files = []
+    for path in sorted(p for p in folder.rglob("*") if p.is_file()):
+        relative = path.relative_to(folder)
+        if relative.parts[0] == "test" or "__pycache__" in relative.parts or path.suffix == ".pyc":
+            continue
+        files.append((f"{WORKSPACE}/src/{package}/{relative.as_posix()}", path.read_text()))
+    return files
+
+
 def reference_files(assignment: str) -> dict[str, str]:
     """{path relative to the notebook's folder (ros2_ws/src/...): text} of an assignment's
     reference packages, solution markers removed, their tests and caches left out."""
-    from course_lib.checks.assignments import WORKSPACE, spec
+    from course_lib.checks.assignments import spec
 
-    files = {}
-    for package in spec(assignment).packages:
-        folder = REFERENCE_SRC / package
-        for path in sorted(p for p in folder.rglob("*") if p.is_file()):
-            relative = path.relative_to(folder)
-            if relative.parts[0] in ("test", "__pycache__") or path.suffix == ".pyc" or "__pycache__" in relative.parts:
-                continue
-            files[f"{WORKSPACE}/src/{package}/{relative.as_posix()}"] = solution_source(path.read_text())
-    return files
+    return {path: solution_source(text) for package in spec(assignment).packages
+            for path, text in package_files(package)}
 
 
 def write_reference_workspace(assignment: str, folder: Path, edits=()) -> Path:

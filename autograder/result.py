@@ -28,7 +28,7 @@ class GradeResult:
     build_reused: bool = False
 
     @classmethod
-    def from_dict(cls, data: dict) -> "GradeResult":
+    def from_dict(cls, data: dict) -> GradeResult:
         """A result as recorded (autograder.json), also one written by an older grader."""
         names = {field.name for field in dataclasses.fields(cls)}
         return cls(**{key: value for key, value in data.items() if key in names})

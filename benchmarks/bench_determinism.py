@@ -32,9 +32,10 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path[:0] = [str(ROOT), str(ROOT / "tests")]  # the grader runs from the repository
 
 import zoo  # noqa: E402 (tests/zoo builds submissions from the reference solutions)
-from autograder import grading, release, sandbox  # noqa: E402
 from zoo.brightness import CALLBACK  # noqa: E402
 from zoo.brightness import entries as brightness_entries  # noqa: E402
+
+from autograder import grading, release, sandbox  # noqa: E402
 from course_lib.checks import assignments  # noqa: E402
 
 ASSIGNMENTS = list(assignments.ASSIGNMENTS)

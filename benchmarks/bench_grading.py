@@ -39,6 +39,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path[:0] = [str(ROOT), str(ROOT / "tests")]  # the grader runs from the repository
 
 import zoo  # noqa: E402 (tests/zoo builds submissions from the reference solutions)
+
 from autograder import grading, packages, pipeline, release, sandbox  # noqa: E402
 from course_lib import contract  # noqa: E402
 from course_lib.checks import assignments  # noqa: E402

@@ -25,8 +25,16 @@ import sys
 import time
 from pathlib import Path
 
-from course_lib.bag_metadata import (METADATA_FILE, NO_START, BagMetadata, TopicInformation, from_dict,
-                                     metadata_yaml, offered_profiles, yaml_lines)
+from course_lib.bag_metadata import (
+    METADATA_FILE,
+    NO_START,
+    BagMetadata,
+    TopicInformation,
+    from_dict,
+    metadata_yaml,
+    offered_profiles,
+    yaml_lines,
+)
 
 #: The storage this module writes and plays (Jazzy's default); ``-s`` names it.
 STORAGE_ID = "mcap"

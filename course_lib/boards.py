@@ -14,6 +14,7 @@ import numpy as np
 from course_lib.marker_board import PICTURES, dictionary
 from course_lib.pictures import draw_cat, draw_dog
 
+
 class Board:
     """The flat board: the cat and dog pictures side by side, each framed by its four markers.
 

@@ -23,7 +23,7 @@ from course_lib import process_tree, progress, rosenv, wheelfix
 class BuildError(RuntimeError):
     """colcon build failed; ``result`` holds the whole output, the message its useful tail."""
 
-    def __init__(self, message: str, result: "BuildResult"):
+    def __init__(self, message: str, result: BuildResult):
         super().__init__(message)
         self.result = result
 

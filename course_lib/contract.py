@@ -4,7 +4,7 @@ the environment variables one sets for the other, the seeds, and the limits of t
 The grader sets these variables for the processes it starts (the notebook's kernel, the hidden
 checks, the student's nodes); the checks and course_lib read them. Nothing here is secret: the
 student's package holds this module, and the answer keys stay on the instructor's side
-(``autograder.answers``).
+(``autograder/answers/``, handed to the checks as ANSWER_KEYS_ENV).
 """
 
 from __future__ import annotations
@@ -36,6 +36,10 @@ CHECKS_SECONDS_ENV = "AUTOGRADER_CHECKS_SECONDS"
 LOAD_FACTOR_ENV = "AUTOGRADER_LOAD_FACTOR"
 #: Where a check's expected answers come from: "selfcheck", "graded" or "record" (checks.answers).
 ANSWERS_ENV = "AUTOGRADER_ANSWERS"
+#: The folder of the grader's answer keys, ``<assignment>.py`` each (a function per question), that
+#: the grader hands its graded checks and recordings (autograder.answers.environment): in a grading,
+#: its private copy, which the student's uid cannot read. Student processes never get it.
+ANSWER_KEYS_ENV = "AUTOGRADER_ANSWER_KEYS"
 #: The file the answers are written to while recording them (``python -m autograder record-answers``).
 RECORD_ANSWERS_ENV = "AUTOGRADER_RECORD_TO"
 #: The JSON report of the grader's build of the submission's workspace (autograder.packages).

@@ -256,6 +256,7 @@ def _check_round_trip(timeout: float) -> Check:
         from rclpy.context import Context
         from rclpy.executors import SingleThreadedExecutor
         from std_msgs.msg import String
+
         from course_lib import processes
     except Exception as error:
         return Check("pub/sub round trip", False, f"cannot start: {error}", SETUP_FIX)

@@ -33,7 +33,6 @@ from course_lib.discovery import _graph_node
 from course_lib.message_yaml import message_class
 from course_lib.rates import RateStatistics, rate_statistics
 
-
 # --- helpers ------------------------------------------------------------------------------
 
 def _wait_until(condition, timeout: float) -> bool:
@@ -488,8 +487,7 @@ def node_info(name: str, include_hidden: bool = False, timeout: float = 2.0) -> 
     Raises:
         ValueError: the node is not in the graph (the message lists the nodes there are).
     """
-    from rclpy.action import (get_action_client_names_and_types_by_node,
-                              get_action_server_names_and_types_by_node)
+    from rclpy.action import get_action_client_names_and_types_by_node, get_action_server_names_and_types_by_node
 
     full = name if name.startswith("/") else "/" + name
     nodes = node_list(all=include_hidden, wait_for=[full], timeout=timeout)

@@ -47,7 +47,7 @@ IMAGE_TYPES = ("sensor_msgs/msg/Image", "sensor_msgs/msg/CompressedImage")
 NUMBER_TYPES = {"boolean", "octet", "byte", "char", "float", "double", "int8", "uint8", "int16", "uint16",
                 "int32", "uint32", "int64", "uint64"}
 
-_views: dict[str, "_View"] = {}  # hidden node name -> the view that holds it
+_views: dict[str, _View] = {}  # hidden node name -> the view that holds it
 _views_lock = threading.Lock()
 
 

@@ -33,7 +33,7 @@ EXPLANATION = ("ROS log lines of the nodes this cell added (they also go to /ros
 LEVELS = {10: "DEBUG", 20: "INFO", 30: "WARN", 40: "ERROR", 50: "FATAL"}
 
 _lock = threading.Lock()
-_views: dict[str, list["_NodeLog"]] = {}  # logger name -> the views of its nodes, oldest first
+_views: dict[str, list[_NodeLog]] = {}  # logger name -> the views of its nodes, oldest first
 _subscribed_node = None  # the tool node that holds the /rosout subscription
 _subscription = None  # that subscription
 _explained = False
@@ -87,7 +87,7 @@ def expect(full_name: str, since: float) -> None:
             _add_view(logger_name(full_name), since)
 
 
-def _add_view(name: str, since: float) -> "_NodeLog":
+def _add_view(name: str, since: float) -> _NodeLog:
     view = _NodeLog(since)
     _views[name] = [v for v in _views.get(name, []) if v.since < since][-3:] + [view]
     return view

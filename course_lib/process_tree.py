@@ -15,6 +15,7 @@ Standard library only: the supervisor runs without site-packages.
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import signal
 import subprocess
@@ -141,3 +142,16 @@ def stop_group(process: subprocess.Popen, steps=STOP_STEPS) -> int | None:
         except subprocess.TimeoutExpired:
             continue
     return process.poll()
+
+
+@dataclasses.dataclass(frozen=True)
+class TreeMember:
+    """One process of a supervised process's tree (SupervisedProcess.member), with the same questions."""
+
+    pid: int
+
+    def running(self) -> bool:
+        return bool(command_line(self.pid))
+
+    def cpu_seconds(self) -> float:
+        return cpu_seconds(self.pid)

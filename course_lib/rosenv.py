@@ -281,7 +281,7 @@ class DomainReservation:
             self._handle.close()
             self._handle = None
 
-    def __enter__(self) -> "DomainReservation":
+    def __enter__(self) -> DomainReservation:
         return self
 
     def __exit__(self, *exc) -> None:

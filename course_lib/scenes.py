@@ -21,11 +21,19 @@ import cv2
 import numpy as np
 
 from course_lib.boards import Board, _paste_marker, _square, default_board
-from course_lib.camera_views import (Look, Pose, _apply_look, _check_difficulty, _in_front, _noise_tile, _project,
-                                     sample_look, sample_pose)
+from course_lib.camera_views import (
+    Look,
+    Pose,
+    _apply_look,
+    _check_difficulty,
+    _in_front,
+    _noise_tile,
+    _project,
+    sample_look,
+    sample_pose,
+)
 from course_lib.marker_board import DEFAULT_SIZE, PICTURES, _check_size, crop_corners
 from course_lib.table import _plain_table, _table
-
 
 #: A marker whose shortest side in the frame is below this many pixels is not counted as
 #: detectable. 4x4 markers have 6x6 cells; in hard scenes (blur, noise, JPEG, dark gamma) the

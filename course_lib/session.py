@@ -44,7 +44,7 @@ import sys
 import threading
 import time
 import traceback
-from typing import Callable
+from collections.abc import Callable
 
 from course_lib import node_logs, rosenv, waiting
 

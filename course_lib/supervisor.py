@@ -29,11 +29,11 @@ import time
 
 if __name__ == "__main__":  # run as a script (python -I -S): find the sibling modules by their folder
     sys.path.append(os.path.dirname(os.path.abspath(__file__)))
-    from bounded_log import BoundedLog
     import process_tree
+    from bounded_log import BoundedLog
 else:
-    from course_lib.bounded_log import BoundedLog
     from course_lib import process_tree
+    from course_lib.bounded_log import BoundedLog
 
 #: Seconds a node gets to shut down after SIGINT when its caller has gone away.
 PARENT_GONE_GRACE = 1.0

@@ -13,7 +13,6 @@ import time
 from pathlib import Path
 
 import psutil
-
 from browser_support import NOTEBOOK, JupyterLab, click_menu, click_toolbar_button
 
 # nbgrader's lab extension answers every press of Validate with a dialog of one of these classes,

@@ -14,8 +14,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import course_support  # noqa: E402
 import zoo  # noqa: E402
-from autograder import grading  # noqa: E402
 from test_autograder import ASSIGNMENTS, CATDOG_CHECK, CATDOG_MISTAKES, FULL_RUN, PUBSUB_MISTAKES  # noqa: E402
+
+from autograder import grading  # noqa: E402
 
 #: Typical mistakes that go through the whole pipeline (nbgrader, grader, feedback page), as
 #: (edits, the check it costs, a phrase of the verdict); the other typical mistakes are run through

@@ -6,7 +6,6 @@ import pytest
 
 from course_lib import colcon, pkg_create, selfcheck
 
-
 LESSON_02 = "02_images_and_brightness.ipynb"
 ANSWER_NODE = lesson_answers.brightness_node()
 SETUP_STUB = lesson_answers.lesson_file(LESSON_02, "brightness/setup.py")

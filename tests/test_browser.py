@@ -11,10 +11,23 @@ import json
 from pathlib import Path
 
 import pytest
-
-from browser_support import (LESSON_RUN_TIMEOUT, NOTEBOOK, SCREENSHOTS, assert_lesson_runs_clean, click_menu,
-                             click_toolbar_button, close_notebook, copy_lessons, course_lessons, open_notebook, run_in_lab,
-                             run_notebook, running_jupyterlab, toolbar_labels, write_notebook)
+from browser_support import (
+    LESSON_RUN_TIMEOUT,
+    NOTEBOOK,
+    SCREENSHOTS,
+    assert_lesson_runs_clean,
+    click_menu,
+    click_toolbar_button,
+    close_notebook,
+    copy_lessons,
+    course_lessons,
+    open_notebook,
+    run_in_lab,
+    run_notebook,
+    running_jupyterlab,
+    toolbar_labels,
+    write_notebook,
+)
 
 ROOT = Path(__file__).resolve().parents[1]
 NOTEBOOKS = ROOT / "notebooks"

@@ -6,9 +6,13 @@ run on two workers at once (browser_support.SECOND_LAB_LESSONS says which lesson
 """
 
 import pytest
-
-from browser_support import (LESSON_RUN_TIMEOUT, assert_lesson_runs_clean, copy_lessons, course_lessons,
-                             running_jupyterlab)
+from browser_support import (
+    LESSON_RUN_TIMEOUT,
+    assert_lesson_runs_clean,
+    copy_lessons,
+    course_lessons,
+    running_jupyterlab,
+)
 
 pytestmark = pytest.mark.browser
 

@@ -8,9 +8,15 @@ the widget's picture. Screenshots go to artifacts/browser/live_image_view-<n>.pn
 from pathlib import Path
 
 import pytest
-
-from browser_support import (NOTEBOOK, close_notebook, code_cell_count, open_notebook, run_notebook, running_jupyterlab,
-                             write_notebook)
+from browser_support import (
+    NOTEBOOK,
+    close_notebook,
+    code_cell_count,
+    open_notebook,
+    run_notebook,
+    running_jupyterlab,
+    write_notebook,
+)
 
 SCREENSHOTS = Path(__file__).resolve().parents[1] / "artifacts" / "browser"
 CAMERA_SIZE = (320, 240)
@@ -19,9 +25,10 @@ pytestmark = pytest.mark.browser
 
 LIVE_NOTEBOOK = [
     "from course_lib import live, processes\n"
-    "camera = processes.python_node('course_lib.camera:main', '--ros-args', '-p', 'width:=%d', '-p', 'height:=%d',\n"
+    f"camera = processes.python_node('course_lib.camera:main', '--ros-args', '-p', 'width:={CAMERA_SIZE[0]}', "
+    f"'-p', 'height:={CAMERA_SIZE[1]}',\n"
     "                               '-p', 'rate:=10.0', name='camera')\n"
-    "camera.wait_for_node('image_publisher', timeout=60)" % CAMERA_SIZE,
+    "camera.wait_for_node('image_publisher', timeout=60)",
     # Explicit bounds: under test a view would stop after live.LIMITED_UPDATES redraws.
     "view = live.image_view('/image', updates=3000, seconds=300)\nview",
 ]

@@ -18,9 +18,15 @@ import sys
 from pathlib import Path
 
 import pytest
-
-from browser_nbgrader import (assignment_lists, chosen_course, kernel_processes, kernels_left, open_assignment_list,
-                              validate, wait_for_assignment)
+from browser_nbgrader import (
+    assignment_lists,
+    chosen_course,
+    kernel_processes,
+    kernels_left,
+    open_assignment_list,
+    validate,
+    wait_for_assignment,
+)
 from browser_support import close_notebook, open_notebook, running_jupyterlab
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))

@@ -1,8 +1,13 @@
 """The brightness node check's throughput verdict (course_lib.checks.brightness.throughput_verdict):
 processor time per frame against the yardstick's, never answers per second."""
 
-from course_lib.checks.brightness import (THROUGHPUT_CPU_RATIO, THROUGHPUT_MIN_ANSWERS,
-                                          THROUGHPUT_MIN_EVIDENCE_CPU, CpuCost, throughput_verdict)
+from course_lib.checks.brightness import (
+    THROUGHPUT_CPU_RATIO,
+    THROUGHPUT_MIN_ANSWERS,
+    THROUGHPUT_MIN_EVIDENCE_CPU,
+    CpuCost,
+    throughput_verdict,
+)
 
 
 def cost(seconds: float, frames: int) -> CpuCost:

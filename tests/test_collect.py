@@ -6,10 +6,10 @@ from __future__ import annotations
 import datetime
 import zipfile
 
+import course_support
 import pytest
 from traitlets.config import Config
 
-import course_support
 from autograder import collect, roster
 
 

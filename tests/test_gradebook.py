@@ -84,7 +84,7 @@ def test_late_submission_gets_the_configured_penalty(course):
         submission = gb.find_submission("hw", "alice")
         assert submission.timestamp == datetime.datetime(2025, 3, 15, 10, 0)
         assert submission.late_submission_penalty == pytest.approx(2.25)
-    assert gradebook.lateness(course, "alice", "hw")["score"] == pytest.approx(2.25)
+    assert gradebook.submission_scores(course, "alice", "hw")["score"] == pytest.approx(2.25)
 
 
 def test_regrade_keeps_manual_scores_and_recomputes_the_penalty(course):
@@ -156,3 +156,21 @@ def test_a_new_gradebook_is_stamped_with_the_revision_alembic_heads_names(tmp_pa
         stamped = connection.execute(text("SELECT version_num FROM alembic_version")).scalar_one()
     engine.dispose()
     assert stamped == heads.split()[0] == gradebook.schema_head()
+
+
+def test_the_feedback_page_reads_every_score_from_the_gradebook(course):
+    """The feedback index reads the record grades.csv is made from: a manual score given in the
+    formgrader shows in its check's line and in the total, not the grader's earlier score."""
+    from autograder import feedback
+    from autograder.result import GradeResult
+
+    _record(course)
+    with gradebook.open_gradebook(course) as gb:
+        gb.find_grade("check_a", "hw", "hw", "alice").manual_score = 4.0
+        gb.db.commit()
+    graded = GradeResult("alice", "hw", "digest", score=4.5, max_score=6,
+                         cells=[{"notebook": "hw", "cell": name, "auto_score": SCORES["hw", name], "max_score": 4}
+                                for name in ("check_a", "check_b")])
+    page = feedback._write_index(course, "alice", [graded]).read_text()
+    assert "check_a: 4 / 4" in page and "check_b: 1.5 / 2" in page
+    assert "3.25 / 6" in page and "5.5 points − late penalty 2.25" in page

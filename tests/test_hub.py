@@ -27,10 +27,10 @@ import pytest
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import zoo  # noqa: E402
-from zoo.brightness import SUM  # noqa: E402
-from browser_support import CHROMIUM_ARGS, VIEWPORT, ChromiumUnavailable, click_menu, find_chromium  # noqa: E402
 from browser_nbgrader import wait_for_assignment  # noqa: E402
+from browser_support import CHROMIUM_ARGS, VIEWPORT, ChromiumUnavailable, click_menu, find_chromium  # noqa: E402
 from hub_support import course_processes, log_in, run_in_kernel, running_hub, why_no_hub  # noqa: E402
+from zoo.brightness import SUM  # noqa: E402
 
 pytestmark = [pytest.mark.hub, pytest.mark.browser, pytest.mark.slow, pytest.mark.timeout(600),
               pytest.mark.skipif(why_no_hub() is not None, reason=str(why_no_hub()))]

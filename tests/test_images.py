@@ -9,8 +9,16 @@ import pytest
 import sensor_msgs.msg._image as generated_image_module
 from sensor_msgs.msg import CompressedImage, Image
 
-from course_lib.images import (ENCODINGS, compressed_to_image, convert_encoding, image_to_compressed,
-                               image_to_msg, msg_to_image, parse_compressed_format, to_bgr)
+from course_lib.images import (
+    ENCODINGS,
+    compressed_to_image,
+    convert_encoding,
+    image_to_compressed,
+    image_to_msg,
+    msg_to_image,
+    parse_compressed_format,
+    to_bgr,
+)
 
 
 def random_image(encoding, height=5, width=7, seed=0):

@@ -20,10 +20,10 @@ from pathlib import Path
 
 import psutil
 import pytest
-
-from course_lib import colcon, graph, launch, pkg_create, rosenv, rqt_graph, session, workspace
 from launch_demo import CHATTER_NODE, CHATTER_SOURCE, make_prefix
 from process_support import in_background_of_a_script
+
+from course_lib import colcon, graph, launch, pkg_create, rosenv, rqt_graph, session, workspace
 
 EVERY_TAG = """\
 <launch>

@@ -9,10 +9,10 @@ test_launch.py starts such processes for real.
 import re
 
 import pytest
+from launch_demo import BOTH, write
 
 from course_lib.launch.actions import run_launch_file
 from course_lib.launch.entities import LaunchFileError
-from launch_demo import BOTH, write
 
 pytestmark = pytest.mark.usefixtures("launch_files_in_tmp_path")
 

@@ -5,7 +5,6 @@ import pytest
 
 from course_lib import selfcheck
 
-
 LAUNCH_NODE = """\
 - node:
     pkg: image_stats

@@ -8,10 +8,10 @@ parameter files it passes (--params-file) are read back, as the node would read 
 import os
 
 import pytest
+from launch_demo import BOTH, params_of, write
 
 from course_lib.launch.actions import run_launch_file
 from course_lib.launch.entities import LaunchFileError
-from launch_demo import BOTH, params_of, write
 
 pytestmark = pytest.mark.usefixtures("launch_files_in_tmp_path")
 

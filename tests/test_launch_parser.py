@@ -11,12 +11,12 @@ import re
 import textwrap
 
 import pytest
+from launch_demo import BOTH, write
 
 from course_lib.launch import cli, substitutions
 from course_lib.launch.actions import run_launch_file
 from course_lib.launch.entities import LaunchFileError
 from course_lib.launch.parser import split_command_line
-from launch_demo import BOTH, write
 
 pytestmark = pytest.mark.usefixtures("launch_files_in_tmp_path")
 

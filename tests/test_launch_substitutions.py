@@ -115,8 +115,9 @@ def test_a_value_that_is_no_boolean_fails_in_launch_s_words(text):
 @pytest.mark.parametrize("form", ["xml", "yaml"])
 def test_boolean_substitutions_in_let_as_launch_xml_and_launch_yaml_test_them(tmp_path, form):
     """launch_xml's and launch_yaml's test_boolean_substitution.py: the same <let> values."""
-    from course_lib.launch.actions import run_launch_file
     from launch_demo import write
+
+    from course_lib.launch.actions import run_launch_file
 
     names = [("not_true", "$(not $(var true_value))"), ("not_false", "$(not $(var false_value))")] + [
         (f"{kind}_{a}_{b}", f"$({kind} $(var {a}_value) $(var {b}_value))")

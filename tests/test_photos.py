@@ -13,9 +13,9 @@ the failure). benchmarks/bench_photos.py measures larger sets.
 import cv2
 import numpy as np
 import pytest
+from photo_support import photo_scenes, recovery, reference_crop
 
 from course_lib import marker_board, photos
-from photo_support import photo_scenes, recovery, reference_crop
 
 crop = reference_crop()
 

@@ -15,7 +15,6 @@ from process_support import marker, processes_with, sleeper, wait_until
 from course_lib import processes
 from course_lib.processes import Limits, NodeProcess, python_node
 
-
 TALKER = '''
 import rclpy
 from rclpy.executors import ExternalShutdownException

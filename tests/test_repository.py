@@ -1,5 +1,7 @@
-"""Repository hygiene: notebooks are committed clean, build products are never committed."""
+"""Repository hygiene: notebooks are committed clean, build products are never committed, and the
+course's packages import each other without cycles."""
 
+import ast
 import json
 import subprocess
 from pathlib import Path
@@ -35,3 +37,64 @@ def test_no_environment_or_colcon_output_is_committed():
 def test_ci_runs_the_readme_test_command():
     assert "make test" in (ROOT / ".ci" / "run").read_text()
     assert "make test" in (ROOT / "README.md").read_text()
+
+
+# --- the course's packages depend on each other in one direction --------------------------------
+
+PACKAGES = ("course_lib", "autograder", "coursehub")
+
+
+def module_imports() -> dict[str, set[str]]:
+    """{module: the course modules it imports}, at the top or inside a function alike; ``from
+    course_lib import X`` is an import of course_lib.X when that is a module."""
+    files = {}
+    for package in PACKAGES:
+        for path in (ROOT / package).rglob("*.py"):
+            parts = path.relative_to(ROOT).with_suffix("").parts
+            files[".".join(parts[:-1] if parts[-1] == "__init__" else parts)] = path
+    graph = {}
+    for name, path in files.items():
+        here = name.split(".") if path.name == "__init__.py" else name.split(".")[:-1]
+        found = set()
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.Import):
+                found |= {alias.name for alias in node.names}
+            elif isinstance(node, ast.ImportFrom):
+                base = node.module or ""
+                if node.level:
+                    base = ".".join(here[:len(here) - node.level + 1] + ([node.module] if node.module else []))
+                found |= {f"{base}.{alias.name}" if f"{base}.{alias.name}" in files else base for alias in node.names}
+        graph[name] = {module for module in found if module in files and module != name}
+    return graph
+
+
+def import_cycle(graph: dict[str, set[str]]) -> list[str] | None:
+    """One cycle of the graph (its modules in order, the first again at the end), or None."""
+    state, path = {}, []
+
+    def visit(module):
+        state[module] = "open"
+        path.append(module)
+        for imported in sorted(graph[module]):
+            if state.get(imported) == "open":
+                return path[path.index(imported):] + [imported]
+            if imported not in state and (cycle := visit(imported)):
+                return cycle
+        state[module] = "done"
+        path.pop()
+        return None
+
+    return next((cycle for module in sorted(graph) if module not in state and (cycle := visit(module))), None)
+
+
+def test_the_finder_finds_a_cycle():
+    assert import_cycle({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}) == ["a", "b", "c", "a"]
+    assert import_cycle({"a": {"b"}, "b": set()}) is None
+
+
+def test_no_import_cycles():
+    """No module of course_lib, autograder or coursehub imports, through others, itself: each
+    part can be read, tested and moved on its own (a parser registers with the actions instead)."""
+    graph = module_imports()
+    assert "course_lib.contract" in graph["course_lib.checks.answers"]
+    assert import_cycle(graph) is None, " -> ".join(import_cycle(graph))

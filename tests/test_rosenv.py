@@ -58,8 +58,8 @@ def test_out_of_range_domain_ids_are_refused_with_the_range(bad):
 
 def test_reservations_are_exclusive_across_processes():
     with rosenv.reserve_domain_id() as mine:
-        code = ("from course_lib import rosenv; r = rosenv.reserve_domain_id(range(%d, %d)); print(r.domain_id)"
-                % (mine.domain_id, mine.domain_id + 1))
+        code = (f"from course_lib import rosenv; r = rosenv.reserve_domain_id(range({mine.domain_id}, "
+                f"{mine.domain_id + 1})); print(r.domain_id)")
         other = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
         assert other.returncode != 0 and "reserved by other processes" in other.stderr
     # Released: now another process can take it.

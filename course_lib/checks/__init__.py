@@ -6,7 +6,8 @@
   ``context`` (what a check gets), ``student_server``/``student_calls``/``student_processes`` (the
   student's code in another process, one per module serving many calls), ``probe`` (the checker's ROS node), ``result`` (the verdict).
 - ``answers``: where a check's expected answers come from: the grader's answer key when graded
-  (instructor side, ``autograder.answers``), answers recorded from it in a self-check.
+  (instructor side: the folder the grader hands over, contract.ANSWER_KEYS_ENV), answers
+  recorded from it in a self-check.
 - ``student``: runs the student's code for a check; ``validate``: the cell timeouts of Validate.
 
 No reference solution and no answer key is in this package: students have it.

@@ -4,8 +4,10 @@ A check asks ``ctx.expected("average_brightness", image)``. Where the answer com
 how the check runs (contract.ANSWERS_ENV, set by runner.execute):
 
 - ``graded`` (the grader, fresh seeds): the grader's answer key, the function of that name in
-  ``autograder.answers.<assignment>``. It lives only on the instructor's side: students'
-  environments never hold it, and the grader's sandbox hides it from the student's processes.
+  ``<assignment>.py`` of the folder the grader hands the checks (contract.ANSWER_KEYS_ENV: its
+  own private copy of ``autograder/answers/``). The key lives only on the instructor's side:
+  students' environments never hold it, the student's processes never get the variable, and the
+  grader's sandbox hides the folder from them. course_lib never imports the grader.
 - ``selfcheck`` (the student's notebook, the fixed self-check seed): the answers the key gave for
   exactly those inputs, recorded as data in ``course_lib/checks/recorded/<assignment>.json``.
   A self-check and a graded run of the same input therefore compare with the same number.
@@ -19,9 +21,9 @@ which a check asks does not matter.
 from __future__ import annotations
 
 import hashlib
-import importlib
 import json
 import os
+import runpy
 from pathlib import Path
 
 from course_lib import contract
@@ -58,29 +60,31 @@ class AnswerKey:
         self.mode = mode or os.environ.get(contract.ANSWERS_ENV, "selfcheck")
         if self.mode not in MODES:
             raise ValueError(f"{contract.ANSWERS_ENV}={self.mode!r}: expected one of {', '.join(MODES)}")
-        self._oracle = None
+        self._key: dict | None = None
         self._recorded: dict | None = None
 
     def expected(self, question: str, *args):
         """The right answer of `question` (a function name of the contract) for these arguments."""
         if self.mode == "selfcheck":
             return self._lookup(question, input_key(*args))
-        answer = getattr(self._key_module(), question)(*args)
+        answer = self._answer_key()[question](*args)
         if self.mode == "record":
             with open(os.environ[contract.RECORD_ANSWERS_ENV], "a") as handle:
                 handle.write(json.dumps({"assignment": self.assignment, "question": question,
                                          "key": input_key(*args), "answer": answer}) + "\n")
         return answer
 
-    def _key_module(self):
-        if self._oracle is None:
-            try:
-                self._oracle = importlib.import_module(f"autograder.answers.{self.assignment}")
-            except ImportError as error:
-                raise RuntimeError(f"The grader's answer key (autograder.answers.{self.assignment}) is not "
-                                   f"importable here ({error}): graded checks run on the instructor's side, "
-                                   "from the course repository") from None
-        return self._oracle
+    def _answer_key(self) -> dict:
+        """The functions of the assignment's answer key, from the folder the grader handed over."""
+        if self._key is None:
+            folder = os.environ.get(contract.ANSWER_KEYS_ENV)
+            path = Path(folder or ".") / f"{self.assignment}.py"
+            if not folder or not path.is_file():
+                raise RuntimeError(f"The grader's answer key of {self.assignment} is not here "
+                                   f"({contract.ANSWER_KEYS_ENV}={folder or ''}): graded checks run on the "
+                                   "instructor's side, where the grader hands them its autograder/answers/")
+            self._key = runpy.run_path(str(path))
+        return self._key
 
     def _lookup(self, question: str, key: str):
         if self._recorded is None:

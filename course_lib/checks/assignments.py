@@ -4,8 +4,10 @@ the grader and the tests read about an assignment.
 An assignment is a colcon workspace beside its notebook (``ros2_ws/src/<package>/``). Its spec says
 which packages the student writes and the executables each installs (what ``ros2 run`` offers),
 which module holds the plain functions the checks call without a build, and where the expected
-answers of its checks come from. Its checks and their points are in
-``course_lib/checks/<name>.py``; its reference packages in ``assignments/reference_ws/src/``.
+answers of its checks come from, and the words of its notebook that are its own (assignments/build.py
+writes the rest: the packages' cells, the imports, a test cell per check). Its checks and their
+points are in ``course_lib/checks/<name>.py``; its reference packages in
+``assignments/reference_ws/src/``.
 """
 
 from __future__ import annotations
@@ -14,6 +16,28 @@ import dataclasses
 
 #: The workspace folder beside an assignment's notebook.
 WORKSPACE = "ros2_ws"
+
+
+@dataclasses.dataclass(frozen=True)
+class NotebookText:
+    """The words of an assignment's notebook that are its own.
+
+    Attributes:
+        intro: the first cell (markdown): the assignment and its contract, what is graded.
+        plain_ros: how its packages come about in plain ROS 2 (ends the packages' introduction).
+        checks: each check -> its heading (after "Check N: ") and, optionally, markdown under it.
+        imports: more lines of the setup cell.
+        names: what the notebook imports from the module of the plain functions (Assignment.functions).
+        try_text, try_code: the cell the student tries the functions in, and the line before it.
+    """
+
+    intro: str
+    plain_ros: str
+    checks: dict[str, tuple[str, ...]]
+    imports: str = ""
+    names: str = ""
+    try_text: str = ""
+    try_code: str = ""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -28,10 +52,12 @@ class Assignment:
         answers: where the checks' expected answers come from: "key" (the grader's answer key,
             autograder/answers/<name>.py, recorded for self-checks in checks/recorded/<name>.json)
             or "scene" (the ground truth of the scenes the checks draw).
+        notebook: the words of its notebook that are its own.
     """
 
     name: str
     packages: dict[str, tuple[str, ...]]
+    notebook: NotebookText
     functions: tuple[str, str] | None = None
     answers: str = "scene"
 
@@ -39,13 +65,132 @@ class Assignment:
         return self.packages[package]
 
 
+# --- the notebooks' introductions (markdown) ----------------------------------------------------
+
+PUBSUB_INTRO = """
+# Assignment: publisher and subscriber
+
+Two nodes that talk over a topic with the lecture's own message, `MsgTutorial`, as in Lesson 01b:
+a message package and a package of nodes that depends on it.
+
+**Contract** (this is exactly what is graded):
+
+1. The interface package **`tutorial_interfaces`** (`ament_cmake`) with `msg/MsgTutorial.msg`:
+   `builtin_interfaces/Time stamp` and `int32 data`.
+2. The package **`pubsub`** (`ament_python`, depending on `rclpy` and `tutorial_interfaces`) with two
+   executables:
+   - **`topic_publisher`** (`pubsub/topic_publisher.py`, class `TopicPublisher`, node
+     **`topic_publisher`**): publishes `MsgTutorial` on **`ros_tutorial_msg`** with a queue depth of
+     **100**, at **10 Hz** (a 0.1 s timer); `stamp` is the time of publishing, `data` a counter that
+     starts at 0 and grows by one per message.
+   - **`topic_subscriber`** (`pubsub/topic_subscriber.py`, class `TopicSubscriber`, node
+     **`topic_subscriber`**): subscribes `ros_tutorial_msg` with a queue depth of 100 and logs each
+     field of every message: `I heard: stamp <sec>.<nanosec> data <data>`.
+
+The grader builds your workspace, starts your executables as `ros2 run pubsub topic_publisher` and
+`ros2 run pubsub topic_subscriber` in separate processes, listens to your publisher, talks to your
+subscriber (reading its log), and runs both together.
+"""
+
+BRIGHTNESS_INTRO = """
+# Assignment: image brightness
+
+You write a small vision node in two layers, as in the lecture: a plain numpy function that does
+the work, and a ROS 2 node that only converts messages and calls it, in an `ament_python` package.
+
+**Contract** (this is exactly what is graded):
+
+1. The package **`brightness`** in `ros2_ws/src/brightness`, with the executable
+   **`brightness_node`** (`ros2 run brightness brightness_node`), whose `package.xml` declares every
+   ROS package its code imports (`rclpy`, `sensor_msgs`, `std_msgs`).
+2. In `brightness/brightness_node.py`: `average_brightness(image: np.ndarray) -> int`, the mean of
+   *all* bytes of the image (every channel of every pixel), rounded **down** as the tutorial's integer
+   division `sum // count`, returned as a Python `int`. It works for colour `(H, W, 3)` and grey
+   `(H, W)` images.
+3. `BrightnessNode()`: a node named **`brightness_node`** (the name lesson 02 gives it) that subscribes **`/image`**
+   (`sensor_msgs/msg/Image`) and publishes **`/brightness`** (`std_msgs/msg/UInt8`), both with the
+   **sensor-data QoS** (`qos_profile_sensor_data`), one value per frame. It accepts `bgr8` and
+   `mono8` frames, keeps up with 1920×1080 frames at 30 Hz, and its names can be remapped
+   (`--ros-args -r __node:=other -r /image:=/camera/image`). `main(args=None)` runs it until Ctrl-C
+   (the executable calls it).
+
+The grader builds your workspace, runs `ros2 run brightness brightness_node` in a separate process,
+publishes generated frames and compares what comes back with the right answer. Each check cell prints
+what is right and what is wrong; at grading the same checks run again with frames you have not seen.
+"""
+
+BRIGHTNESS_NODE_CHECK = """The check starts your node as `ros2 run brightness brightness_node` (build first) in a ROS domain of
+its own, publishes frames on `/image` and reads `/brightness`. A Python loop over every byte is too
+slow for 30 frames of 1920×1080 per second: let numpy do the sum.
+"""
+
+CATDOG_WARP_INTRO = """
+# Assignment: cat and dog, warped upright
+
+A camera looks at the course's marker board: a cat picture framed by ArUco markers 1-4 and a dog
+picture framed by markers 5-8 (dictionary `DICT_4X4_50`), in the order top-left, top-right,
+bottom-right, bottom-left. Each marker touches its picture with one corner: marker 1 with its
+corner 2, marker 2 with corner 3, marker 3 with corner 0, marker 4 with corner 1
+(`course_lib.marker_board.PICTURES` and `CORNER_OF_MARKER`; OpenCV numbers a marker's corners
+clockwise from its top-left).
+
+**Contract** (this is exactly what is graded). Your workspace `ros2_ws/src` holds three packages:
+
+1. **`catdog_interfaces`**: the message `msg/CroppedPicture.msg` with `int32 picture` (constants
+   `CAT=1`, `DOG=2`) and `sensor_msgs/CompressedImage image`.
+2. **`webcam`**: the executable **`image_publisher`** (given: the course's simulated board, a video
+   file or a real camera on `image`).
+3. **`readmarker`**:
+   - `readmarker/crop.py`: `crop_pictures(frame_bgr, size=(320, 240)) -> dict`, `{"cat": crop,
+     "dog": crop}` with a key **only when all four markers** of that picture are found; each crop is
+     a BGR `uint8` image of `size` = (width, height), upright and not mirrored (the picture's
+     top-left corner at pixel (0, 0));
+   - `readmarker/marker_reader.py`: the node **`marker_reader`** (executable `marker_reader`);
+     subscribes **`image`** (`sensor_msgs/msg/Image`) and for every frame publishes each crop it
+     finds on **`cropped_img`** as a `CroppedPicture` (`picture` 1 for the cat, 2 for the dog; the
+     crop as a PNG, `images.image_to_compressed(crop, "png")`);
+   - `launch/catdog_warp.launch.xml`, starting `image_publisher` and `marker_reader`
+     (`ros2 launch readmarker catdog_warp.launch.xml`); `package.xml` declares every ROS package the
+     code imports.
+
+The grader renders scenes (`course_lib.scenes.render_scene`) with poses and lighting you have not
+seen, and compares your crops with the true ones (`marker_board.crop_similarity`, passing at
+`marker_board.SAME_CROP_THRESHOLD`). Try your function on `scenes.render_scene(seed).frame`.
+"""
+
+
 #: Every graded assignment, in the order the course teaches them.
 ASSIGNMENTS: dict[str, Assignment] = {spec.name: spec for spec in (
-    Assignment("pubsub", {"tutorial_interfaces": (), "pubsub": ("topic_publisher", "topic_subscriber")}),
+    Assignment("pubsub", {"tutorial_interfaces": (), "pubsub": ("topic_publisher", "topic_subscriber")},
+               NotebookText(intro=PUBSUB_INTRO, plain_ros=(
+                   "In plain ROS 2: `ros2 pkg create --build-type ament_cmake tutorial_interfaces` and "
+                   "`ros2 pkg create --build-type ament_python --dependencies rclpy tutorial_interfaces "
+                   "--node-name topic_publisher pubsub`, then the edits of Lesson 01b."),
+                   checks={"publisher": ("the publisher",), "subscriber": ("the subscriber",),
+                           "together": ("both together",)})),
     Assignment("brightness", {"brightness": ("brightness_node",)},
+               NotebookText(intro=BRIGHTNESS_INTRO, plain_ros=(
+                   "In plain ROS 2 the package comes from `ros2 pkg create --build-type "
+                   "ament_python --dependencies rclpy sensor_msgs std_msgs --node-name brightness_node brightness`."),
+                   checks={"values": ("`average_brightness`",), "node": ("`BrightnessNode`", BRIGHTNESS_NODE_CHECK)},
+                   names="average_brightness, BrightnessNode",
+                   try_text="Try your function (this cell is yours to change):", try_code="""
+grey = np.array([[0, 255], [255, 255]], dtype=np.uint8)
+print(average_brightness(grey))   # (0 + 255 + 255 + 255) // 4 = 191
+"""),
                functions=("brightness", "brightness.brightness_node"), answers="key"),
     Assignment("catdog_warp", {"catdog_interfaces": (), "webcam": ("image_publisher",),
                                "readmarker": ("marker_reader",)},
+               NotebookText(intro=CATDOG_WARP_INTRO, plain_ros=(
+                   "In plain ROS 2 the packages come from `ros2 pkg create` (`--build-type ament_cmake` for "
+                   "`catdog_interfaces`, `ament_python` for the others)."),
+                   checks={"easy": ("easy views",), "hard": ("hard views",), "missing_and_none": ("missing markers",),
+                           "noisy": ("noise, blur, another size",), "node": ("the node",)},
+                   imports="from course_lib import marker_board, scenes\n", names="crop_pictures",
+                   try_text="Try it on a generated scene (this cell is yours to change):", try_code="""
+scene = scenes.render_scene(1)
+print(sorted(crop_pictures(scene.frame)))   # ['cat', 'dog']
+"""),
                functions=("readmarker", "readmarker.crop")),
 )}
 

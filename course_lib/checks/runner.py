@@ -22,7 +22,8 @@ grading draws a fresh seed per check (or takes AUTOGRADER_SEED to reproduce a gr
 the verdict prints it, so that the feedback records it.
 
 Expected answers (:meth:`Context.expected`, course_lib.checks.answers): graded, from the grader's
-answer key (``autograder.answers``, instructor side only); in a self-check, the answers that key
+answer key (instructor side only: the grader hands its checks ``autograder/answers/`` as
+contract.ANSWER_KEYS_ENV); in a self-check, the answers that key
 gave for the self-check's inputs, recorded as data. Nothing a student can import or read holds
 a reference solution, and nothing the student's process can read holds a graded answer.
 

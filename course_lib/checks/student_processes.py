@@ -23,7 +23,8 @@ def student_env() -> dict:
     # Fast DDS's set-up for camera frames comes, as for every course process, from
     # course_lib.rosenv.ros_environment (its shared-memory segments need RLIMIT_FSIZE above 32 MB).
     return {"PYTHONPATH": child_pythonpath(), contract.SEED_ENV: None, contract.CHECK_SEED_ENV: None,
-            contract.ANSWERS_ENV: None, contract.RECORD_ANSWERS_ENV: None, "PYTHONDONTWRITEBYTECODE": "1", **MALLOC_ENV}
+            contract.ANSWERS_ENV: None, contract.ANSWER_KEYS_ENV: None, contract.RECORD_ANSWERS_ENV: None,
+            "PYTHONDONTWRITEBYTECODE": "1", **MALLOC_ENV}
 
 
 #: glibc's allocator, fixed: blocks below 32 MB come from the heap, which keeps 128 MB before it

@@ -30,6 +30,9 @@ processes to start; parameters.py types and writes a node's parameters), runner.
 stops the processes, cli.py is ``ros2 launch``.
 """
 
+# The parser registers its reading of launch files with actions (actions.reads_launch_files);
+# cli imports it too, but a user of actions alone relies on this import.
+from course_lib.launch import parser  # noqa: F401
 from course_lib.launch.cli import main
 from course_lib.launch.entities import LaunchFileError
 from course_lib.launch.runner import Launch, start, stop_all

@@ -24,6 +24,24 @@ from course_lib.launch.entities import LaunchFileError
 #: A name token of ROS names (node names, namespace parts).
 NAME_TOKEN = re.compile(r"[A-Za-z_][A-Za-z0-9_]*$")
 
+#: The function that reads a launch file into its actions (``<include>`` runs another file). The
+#: parser builds these actions, so this module does not import it: parser.py registers its
+#: load_description here (reads_launch_files) when it is imported, which course_lib.launch does.
+#: ros2/launch breaks the same cycle the other way round: actions register with the parser.
+_loader = None
+
+
+def reads_launch_files(load):
+    """Register `load(path) -> [actions]`, the parser's reading of a launch file; return it."""
+    global _loader
+    _loader = load
+    return load
+
+
+def load_description(path: Path) -> list:
+    """The actions of a launch file, read by the registered parser (see reads_launch_files)."""
+    return _loader(path)
+
 
 class LaunchContext:
     """The state a launch file runs in.
@@ -216,8 +234,6 @@ class IncludeLaunchDescription(Action):
     from_command_line: bool = False
 
     def execute(self, context: LaunchContext) -> None:
-        from course_lib.launch.parser import load_description  # the parser builds these actions
-
         path = Path(os.path.abspath(substitutions.perform(self.path, context)))
         actions = load_description(path)
         given = [substitutions.perform(name, context) for name, _ in self.arguments]
@@ -317,8 +333,6 @@ def declared_arguments(actions: list, context: LaunchContext | None, file: Path,
             elif isinstance(action, Group):
                 visit(action.actions, current_file, passed, conditional or action.condition is not None)
             elif isinstance(action, IncludeLaunchDescription):
-                from course_lib.launch.parser import load_description
-
                 probe = LaunchContext(current_file=current_file,
                                       environment=None if context is None else context.environment)
                 try:

@@ -104,7 +104,7 @@ class Entity:
             return value.strip().lower() in ("true", "1")
         raise self.error(f"<{self.kind}> attribute '{name}' must be true or false, not {value!r}", name)
 
-    def nested(self, kind: str) -> list["Entity"]:
+    def nested(self, kind: str) -> list[Entity]:
         """The nested tags of one kind: XML child elements ``<kind .../>``, or YAML's list under
         the key ``kind`` (``param: [{name: ..., value: ...}, ...]``)."""
         if not self.typed:
@@ -119,7 +119,7 @@ class Entity:
         line = self._attribute_lines.get(kind, self.line)
         return [_yaml_entity(kind, item, self.file, line) for item in value]
 
-    def children(self) -> list["Entity"]:
+    def children(self) -> list[Entity]:
         """The nested action tags of <launch> or <group>, in order."""
         if not self.typed:
             self._read.update(f"<{child.kind}>" for child in self._nested or [])

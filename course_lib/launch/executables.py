@@ -19,7 +19,13 @@ from pathlib import Path
 
 from course_lib.launch import parameters, substitutions
 from course_lib.launch.actions import (
-    NAME_TOKEN, Action, LaunchContext, absolute_namespace, namespace_problem, prefix_namespace)
+    NAME_TOKEN,
+    Action,
+    LaunchContext,
+    absolute_namespace,
+    namespace_problem,
+    prefix_namespace,
+)
 
 #: The outputs a process may have here (launch also has own_log and per-stream forms).
 OUTPUTS = ("screen", "log", "both")

@@ -12,7 +12,14 @@ from pathlib import Path
 
 from course_lib.launch import entities, parameters, substitutions
 from course_lib.launch.actions import (
-    DeclareArgument, Group, IncludeLaunchDescription, PushRosNamespace, SetEnvironmentVariable, SetLaunchConfiguration)
+    DeclareArgument,
+    Group,
+    IncludeLaunchDescription,
+    PushRosNamespace,
+    SetEnvironmentVariable,
+    SetLaunchConfiguration,
+    reads_launch_files,
+)
 from course_lib.launch.entities import Entity, did_you_mean
 from course_lib.launch.executables import ExecuteProcess, Node
 
@@ -48,8 +55,9 @@ KNOWN = {
 }
 
 
+@reads_launch_files
 def load_description(path) -> list:
-    """The actions of a launch file (XML or YAML).
+    """The actions of a launch file (XML or YAML); what ``<include>`` reads (actions.load_description).
 
     Raises:
         LaunchFileError: the file cannot be read, or uses what is not supported (with its line).

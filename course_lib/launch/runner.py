@@ -29,13 +29,13 @@ import socket
 import threading
 import time
 from collections import deque
+from collections.abc import Callable
 from pathlib import Path
-from typing import Callable
 
 from course_lib import processes
 from course_lib.launch.actions import LaunchContext, run_launch_file
-from course_lib.launch.executables import ProcessToStart
 from course_lib.launch.entities import LaunchFileError
+from course_lib.launch.executables import ProcessToStart
 
 #: How a launch stops a process that still runs, as ros2/launch's ExecuteLocal does: SIGINT, then
 #: SIGTERM after ``sigterm_timeout`` seconds, then SIGKILL after ``sigkill_timeout`` seconds more.
@@ -191,7 +191,7 @@ class Launch:
             self.warning(logger, message)
         return self._to_start
 
-    def start(self) -> "Launch":
+    def start(self) -> Launch:
         """Start every process (prepare() first if it was not called) and return self."""
         if self._context is None:
             self.prepare()
@@ -332,7 +332,7 @@ class Launch:
                     self.info(name, f"sending signal '{sent}' to process[{name}]")
                 process.send_signal(getattr(signal, sent))
 
-    def __enter__(self) -> "Launch":
+    def __enter__(self) -> Launch:
         return self
 
     def __exit__(self, *exc) -> None:

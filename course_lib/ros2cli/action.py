@@ -2,8 +2,16 @@
 
 from __future__ import annotations
 
-from course_lib.ros2cli.common import (DEFAULT_SPIN_TIME, Verb, print_names, print_types, run_group, wait_for_name,
-                                       wait_for_whole_graph, wait_until)
+from course_lib.ros2cli.common import (
+    DEFAULT_SPIN_TIME,
+    Verb,
+    print_names,
+    print_types,
+    run_group,
+    wait_for_name,
+    wait_for_whole_graph,
+    wait_until,
+)
 
 #: ros2action's words for the states of action_msgs/msg/GoalStatus.
 STATUS_WORDS = {1: "ACCEPTED", 2: "EXECUTING", 3: "CANCELING", 4: "SUCCEEDED", 5: "CANCELED", 6: "ABORTED"}
@@ -53,8 +61,7 @@ def _info_arguments(parser) -> None:
 
 
 def _info(args) -> str | None:
-    from rclpy.action import (get_action_client_names_and_types_by_node,
-                              get_action_server_names_and_types_by_node)
+    from rclpy.action import get_action_client_names_and_types_by_node, get_action_server_names_and_types_by_node
     from rclpy.exceptions import InvalidTopicNameException
 
     from course_lib import session

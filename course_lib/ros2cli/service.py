@@ -4,8 +4,17 @@ from __future__ import annotations
 
 import time
 
-from course_lib.ros2cli.common import (DEFAULT_SPIN_TIME, Verb, add_discovery_arguments, print_names, print_types,
-                                       run_group, wait_for_name, wait_for_whole_graph, wait_until)
+from course_lib.ros2cli.common import (
+    DEFAULT_SPIN_TIME,
+    Verb,
+    add_discovery_arguments,
+    print_names,
+    print_types,
+    run_group,
+    wait_for_name,
+    wait_for_whole_graph,
+    wait_until,
+)
 
 #: Verbs of ros2cli's ``ros2 service`` (Jazzy) that the course leaves out.
 LEFT_OUT = ("echo", "info")

@@ -4,10 +4,23 @@ from __future__ import annotations
 
 import time
 
-from course_lib.ros2cli.common import (DISCOVERY_BACKSTOP, Verb, add_discovery_arguments, add_qos_arguments,
-                                       loop_limit, print_names, print_types, qos_from_arguments, qos_overridden,
-                                       run_group, say, wait_for_name, wait_for_nothing, wait_for_whole_graph,
-                                       wait_until)
+from course_lib.ros2cli.common import (
+    DISCOVERY_BACKSTOP,
+    Verb,
+    add_discovery_arguments,
+    add_qos_arguments,
+    loop_limit,
+    print_names,
+    print_types,
+    qos_from_arguments,
+    qos_overridden,
+    run_group,
+    say,
+    wait_for_name,
+    wait_for_nothing,
+    wait_for_whole_graph,
+    wait_until,
+)
 
 #: Verbs of ros2cli's ``ros2 topic`` that the course leaves out.
 LEFT_OUT = ()

@@ -14,13 +14,23 @@ A lesson calls them as ``selfcheck.<name>``; they live by kind of answer:
 - :mod:`.verdicts`: the :class:`Verdict` they return and the helpers they share.
 """
 
-from course_lib.selfcheck.brightness_package import (BRIGHTNESS_ENTRY_POINT, BRIGHTNESS_EXECUTABLE,
-                                                     BRIGHTNESS_PACKAGE, CHECK_CAMERA_TOPIC, PYTHON_DEPENDENCIES,
-                                                     brightness_package_exercise)
+from course_lib.selfcheck.brightness_package import (
+                                                     BRIGHTNESS_ENTRY_POINT,
+                                                     BRIGHTNESS_EXECUTABLE,
+                                                     BRIGHTNESS_PACKAGE,
+                                                     CHECK_CAMERA_TOPIC,
+                                                     PYTHON_DEPENDENCIES,
+                                                     brightness_package_exercise,
+)
 from course_lib.selfcheck.launch_exercise import task_launch_yaml
 from course_lib.selfcheck.node_exercises import publisher_exercise, subscriber_exercise
-from course_lib.selfcheck.tasks import (task1_node_name, task2_echo, task3_brightness_on_change, task4_order_corners,
-                                        task_picture_corners)
+from course_lib.selfcheck.tasks import (
+                                                     task1_node_name,
+                                                     task2_echo,
+                                                     task3_brightness_on_change,
+                                                     task4_order_corners,
+                                                     task_picture_corners,
+)
 from course_lib.selfcheck.verdicts import PLACEHOLDERS, Verdict
 
 __all__ = ["BRIGHTNESS_ENTRY_POINT", "BRIGHTNESS_EXECUTABLE", "BRIGHTNESS_PACKAGE", "CHECK_CAMERA_TOPIC",

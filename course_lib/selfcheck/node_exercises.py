@@ -7,6 +7,7 @@ from __future__ import annotations
 from course_lib import progress
 from course_lib.selfcheck.verdicts import Verdict, _not_done, _verdict
 
+
 def _exercise_node(node_or_class, class_name: str, hint: str):
     """(node added to the session, None) or (None, a Verdict) for a student's Node class or instance."""
     from rclpy.node import Node

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from course_lib.selfcheck.verdicts import Verdict, _call, _not_a_function, _not_done, _verdict
 
+
 def task1_node_name(answer, expected_node: str = "my_node") -> Verdict:
     """Task 1 (lesson 00): the name of the student's node as `ros2 node list` prints it."""
     from course_lib import graph
