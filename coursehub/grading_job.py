@@ -5,16 +5,18 @@ graded (root; coursehub.grading_service runs these in its threads).
   result: the one recorded for these very files (the service was stopped after recording it),
   else that of a submission with the same content graded before (the same work handed in
   again, or by another student: graded once), else a grading in the grader's sandbox
-  (autograder.pipeline). The result goes into the gradebook, the grading report and grades.csv
-  as the instructor's grade run writes them, so that run later finds it and grades nothing again.
+  (autograder.pipeline). The result goes into the gradebook and the grader's records as the
+  instructor's grade run writes them, so that run later finds it and grades nothing again.
 - :func:`release`: the feedback of graded submissions of one assignment (nbgrader's
   generate_feedback, in this process) released into the exchange as ``nbgrader release_feedback``
-  does, so that Fetch Feedback in the student's Assignments panel shows it.
+  does, so that Fetch Feedback in the student's Assignments panel shows it; then the grading
+  report and grades.csv are written again.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import os
 import shutil
 from datetime import datetime, timezone
 from pathlib import Path
@@ -45,8 +47,6 @@ def grade(course, queue: SubmitQueue, row: Row) -> None:
             with rosenv.reserve_domain_id() as reservation:
                 result = grade_submission(sub, course_dir, reservation.domain_id)
         store.save_result(course_dir, result, course_config)
-    report.write_report(course_dir, [result])
-    export.export(course_dir)
     chown_tree(course_dir, course.instructor)  # the instructor's formgrader and commands write here too
     message = result.reason.strip().splitlines()[0] if result.status == "failed" and result.reason.strip() else ""
     queue.graded(row.id, content, result.score, result.max_score, message, reused_from)
@@ -95,21 +95,34 @@ def release(course, assignment: str, rows: list[Row], hide_reasons: bool) -> Non
     feedback.write_in_process(course_dir, assignment, students, scores_only=hide_reasons)
     for student in students:
         _release_one(course, assignment, student)
+    report.write_report(course_dir)  # the instructor's files, once for the batch
+    export.export(course_dir)
     chown_tree(course_dir, course.instructor)
-    chown_tree(inbound.inbound(course.exchange, course.course_id).parent / "feedback", course.instructor)
 
 
 def _release_one(course, assignment: str, student: str) -> None:
-    """nbgrader's release_feedback for one student (its exchange class, in this process)."""
-    from nbgrader.auth import Authenticator
-    from nbgrader.coursedir import CourseDirectory
-    from nbgrader.exchange.default.release_feedback import ExchangeReleaseFeedback
+    """What nbgrader's release_feedback does for one student: each feedback page to
+    ``<exchange>/<course>/feedback/<hash of the submission's secret and the notebook>.html`` (the
+    name the student's Fetch Feedback looks for), readable by all, the instructor's like the folder
+    (whose later release_feedback replaces them)."""
+    import pwd
 
-    settings = config.load(course.course_dir)
-    settings.Exchange.root = str(course.exchange)
-    coursedir = CourseDirectory(config=settings, root=str(course.course_dir))
-    coursedir.assignment_id, coursedir.student_id = assignment, student
-    ExchangeReleaseFeedback(coursedir=coursedir, authenticator=Authenticator(config=settings), config=settings).start()
+    from nbgrader.utils import notebook_hash
+
+    owner = pwd.getpwnam(course.instructor)
+    source = course.course_dir / "feedback" / student / assignment
+    target = inbound.inbound(course.exchange, course.course_id).parent / "feedback"
+    if not target.is_dir():
+        target.mkdir(mode=0o711)  # nbgrader's mode: students reach a page by its name only
+        os.chown(target, owner.pw_uid, owner.pw_gid)
+    secret = (source / "submission_secret.txt").read_text()
+    for page in sorted(source.glob("*.html")):
+        name = f"{notebook_hash(secret=secret, notebook_id=page.stem)}.html"
+        temporary = target / f".{name}.tmp"
+        shutil.copyfile(page, temporary)
+        os.chmod(temporary, 0o644)
+        os.chown(temporary, owner.pw_uid, owner.pw_gid)
+        os.replace(temporary, target / name)
 
 
 def duedate(course_dir: Path, assignment: str) -> datetime | None:

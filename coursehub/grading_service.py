@@ -34,6 +34,10 @@ from coursehub import course as course_settings
 from coursehub import grading_job, inbound
 
 
+#: Seconds before the feedback that could not be released is tried again.
+RETRY_SECONDS = 30.0
+
+
 def _log(text: str) -> None:
     print(f"coursehub.grading_service: {text}", file=sys.stderr, flush=True)
 
@@ -130,8 +134,9 @@ class Service:
                     grading_job.release(self.course, assignment, group, grading_job.scores_only(rules, due))
                     self.queue.released([r.id for r in group])
                 except Exception:  # noqa: BLE001 - logged; the scores are recorded, the next round tries again
-                    _log(f"could not release the feedback of {assignment}:\n{traceback.format_exc()}")
-                    self.stopping.wait(self.poll_seconds)
+                    _log(f"could not release the feedback of {assignment} (trying again in "
+                         f"{RETRY_SECONDS:g} s):\n{traceback.format_exc()}")
+                    self.stopping.wait(RETRY_SECONDS)
                     self.graded.set()
 
 
