@@ -50,6 +50,12 @@ class Course:
         return self.hub_dir / "jupyter"
 
     @property
+    def submit_rules(self) -> Path:
+        """The attempts and due dates the grading service publishes for the students' Submit
+        (coursehub.limited_submit), readable by all."""
+        return self.jupyter_config_dir / "submit_rules.json"
+
+    @property
     def course_dir(self) -> Path:
         """The nbgrader course root (source/ release/ submitted/ ... gradebook.db), the instructor's."""
         return Path(pwd.getpwnam(self.instructor).pw_dir) / "course"

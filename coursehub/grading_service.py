@@ -11,7 +11,8 @@ autograder.config), it
 - grades the queue in arrival order, one submission per worker (coursehub.grading_job.grade);
 - writes and releases the feedback of what was graded (coursehub.grading_job.release), so that
   Fetch Feedback in the student's Assignments panel shows it;
-- serves each student the state of their submissions (coursehub.grading_status).
+- serves each student the state of their submissions (coursehub.grading_status), and publishes
+  the attempts and due dates for the Submit of the students' servers (coursehub.limited_submit).
 
 After the due date the instructor's usual collect, grade and feedback steps (coursehub.instructor)
 find the service's results in the gradebook and the grader's records and give the final grades.
@@ -24,6 +25,7 @@ import itertools
 import os
 import sys
 import threading
+import time
 import traceback
 from pathlib import Path
 
@@ -31,11 +33,14 @@ from autograder import config
 from autograder.release import assignments_in
 from autograder.submit_queue import SubmitQueue
 from coursehub import course as course_settings
-from coursehub import grading_job, inbound
+from coursehub import grading_job, inbound, limited_submit
 
 
 #: Seconds before the feedback that could not be released is tried again.
 RETRY_SECONDS = 30.0
+#: Seconds between two publications of the rules for the students' servers (the due dates change
+#: in the gradebook, which is not read every second).
+PUBLISH_SECONDS = 30.0
 
 
 def _log(text: str) -> None:
@@ -45,8 +50,11 @@ def _log(text: str) -> None:
 class Service:
     """The threads of the service: one looks at inbound/, `workers` grade, one releases feedback."""
 
-    def __init__(self, course, workers: int = config.SUBMIT_WORKERS, poll_seconds: float = config.SUBMIT_POLL_SECONDS):
-        self.course, self.workers, self.poll_seconds = course, workers, poll_seconds
+    def __init__(self, course, workers: int = config.SUBMIT_WORKERS, poll_seconds: float = config.SUBMIT_POLL_SECONDS,
+                 rules_file: Path | None = None):
+        """`rules_file`: where the students' servers read the attempts and due dates
+        (coursehub.limited_submit); None: not published."""
+        self.course, self.workers, self.poll_seconds, self.rules_file = course, workers, poll_seconds, rules_file
         self.queue = SubmitQueue(course.course_dir)
         self.stopping = threading.Event()
         self.queued = threading.Semaphore(0)  # one release per row queued (and per recovered row)
@@ -79,7 +87,16 @@ class Service:
                 _log(f"{error} Grading on submission waits until it is corrected.")
                 self._rules = {}
             self._rules_read = stamp
+            self.publish()
         return self._rules
+
+    def publish(self) -> None:
+        """The attempts and due dates for the students' servers' Submit (coursehub.limited_submit)."""
+        if self.rules_file is not None:
+            due = {name: grading_job.duedate(self.course.course_dir, name) for name in self._rules}
+            limited_submit.write_rules(self.rules_file, {
+                name: {"attempts": rule.attempts, "duedate": f"{due[name]} UTC" if due[name] else None}
+                for name, rule in self._rules.items()})
 
     def look_once(self) -> int:
         """Queue the new complete submissions of assignments graded on submission; return how many."""
@@ -98,9 +115,13 @@ class Service:
         return len(entries)
 
     def _look(self) -> None:
+        published = time.monotonic()
         while not self.stopping.is_set():
             try:
                 self.look_once()
+                if time.monotonic() - published > PUBLISH_SECONDS:
+                    self.publish()
+                    published = time.monotonic()
             except Exception:  # noqa: BLE001 - logged; the next look tries again
                 _log(f"could not read the inbound submissions:\n{traceback.format_exc()}")
             self.stopping.wait(self.poll_seconds)
@@ -151,7 +172,8 @@ def main(argv=None) -> int:
     from coursehub import grading_status
 
     course = course_settings.load(args.hub_dir)
-    service = Service(course, workers=max(1, args.workers))
+    service = Service(course, workers=max(1, args.workers),
+                      rules_file=course.submit_rules)
     service.start()
     prefix = os.environ.get("JUPYTERHUB_SERVICE_PREFIX", "/services/grading/")
     grading_status.application(service.queue, prefix).listen(course.grading_port, "127.0.0.1")
