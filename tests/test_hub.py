@@ -3,13 +3,14 @@
 
 Both students' kernels run talkers on `chatter` with the same ROS_DOMAIN_ID and discovery range
 and hear only themselves, and cannot read each other's home, the gradebook, the exchange's
-submissions or the reference solutions. In headless Chromium the students log in,
-fetch brightness from the Assignments panel and submit (one the reference solution, one a wrong
-average); the instructor's commands collect, grade in the sandbox and release feedback; the
-formgrader shows the grader's scores; each student fetches their own feedback and cannot reach
-the other's server. Stopping the hub leaves no process of the course behind. Root only
-(accounts, namespaces); skipped otherwise.
-"""
+submissions or the reference solutions. In headless Chromium the students log in, fetch
+brightness from the Assignments panel and submit; the hub's grading service grades each
+submission and releases its feedback, with no instructor step: bob's wrong average shows its
+reasons, his fix full marks, a Submit past the attempts is refused with the reason; each student
+sees only their own submissions and feedback and cannot reach the other's server. The
+instructor's collect, grade and feedback afterwards agree with the service and grade nothing
+again. Many submissions at once survive a SIGKILL of the service, each graded once. Stopping the
+hub leaves no process of the course behind. Root only (accounts, namespaces); skipped otherwise."""
 
 from __future__ import annotations
 
