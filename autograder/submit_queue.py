@@ -182,6 +182,12 @@ class SubmitQueue:
         return self._transaction(lambda db: db.execute(
             "UPDATE submissions SET state='queued', changed=? WHERE state='grading'", (_now(),)).rowcount)
 
+    def busy(self) -> bool:
+        """Whether a row is queued or being graded."""
+        with self._lock:
+            return self._db.execute("SELECT 1 FROM submissions WHERE state IN ('queued', 'grading') LIMIT 1"
+                                    ).fetchone() is not None
+
     def waiting_for_feedback(self) -> list[Row]:
         return self._rows("SELECT * FROM submissions WHERE state='graded' ORDER BY id")
 

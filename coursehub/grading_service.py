@@ -38,6 +38,8 @@ from coursehub import grading_job, inbound, limited_submit
 
 #: Seconds before the feedback that could not be released is tried again.
 RETRY_SECONDS = 30.0
+#: Seconds the feedback of a grading waits for the next one while the workers are busy.
+BATCH_SECONDS = 2.0
 #: Seconds between two publications of the rules for the students' servers (the due dates change
 #: in the gradebook, which is not read every second).
 PUBLISH_SECONDS = 30.0
@@ -145,6 +147,11 @@ class Service:
             if not self.graded.wait(self.poll_seconds):
                 continue
             self.graded.clear()
+            # Quick gradings in a row (the same content handed in by many) make one batch: a batch
+            # costs about a second of processor time whatever its size. A lone one waits not.
+            deadline = time.monotonic() + BATCH_SECONDS
+            while self.queue.busy() and time.monotonic() < deadline and not self.stopping.is_set():
+                self.stopping.wait(0.2)
             rows = self.queue.waiting_for_feedback()
             for assignment, group in itertools.groupby(sorted(rows, key=lambda r: r.assignment),
                                                        key=lambda r: r.assignment):

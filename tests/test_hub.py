@@ -298,7 +298,7 @@ def test_students_get_graded_feedback_minutes_after_submit_and_only_their_own(hu
 
 
 #: Submissions handed in at once in the queue test, and while its service is down.
-AT_ONCE, WHILE_DOWN = 12, 2
+AT_ONCE, WHILE_DOWN = 10, 2
 
 
 def _drop_in_inbound(hub, student: str, like: Path) -> str:

@@ -35,7 +35,7 @@ def test_rows_are_claimed_in_arrival_order_and_each_by_one_worker(tmp_path):
     for thread in threads:
         thread.join()
     assert sorted(claimed) == [f"s{n:02d}" for n in range(20)]  # each once
-    assert {r.state for r in queue.all()} == {"grading"}
+    assert {r.state for r in queue.all()} == {"grading"} and queue.busy()
 
 
 def test_a_newer_submission_supersedes_the_queued_one_and_the_page_counts_who_is_ahead(tmp_path):
