@@ -17,6 +17,9 @@
   hidden checks and their verdicts), ``autograder.outputs`` (autograded notebooks, logs),
   ``autograder.result``, ``autograder.store`` (recorded results, cache), ``autograder.grading``
   (the whole class, in parallel).
+- Grading on submission (the hub's service, coursehub.grading_service): ``autograder.submit_queue``
+  (its durable queue), ``autograder.scores_only`` (feedback without the verdicts before the due
+  date); the rules per assignment are ``autograder.config.GradeOnSubmit``.
 
 The checks themselves are shared with the students' self-checks: ``course_lib.checks``.
 """

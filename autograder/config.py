@@ -10,7 +10,11 @@ the LMS export ``grades.csv`` in the course root.
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
+
+from traitlets import Dict
+from traitlets.config import Configurable
 
 from course_lib.checks.validate import apply_student
 from course_lib.contract import COURSE_ID
@@ -62,6 +66,65 @@ def quiet_add_submission() -> None:
                             category=SAWarning, module=r"nbgrader\.api")
 
 
+class GradeOnSubmit(Configurable):
+    """Grading on submission (the hub's grading service, coursehub.grading_service), per assignment,
+    in the course's nbgrader_config.py::
+
+        c.GradeOnSubmit.assignments = {"brightness": {"attempts": 3, "reasons_before_due": False}}
+
+    An assignment not named is graded only by the instructor's grade run. ``attempts``: how many
+    submissions before the due date are graded (default: no limit; later ones are refused and set
+    aside, so the instructor's collect takes the last one graded). ``reasons_before_due``: False
+    shows only the scores of the hidden checks until the due date, not why they failed (default
+    True). After the due date the instructor's grade and feedback runs give the final grades."""
+
+    assignments = Dict(default_value={}, help="assignment -> {'attempts': int, 'reasons_before_due': bool}; "
+                       "named assignments are graded when submitted").tag(config=True)
+
+
+@dataclasses.dataclass(frozen=True)
+class SubmitRules:
+    """One assignment's grading on submission (GradeOnSubmit)."""
+    attempts: int | None = None       # graded submissions before the due date; None: no limit
+    reasons_before_due: bool = True   # False: scores only until the due date
+
+
+SUBMIT_RULE_KEYS = {field.name for field in dataclasses.fields(SubmitRules)}
+
+#: Seconds between two looks of the hub's grading service at the exchange's inbound/.
+SUBMIT_POLL_SECONDS = 1.0
+#: Submissions the hub's grading service grades at the same time (each keeps 2 cores busy).
+SUBMIT_WORKERS = 1
+
+
+def submit_rules(course_config, assignments: list[str]) -> dict[str, SubmitRules]:
+    """The assignments graded on submission and their rules, from a course's configuration (load).
+
+    Raises:
+        ValueError: c.GradeOnSubmit.assignments names no assignment of the course, or holds a
+            setting that does not exist or has the wrong type (the message names the fix).
+    """
+    named = dict(GradeOnSubmit(config=course_config).assignments)
+    rules = {}
+    for name, settings in named.items():
+        where = f"c.GradeOnSubmit.assignments[{name!r}] in the course's nbgrader_config.py"
+        if name not in assignments:
+            raise ValueError(f"{where}: {name!r} is no assignment of the course ({', '.join(assignments)}): "
+                             "correct the name.")
+        settings = dict(settings or {})
+        unknown = sorted(set(settings) - SUBMIT_RULE_KEYS)
+        if unknown:
+            raise ValueError(f"{where} has {', '.join(unknown)}: the settings are {', '.join(sorted(SUBMIT_RULE_KEYS))}.")
+        attempts = settings.get("attempts")
+        if attempts is not None and (not isinstance(attempts, int) or isinstance(attempts, bool) or attempts < 1):
+            raise ValueError(f"{where}: 'attempts' is {attempts!r}; give a whole number of at least 1, or leave it "
+                             "out for no limit.")
+        if not isinstance(settings.get("reasons_before_due", True), bool):
+            raise ValueError(f"{where}: 'reasons_before_due' must be True or False.")
+        rules[name] = SubmitRules(**settings)
+    return rules
+
+
 #: The line of the course's nbgrader_config.py below which the instructor's settings are kept.
 MARKER = "# ---- Your settings below this line are kept when the autograder rewrites this file ----"
 
@@ -93,6 +156,9 @@ SETTINGS_EXAMPLE = '''\
 # Due dates are in the gradebook: python -m autograder release COURSE_DIR --assignment pubsub --duedate "2025-03-14 23:59 Europe/Berlin"
 # c.LatePenalty.per_day = {"pubsub": 0.1, "brightness": 0.1, "catdog_warp": 0.1}
 # c.LatePenalty.maximum = 0.5
+# Grading on submission on the course's JupyterHub (its grading service), per assignment: how many
+# submissions before the due date are graded, and whether the hidden checks' reasons show before it:
+# c.GradeOnSubmit.assignments = {"brightness": {"attempts": 3, "reasons_before_due": True}}
 # The time zone of the submission times in your LMS's file names (python -m autograder collect):
 # c.LmsFileNames.timezone = "Europe/Berlin"
 # The file names of your LMS's download, when they differ from autograder.collect.LMS_FILE_NAME

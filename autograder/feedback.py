@@ -35,6 +35,11 @@ def write_feedback(course_dir, assignment: str | None = None, student: str | Non
     for name in sorted({r.assignment for r in chosen if r.status != "failed"}):
         nbgrader_cli.run_nbgrader(["generate_feedback", name, "--force", *(["--student", student] if student else [])],
                              course)
+    return _finish(course, chosen)
+
+
+def _finish(course: Path, chosen: list) -> list[Path]:
+    """Wrap the long lines of the results' pages and write each student's index; return the indexes."""
     for r in chosen:
         for page in (course / "feedback" / r.student / r.assignment).glob("*.html"):
             _wrap_lines(page)
@@ -43,6 +48,36 @@ def write_feedback(course_dir, assignment: str | None = None, student: str | Non
         # Every assignment of the student, not only this run's: the index lists them all.
         pages.append(_write_index(course, name, store.recorded_results(course, student=name)))
     return pages
+
+
+def write_in_process(course_dir, assignment: str, students: list[str], scores_only: bool = False) -> list[Path]:
+    """The feedback of some students' submissions of one assignment, with nbgrader's
+    generate_feedback run in this process (a long-lived caller pays its import once, and one run
+    serves every student named). `scores_only`: the checks' verdicts left out
+    (autograder.scores_only). Return the index pages written."""
+    import shutil
+
+    from nbconvert.preprocessors import CSSHTMLHeaderPreprocessor
+    from nbgrader.converters import GenerateFeedback
+    from nbgrader.coursedir import CourseDirectory
+    from nbgrader.preprocessors import GetGrades
+
+    from autograder import config
+    from autograder import scores_only as hide
+
+    course = Path(course_dir).resolve()
+    for student in students:  # generate_feedback without --force makes only what is missing
+        shutil.rmtree(course / "feedback" / student / assignment, ignore_errors=True)
+    settings = config.load(course)
+    settings.GenerateFeedback.preprocessors = [GetGrades, CSSHTMLHeaderPreprocessor,
+                                               *([hide.ScoresOnly] if scores_only else [])]
+    coursedir = CourseDirectory(config=settings, root=str(course))
+    coursedir.assignment_id = assignment
+    converter = GenerateFeedback(coursedir=coursedir, config=settings)
+    converter.force = False
+    converter.start()
+    chosen = [r for student in students for r in store.recorded_results(course, assignment, student)]
+    return _finish(course, chosen)
 
 
 def _wrap_lines(page: Path) -> None:

@@ -36,10 +36,17 @@ def find_submissions(course: Path, assignment: str | None = None, student: str |
     return found
 
 
-def _tree_digest(paths: list[Path], digest) -> None:
+#: The files nbgrader's submit adds to every submission (its time, the secret its feedback's name
+#: derives from): two submissions that differ only in them have the same content.
+PER_SUBMISSION_FILES = ("timestamp.txt", "submission_secret.txt")
+
+
+def _tree_digest(paths: list[Path], digest, skip: tuple = ()) -> None:
     for base in paths:
         files = [base] if base.is_file() else sorted(p for p in base.rglob("*") if p.is_file())
         for path in files:
+            if path.parent == base and path.name in skip:
+                continue
             digest.update(str(path.relative_to(base.parent)).encode() + b"\0" + path.read_bytes() + b"\0")
 
 
@@ -48,10 +55,14 @@ CHECK_MODULES = ["registry", "result", "runner", "check_process", "context", "st
                  "student_server", "probe", "student", "answers", "packages"]
 
 
-def submission_digest(sub: Submission, course: Path) -> str:
-    """Changes when the submission, the assignment's source or the grading code changes."""
+def submission_digest(sub: Submission, course: Path, content_only: bool = False) -> str:
+    """Changes when the submission, the assignment's source or the grading code changes.
+
+    `content_only`: the same for two submissions that differ only in nbgrader's per-submission
+    files (PER_SUBMISSION_FILES): the same work, handed in again or by another student."""
     digest = hashlib.sha256()
-    _tree_digest([sub.path, course / "source" / sub.assignment], digest)
+    _tree_digest([sub.path], digest, PER_SUBMISSION_FILES if content_only else ())
+    _tree_digest([course / "source" / sub.assignment], digest)
     here, checks = Path(__file__).resolve().parent, Path(registry.__file__).resolve().parent
     code = [here / "kernel.py", here / "config.py", here / "hidden_checks_process.py", here / "student_uid.py", here / "run_as.py",
             here / "packages.py",

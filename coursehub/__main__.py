@@ -128,6 +128,7 @@ def _parser() -> argparse.ArgumentParser:
         if step == "grade":
             one.add_argument("--workers", type=int, default=2)
             one.add_argument("--student")
+            one.add_argument("--force", action="store_true", help="grade again submissions that did not change")
     sub.add_parser("remove-course", help="delete the course's accounts, homes, exchange folder and hub directory")
     return parser
 
@@ -153,7 +154,8 @@ def main(argv=None) -> int:
             return 0
         step = getattr(instructor, args.command)
         extra = {"release": {"duedate": getattr(args, "duedate", None)},
-                 "grade": {"workers": getattr(args, "workers", 2), "student": getattr(args, "student", None)}}
+                 "grade": {"workers": getattr(args, "workers", 2), "student": getattr(args, "student", None),
+                           "force": getattr(args, "force", False)}}
         print(step(course, args.assignment, **extra.get(args.command, {})), end="")
         return 0
     except (ValueError, FileNotFoundError, RuntimeError) as error:

@@ -30,6 +30,11 @@ class Course:
     ip: str = "127.0.0.1"  # the proxy's public address; 0.0.0.0 behind a TLS-terminating front end
 
     @property
+    def grading_port(self) -> int:
+        """The hub's grading service (coursehub.grading_service) on 127.0.0.1: the port after the hub's."""
+        return self.hub_port + 1
+
+    @property
     def run_dir(self) -> Path:
         return self.hub_dir / "run"
 
@@ -43,6 +48,12 @@ class Course:
     @property
     def jupyter_config_dir(self) -> Path:
         return self.hub_dir / "jupyter"
+
+    @property
+    def submit_rules(self) -> Path:
+        """The attempts and due dates the grading service publishes for the students' Submit
+        (coursehub.limited_submit), readable by all."""
+        return self.jupyter_config_dir / "submit_rules.json"
 
     @property
     def course_dir(self) -> Path:

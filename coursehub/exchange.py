@@ -22,7 +22,8 @@ def create_exchange(root: Path) -> None:
 
 def write_settings(course) -> Path:
     """``<hub dir>/jupyter/nbgrader_config.py``, read by every server of the hub (JUPYTER_CONFIG_PATH)
-    and by the instructor's commands: the course id, the exchange, the course's cell timeouts."""
+    and by the instructor's commands: the course id, the exchange, the Submit that refuses what the
+    grading service would not grade (coursehub.limited_submit), the course's cell timeouts."""
     folder = course.jupyter_config_dir
     folder.mkdir(parents=True, exist_ok=True)
     os.chmod(folder, 0o755)
@@ -33,6 +34,9 @@ def write_settings(course) -> Path:
         "c = get_config()  # noqa: F821 (provided by nbgrader)\n"
         f"c.CourseDirectory.course_id = {course.course_id!r}\n"
         f"c.Exchange.root = {str(course.exchange)!r}\n"
+        "# Submit refused past the attempts the hub's grading service grades (coursehub.limited_submit).\n"
+        "c.ExchangeFactory.submit = 'coursehub.limited_submit.LimitedSubmit'\n"
+        f"c.LimitedSubmit.rules_file = {str(course.submit_rules)!r}\n"
         "apply_student(c)\n")
     os.chmod(path, 0o644)
     return path

@@ -51,10 +51,12 @@ def collect(course, assignment: str) -> str:
     return _as_instructor(course, _nbgrader("collect", assignment, "--update"))
 
 
-def grade(course, assignment: str, workers: int = 2, student: str | None = None) -> str:
+def grade(course, assignment: str, workers: int = 2, student: str | None = None, force: bool = False) -> str:
     command = _autograder("grade", str(course.course_dir), "--assignment", assignment, "--workers", str(workers))
     if student:
         command += ["--student", student]
+    if force:
+        command += ["--force"]
     done = subprocess.run(command, cwd=sandbox.REPO, capture_output=True, text=True,
                           env=dict(os.environ, PYTHONPATH=str(sandbox.REPO)))
     chown_tree(course.course_dir, course.instructor)  # the formgrader (the instructor's) writes the gradebook

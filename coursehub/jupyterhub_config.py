@@ -36,3 +36,12 @@ c.Spawner.args = ["--ServerApp.terminado_settings=" + json.dumps({"shell_command
 # Ten students logging in at once on two cores start in about a minute (README: capacity).
 c.Spawner.start_timeout = 180
 c.Spawner.http_timeout = 180
+
+# Graded feedback minutes after Submit (coursehub.grading_service), as root (the grader's sandbox
+# needs it); the hub restarts it when it dies. Students reach its page behind the hub's login.
+c.JupyterHub.services = [{
+    "name": "grading", "url": f"http://127.0.0.1:{course.grading_port}", "display": True, "oauth_no_confirm": True,
+    "command": [sys.executable, "-m", "coursehub.grading_service"],
+    "environment": {"COURSEHUB_HUB_DIR": str(course.hub_dir)},
+}]
+c.JupyterHub.load_roles = [{"name": "user", "scopes": ["self", "access:services!service=grading"]}]

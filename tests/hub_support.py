@@ -6,7 +6,9 @@ and find every process of the course's users.
   the hub started by ``python -m coursehub start``; on exit the hub is stopped and the course removed;
 - ``log_in``: a requests session logged in through the hub's login form, with the user's server up;
 - ``run_in_kernel``: start a kernel in a user's server, run code, return what it printed;
-- ``course_processes``: the processes of the course's uids and of their network namespaces.
+- ``course_processes``: the processes of the course's uids and of their network namespaces;
+- ``grading_service``, ``submission_states``: the hub's grading service process, and the rows of
+  its queue as its page shows them to a student.
 """
 
 from __future__ import annotations
@@ -112,9 +114,10 @@ def free_port_pair() -> int:
 
 @contextlib.contextmanager
 def running_hub(prefix: str, students: list[str], hub_dir: Path, scratch: Path, release: list[str] = (),
-                timeout: float = 60):
+                timeout: float = 60, settings: str = ""):
     """Create a course (instructor ``<prefix>i``, the students ``<prefix><name>``) and run its hub;
-    the roster and the hub's log go to `scratch`."""
+    the roster and the hub's log go to `scratch`. `settings`: lines for the instructor's part of
+    the course's nbgrader_config.py (e.g. c.GradeOnSubmit.assignments)."""
     import requests
 
     roster = scratch / f"{prefix}-roster.csv"
@@ -124,6 +127,10 @@ def running_hub(prefix: str, students: list[str], hub_dir: Path, scratch: Path, 
     try:
         coursehub(hub_dir, "create-course", str(roster), "--instructor", f"{prefix}i", "--group", f"{prefix}g",
                   "--exchange", str(hub_dir / "exchange"), "--port", str(port), "--hub-port", str(hub_port))
+        if settings:
+            instructor = pwd.getpwnam(f"{prefix}i")
+            with open(Path(instructor.pw_dir) / "course" / "nbgrader_config.py", "a") as handle:
+                handle.write(settings)
         with open(hub_dir / "passwords.csv", newline="") as handle:
             passwords = {row["user"]: row["password"] for row in csv.DictReader(handle)}
         log = scratch / f"{prefix}-hub.log"
@@ -236,3 +243,44 @@ def course_processes(hub: Hub, namespaces: set[str] = frozenset()) -> list[psuti
         except (psutil.Error, OSError, TypeError):
             pass
     return found
+
+
+def grading_service(hub: Hub, timeout: float = 120) -> psutil.Process:
+    """The hub's grading service (coursehub.grading_service), a child of the hub's process, once it
+    answers on its port (the hub restarts it when it dies)."""
+    import socket
+
+    from coursehub import course as course_settings
+
+    port = course_settings.load(hub.hub_dir).grading_port
+    deadline = time.monotonic() + timeout
+    while True:
+        found = [child for child in psutil.Process(hub.process.pid).children()
+                 if "coursehub.grading_service" in " ".join(_cmdline(child))]
+        if found:
+            with contextlib.suppress(OSError), socket.create_connection(("127.0.0.1", port), timeout=2):
+                return found[0]
+        if time.monotonic() > deadline:
+            raise TimeoutError(f"the grading service did not answer on 127.0.0.1:{port} within {timeout:.0f} s:\n"
+                               f"{hub.log_tail()}")
+        time.sleep(0.2)
+
+
+def _cmdline(process: psutil.Process) -> list[str]:
+    try:
+        return process.cmdline()
+    except psutil.Error:
+        return []
+
+
+#: A row of the grading service's page (coursehub.grading_status.page).
+_STATUS_ROW = r"<tr class='submission (\w+)'><td>([^<]*)</td><td>(\d+)</td><td>[^<]*</td><td>([^<]*)</td></tr>"
+
+
+def submission_states(html_text: str) -> list[dict]:
+    """The rows of the grading service's page: state, assignment, attempt, what it says (newest first)."""
+    import html
+    import re
+
+    return [{"state": state, "assignment": assignment, "attempt": int(attempt), "says": html.unescape(says)}
+            for state, assignment, attempt, says in re.findall(_STATUS_ROW, html_text)]

@@ -37,3 +37,31 @@ def test_file_not_written_by_the_autograder_is_left_alone(tmp_path):
     with pytest.raises(ValueError, match="not written by the autograder.*copy your settings below the line"):
         config.write_config(tmp_path)
     assert "course_id = 'mine'" in path.read_text()
+
+
+def _rules(tmp_path, line: str):
+    path = config.write_config(tmp_path)
+    path.write_text(path.read_text() + line + "\n")
+    return config.submit_rules(config.load(tmp_path), ["brightness", "pubsub"])
+
+
+def test_grading_on_submission_is_set_per_assignment(tmp_path):
+    rules = _rules(tmp_path, "c.GradeOnSubmit.assignments = {'brightness': {'attempts': 3, 'reasons_before_due': False},"
+                             " 'pubsub': {}}")
+    assert rules == {"brightness": config.SubmitRules(attempts=3, reasons_before_due=False),
+                     "pubsub": config.SubmitRules(attempts=None, reasons_before_due=True)}
+
+
+def test_without_rules_no_assignment_is_graded_on_submission(tmp_path):
+    assert _rules(tmp_path, "") == {}
+
+
+@pytest.mark.parametrize("line, fix", [
+    ("c.GradeOnSubmit.assignments = {'brightnes': {}}", "'brightnes' is no assignment of the course"),
+    ("c.GradeOnSubmit.assignments = {'pubsub': {'tries': 2}}", "has tries: the settings are attempts, reasons_before_due"),
+    ("c.GradeOnSubmit.assignments = {'pubsub': {'attempts': 0}}", "a whole number of at least 1"),
+    ("c.GradeOnSubmit.assignments = {'pubsub': {'reasons_before_due': 'no'}}", "must be True or False"),
+])
+def test_a_mistake_in_the_rules_names_the_fix(tmp_path, line, fix):
+    with pytest.raises(ValueError, match=fix):
+        _rules(tmp_path, line)

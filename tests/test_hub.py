@@ -3,20 +3,24 @@
 
 Both students' kernels run talkers on `chatter` with the same ROS_DOMAIN_ID and discovery range
 and hear only themselves, and cannot read each other's home, the gradebook, the exchange's
-submissions or the reference solutions. In headless Chromium the students log in,
-fetch brightness from the Assignments panel and submit (one the reference solution, one a wrong
-average); the instructor's commands collect, grade in the sandbox and release feedback; the
-formgrader shows the grader's scores; each student fetches their own feedback and cannot reach
-the other's server. Stopping the hub leaves no process of the course behind. Root only
-(accounts, namespaces); skipped otherwise.
-"""
+submissions or the reference solutions. In headless Chromium the students log in, fetch
+brightness from the Assignments panel and submit; the hub's grading service grades each
+submission and releases its feedback, with no instructor step: bob's wrong average shows its
+reasons, his fix full marks, a Submit past the attempts is refused with the reason; each student
+sees only their own submissions and feedback and cannot reach the other's server. The
+instructor's collect, grade and feedback afterwards agree with the service and grade nothing
+again. Many submissions at once survive a SIGKILL of the service, each graded once. Stopping the
+hub leaves no process of the course behind. Root only (accounts, namespaces); skipped otherwise."""
 
 from __future__ import annotations
 
 import concurrent.futures
+import contextlib
+import csv
 import os
 import re
 import secrets
+import shutil
 import sys
 import time
 from pathlib import Path
@@ -29,7 +33,15 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import zoo  # noqa: E402
 from browser_nbgrader import wait_for_assignment  # noqa: E402
 from browser_support import CHROMIUM_ARGS, VIEWPORT, ChromiumUnavailable, click_menu, find_chromium  # noqa: E402
-from hub_support import course_processes, log_in, run_in_kernel, running_hub, why_no_hub  # noqa: E402
+from hub_support import (  # noqa: E402  # noqa: E402
+    course_processes,
+    grading_service,
+    log_in,
+    run_in_kernel,
+    running_hub,
+    submission_states,
+    why_no_hub,
+)
 from zoo.brightness import SUM  # noqa: E402
 
 pytestmark = [pytest.mark.hub, pytest.mark.browser, pytest.mark.slow, pytest.mark.timeout(600),
@@ -39,6 +51,9 @@ ASSIGNMENT = "brightness"
 SCREENSHOTS = Path(__file__).resolve().parents[1] / "artifacts" / "browser"
 #: The wrong submission: the brightest pixel instead of the average.
 WRONG_AVERAGE = [(SUM, "return int(image.max())")]
+#: Submissions graded before the due date (the course's nbgrader_config.py; coursehub.grading_service).
+ATTEMPTS = 2
+SETTINGS = f"c.GradeOnSubmit.assignments = {{{ASSIGNMENT!r}: {{'attempts': {ATTEMPTS}}}}}\n"
 
 #: Each student's kernel: a talker and a listener on `chatter`, on the same domain and discovery
 #: range as the other student (set on purpose); prints who it heard, and what it may read.
@@ -84,7 +99,8 @@ def hub(tmp_path_factory):
     prefix = "h15" + "".join(secrets.choice("abcdefghijkmnpqrstuvwxyz") for _ in range(4))
     hub_dir = Path("/srv") / f"{prefix}-hub"
     scratch = tmp_path_factory.mktemp("hub")
-    with running_hub(prefix, ["alice", "bob"], hub_dir, scratch, release=[ASSIGNMENT]) as running:
+    with running_hub(prefix, ["alice", "bob"], hub_dir, scratch, release=[ASSIGNMENT],
+                     settings=SETTINGS) as running:
         yield running
 
 
@@ -166,58 +182,224 @@ def test_talkers_in_two_students_kernels_on_one_domain_never_hear_each_other(hub
         assert "reference solutions []" in said[user], said
 
 
-def test_students_submit_in_the_assignments_panel_and_each_fetches_only_their_feedback(hub, sessions, chromium):
+def _status(page, hub, attempt: int, timeout: float = 420) -> tuple[dict, list[str]]:
+    """Wait until the grading service's page shows the student's submission `attempt` graded, refused
+    or failed (its feedback released); return that row and every state the page said meanwhile."""
+    said, deadline = [], time.monotonic() + timeout
+    while True:
+        # The context's cookies (the service's login, done by page.goto) go with the request.
+        rows = submission_states(page.context.request.get(f"{hub.url}/services/grading/").text())
+        row = next((r for r in rows if r["assignment"] == ASSIGNMENT and r["attempt"] == attempt), None)
+        if row is not None and (not said or said[-1] != row["says"]):
+            said.append(row["says"])
+        if row is not None and row["state"] in ("released", "refused", "failed"):
+            return row, said
+        if time.monotonic() > deadline:
+            raise TimeoutError(f"submission {attempt} not graded after {timeout:.0f} s; the page said {said}, "
+                               f"the service's log:\n{hub.log_tail()}")
+        time.sleep(1.5)  # a grading takes ten seconds and more; each look costs the proxy and the service
+
+
+def _submit(page, hub, user, edits, attempt: int) -> tuple[dict, list[str]]:
+    """Hand in the reference with `edits`, press Submit, and wait for the service's verdict."""
+    _hand_in(hub, user, edits)
+    _press(page, "fetched", "Submit")
+    return _status(page, hub, attempt)
+
+
+def _fetch_feedback(page, hub, user, count: int) -> str:
+    """Press Fetch Feedback until the student's home holds `count` feedback pages; open the newest
+    from the student's server in a tab of its own (the lab stays open) and return its text."""
+    folder = Path(f"/home/{user}") / ASSIGNMENT / "feedback"
+    _press(page, "submitted", "Fetch Feedback")
+    deadline = time.monotonic() + 60
+    while len(pages := sorted(folder.glob(f"*/{ASSIGNMENT}.html"))) < count and time.monotonic() < deadline:
+        time.sleep(0.2)
+    assert len(pages) == count, f"{user} fetched {pages}, not {count} feedback pages"
+    relative = pages[-1].relative_to(f"/home/{user}").as_posix()  # the folders are the submissions' times
+    viewer = page.context.new_page()
+    try:
+        viewer.goto(f"{hub.url}/user/{user}/files/{relative}", wait_until="domcontentloaded")
+        return viewer.inner_text("body")
+    finally:
+        viewer.close()
+
+
+def test_students_get_graded_feedback_minutes_after_submit_and_only_their_own(hub, sessions, chromium):
     alice, bob = hub.students
     pages = {user: _log_in_page(chromium, hub, user) for user in (alice, bob)}
-    instructor = sessions[hub.instructor]
     hub.released.result()
     for user, page in pages.items():
         _open_assignments(page, hub, user)
         wait_for_assignment(page, "released", ASSIGNMENT, 60)
         _press(page, "released", "Fetch")
         wait_for_assignment(page, "fetched", ASSIGNMENT, 60)
-    _hand_in(hub, alice, [])
-    _hand_in(hub, bob, WRONG_AVERAGE)
+    # Each student's page of the grading service, behind the hub's login (HubOAuth); closed while
+    # the test looks through the same login with requests (a page open reloads itself every 2 s).
     for user, page in pages.items():
-        _press(page, "fetched", "Submit")
-        wait_for_assignment(page, "submitted", ASSIGNMENT, 60)
+        status = page.context.new_page()
+        status.goto(f"{hub.url}/services/grading/", wait_until="domcontentloaded")
+        assert "No submission yet" in status.inner_text("body"), status.url
+        status.close()
 
+    _hand_in(hub, bob, WRONG_AVERAGE)
+    _hand_in(hub, alice, [])
+    for page in (pages[bob], pages[alice]):  # one after the other: alice's waits behind bob's
+        _press(page, "fetched", "Submit")
+    wrong, said = _status(pages[bob], hub, 1)
+    first, seen = _status(pages[alice], hub, 1)
+    assert wrong["state"] == "released" and wrong["says"].startswith("graded: "), said
+    score, maximum = (float(x) for x in re.match(r"graded: ([\d.]+) / ([\d.]+)", wrong["says"]).groups())
+    assert 0 <= score < maximum, said
+    # What bob saw: queued or grading first, then the score (the page asks for Fetch Feedback).
+    assert said[0].startswith(("queued (", "grading")) and "Fetch Feedback" in said[-1], said
+    text = _fetch_feedback(pages[bob], hub, bob, 1)
+    assert f"{ASSIGNMENT} (Score: {score:.1f} / {maximum:.1f})" in text, text[:500]
+    assert "\u2718" in text and "expected" in text, text  # the reasons: each failed item, what was expected
+
+    fixed, said = _submit(pages[bob], hub, bob, [], 2)
+    assert fixed["says"].startswith(f"graded: {maximum:g} / {maximum:g}"), said
+    text = _fetch_feedback(pages[bob], hub, bob, 2)
+    assert f"{ASSIGNMENT} (Score: {maximum:.1f} / {maximum:.1f})" in text, text[:500]
+    # A third Submit before the due date: the panel refuses it and says why (coursehub.limited_submit).
+    _press(pages[bob], "fetched", "Submit")
+    dialog = pages[bob].locator("#submission-message")
+    dialog.wait_for()
+    assert f"{ASSIGNMENT} allows {ATTEMPTS} graded submissions before the due date" in dialog.inner_text()
+    pages[bob].locator(".jp-Dialog .jp-mod-accept").click()
+    # Copied into inbound/ past the panel (from a terminal, say): the service refuses it and says so.
+    _drop_in_inbound(hub, bob, hub.course_dir / "submitted" / bob / ASSIGNMENT)
+    refused, said = _status(pages[bob], hub, 3)
+    assert refused["state"] == "refused", said
+    assert f"{ASSIGNMENT} allows {ATTEMPTS} graded submissions before the due date" in refused["says"], said
+    status = {user: page.context.new_page() for user, page in pages.items()}
+    for page in status.values():
+        page.goto(f"{hub.url}/services/grading/", wait_until="domcontentloaded")
+    SCREENSHOTS.mkdir(parents=True, exist_ok=True)
+    status[bob].screenshot(path=str(SCREENSHOTS / "hub_grading_status.png"))
+    assert "this is your 3rd" in status[bob].inner_text("body")
+
+    assert seen[0].startswith(("queued (", "grading")) and first["says"].startswith(f"graded: {maximum:g} / {maximum:g}"), seen
+    shown = status[alice].inner_text("body")
+    assert status[alice].locator("tr.submission").count() == 1 and bob not in shown, shown
+    text = _fetch_feedback(pages[alice], hub, alice, 1)
+    assert f"{ASSIGNMENT} (Score: {maximum:.1f} / {maximum:.1f})" in text, text[:500]
+    answer = pages[alice].goto(f"{hub.url}/user/{bob}/lab", wait_until="domcontentloaded")
+    assert answer.status == 403 or f"/user/{bob}/lab" not in pages[alice].url, (answer.status, pages[alice].url)
+
+    # After the due date the instructor's usual steps find what the service recorded: the same
+    # scores in the formgrader, nothing graded again (the refused submission is not in inbound/).
     hub.coursehub("collect", ASSIGNMENT)
     hub.coursehub("grade", ASSIGNMENT)
     hub.coursehub("feedback", ASSIGNMENT)
-
-    xsrf = instructor.cookies.get("_xsrf", path=f"/user/{hub.instructor}/")
-    shown = instructor.get(f"{hub.url}/user/{hub.instructor}/formgrader/api/submissions/{ASSIGNMENT}",
-                           headers={"X-XSRFToken": xsrf}, timeout=60).json()
-    scores = {row["student"]: (row["score"], row["max_score"]) for row in shown}
-    # On failure, the grader's verdicts say which item cost the points.
-    assert scores[alice][0] == scores[alice][1] > 0, (shown, zoo.graded_outputs(hub.course_dir, alice, ASSIGNMENT)[-3000:])
-    assert 0 <= scores[bob][0] < scores[bob][1], (shown, zoo.graded_outputs(hub.course_dir, bob, ASSIGNMENT)[-3000:])
-
-    for user, page in pages.items():
-        _press(page, "submitted", "Fetch Feedback")
-    for user, page in pages.items():
-        other = bob if user == alice else alice
-        page.wait_for_function(
-            "() => [...document.querySelectorAll('#submitted_assignments_list .list_item')]"
-            ".some(row => row.innerText.includes('feedback'))", timeout=60_000)
-        SCREENSHOTS.mkdir(parents=True, exist_ok=True)
-        page.screenshot(path=str(SCREENSHOTS / f"hub_assignments_{'first' if user == alice else 'second'}.png"))
-        feedback = sorted((Path(f"/home/{user}") / ASSIGNMENT / "feedback").glob(f"*/{ASSIGNMENT}.html"))
-        assert len(feedback) == 1, f"{user} fetched {feedback}"
-        relative = feedback[0].relative_to(f"/home/{user}").as_posix()
-        page.goto(f"{hub.url}/user/{user}/files/{relative}", wait_until="domcontentloaded")
-        text = page.inner_text("body")
-        page.screenshot(path=str(SCREENSHOTS / f"hub_feedback_{'first' if user == alice else 'second'}.png"))
-        # nbgrader's feedback page of the student's own submission: their score, not the other's.
-        assert f"{ASSIGNMENT} (Score: {scores[user][0]:.1f} / {scores[user][1]:.1f})" in text, text[:500]
-        assert f"(Score: {scores[other][0]:.1f} / {scores[other][1]:.1f})" not in text, text[:500]
-        answer = page.goto(f"{hub.url}/user/{other}/lab", wait_until="domcontentloaded")
-        assert answer.status == 403 or f"/user/{other}/lab" not in page.url, (answer.status, page.url)
+    xsrf = sessions[hub.instructor].cookies.get("_xsrf", path=f"/user/{hub.instructor}/")
+    listed = sessions[hub.instructor].get(f"{hub.url}/user/{hub.instructor}/formgrader/api/submissions/{ASSIGNMENT}",
+                                          headers={"X-XSRFToken": xsrf}, timeout=60).json()
+    scores = {row["student"]: (row["score"], row["max_score"]) for row in listed}
+    assert scores[alice] == scores[bob] == (maximum, maximum), listed
+    with open(hub.course_dir / "grading_report.csv", newline="") as handle:
+        report = {row["student_id"]: row for row in csv.DictReader(handle)}
+    assert report[alice]["from_cache"] == report[bob]["from_cache"] == "1", report
+    for page in pages.values():
         page.context.close()
 
 
+#: Submissions handed in at once in the queue test, and while its service is down.
+AT_ONCE, WHILE_DOWN = 10, 2
+
+
+def _drop_in_inbound(hub, student: str, like: Path) -> str:
+    """A submission of `student` in the exchange's inbound/ as nbgrader's submit leaves it (the files
+    of `like`, a submitted folder; a time and secret of its own; the folder made 0777 last)."""
+    from datetime import datetime, timezone
+
+    from autograder.config import COURSE_ID
+
+    stamp = datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M:%S.%f %Z")
+    folder = hub.hub_dir / "exchange" / COURSE_ID / "inbound" / f"{student}+{ASSIGNMENT}+{stamp}+{secrets.token_hex(4)}"
+    shutil.copytree(like, folder, ignore=shutil.ignore_patterns("timestamp.txt", "submission_secret.txt"))
+    (folder / "timestamp.txt").write_text(stamp)
+    (folder / "submission_secret.txt").write_text(secrets.token_hex(64))
+    os.chmod(folder, 0o777)
+    return folder.name
+
+
+def _wait_until_gone(process, timeout: float = 60) -> None:
+    """Wait until `process` has ended (a zombie its parent has not reaped yet counts as ended)."""
+    import psutil
+
+    deadline = time.monotonic() + timeout
+    while True:
+        try:
+            if process.status() == psutil.STATUS_ZOMBIE:
+                return
+        except psutil.NoSuchProcess:
+            return
+        assert time.monotonic() < deadline, f"{process} still runs after {timeout:.0f} s"
+        time.sleep(0.1)
+
+
+def _queue_rows(hub, students) -> dict:
+    import sqlite3
+
+    with contextlib.closing(sqlite3.connect(hub.course_dir / "autograder" / "submit_queue.sqlite", timeout=30)) as db:
+        db.row_factory = sqlite3.Row
+        return {row["student"]: dict(row) for row in db.execute("SELECT * FROM submissions")
+                if row["student"] in students}
+
+
+def _wait_for_rows(hub, students, done, timeout: float = 300) -> dict:
+    deadline = time.monotonic() + timeout
+    while not done(rows := _queue_rows(hub, students)):
+        assert time.monotonic() < deadline, (rows, hub.log_tail())
+        time.sleep(0.25)
+    return rows
+
+
+def test_submissions_at_once_are_each_graded_once_across_a_kill_of_the_service(hub):
+    """Many submissions of one content at once (alice's, graded in the browser test: cheap), the
+    service killed with SIGKILL mid-queue, more submitted while it is down: when the hub has
+    restarted it, each is graded exactly once, with the score a plain grade run gives."""
+    from nbgrader.utils import notebook_hash
+
+    from autograder import store
+    from autograder.config import COURSE_ID
+
+    alice = hub.students[0]
+    like = hub.course_dir / "submitted" / alice / ASSIGNMENT
+    graded = store.recorded_results(hub.course_dir, ASSIGNMENT, alice)[0]
+    students = [f"{hub.instructor[:-1]}q{n:02d}" for n in range(AT_ONCE + WHILE_DOWN)]
+    service = grading_service(hub)
+    for student in students[:AT_ONCE]:
+        _drop_in_inbound(hub, student, like)
+    at_kill = _wait_for_rows(hub, students, lambda rows: any(r["state"] in ("graded", "released") for r in rows.values()))
+    service.kill()
+    _wait_until_gone(service)
+    left = [s for s, r in _queue_rows(hub, students).items() if r["state"] in ("queued", "grading", "graded")]
+    assert left, f"every submission was done before the kill: {at_kill}"
+    for student in students[AT_ONCE:]:  # handed in while the service is down
+        _drop_in_inbound(hub, student, like)
+    assert grading_service(hub, timeout=180).pid != service.pid  # the hub restarts it
+
+    rows = _wait_for_rows(hub, students, lambda rows: len(rows) == len(students) and all(
+        r["state"] == "released" for r in rows.values()))
+    for student, row in rows.items():
+        # Graded once each; the content was graded before (alice's), so no grading ran again.
+        assert row["gradings"] == 1 and row["reused_from"] is not None, row
+        assert (row["score"], row["max_score"]) == (graded.score, graded.max_score), row
+        with open(hub.course_dir / "feedback" / student / ASSIGNMENT / "submission_secret.txt") as handle:
+            checksum = notebook_hash(secret=handle.read(), notebook_id=ASSIGNMENT)
+        assert (hub.hub_dir / "exchange" / COURSE_ID / "feedback" / f"{checksum}.html").is_file(), student
+    # The instructor's plain grade run of one of them, from scratch, gives the same scores.
+    service_cells = store.recorded_results(hub.course_dir, ASSIGNMENT, students[0])[0].cells
+    hub.coursehub("grade", ASSIGNMENT, "--student", students[0], "--force")
+    plain = store.recorded_results(hub.course_dir, ASSIGNMENT, students[0])[0]
+    assert not plain.from_cache and plain.score == graded.score, plain
+    assert [c["auto_score"] for c in plain.cells] == [c["auto_score"] for c in service_cells], (plain.cells, service_cells)
+
+
 def test_stopping_the_hub_stops_every_process_of_the_course(hub):
+    service = grading_service(hub)
     namespaces = set()
     for process in course_processes(hub):
         try:
@@ -231,3 +413,4 @@ def test_stopping_the_hub_stops_every_process_of_the_course(hub):
     while (left := course_processes(hub, namespaces)) and time.monotonic() < deadline:
         time.sleep(0.2)
     assert not left, [(p.pid, p.info) for p in left]
+    _wait_until_gone(service)  # the grading service (root) stops with the hub

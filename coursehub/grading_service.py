@@ -1,0 +1,197 @@
+"""The hub's grading service: graded feedback minutes after Submit (``python -m
+coursehub.grading_service``, a JupyterHub-managed service: the hub starts it as root with itself,
+restarts it when it dies, and stops it when the hub stops).
+
+For the assignments the course's nbgrader_config.py names (``c.GradeOnSubmit.assignments``,
+autograder.config), it
+
+- looks at the exchange's inbound/ every second and queues each new, complete submission
+  (coursehub.inbound; the queue autograder.submit_queue is durable, so a submission that arrives
+  while the service is down, or one it was grading when killed, is graded when it is back);
+- grades the queue in arrival order, one submission per worker (coursehub.grading_job.grade);
+- writes and releases the feedback of what was graded (coursehub.grading_job.release), so that
+  Fetch Feedback in the student's Assignments panel shows it;
+- serves each student the state of their submissions (coursehub.grading_status), and publishes
+  the attempts and due dates for the Submit of the students' servers (coursehub.limited_submit).
+
+After the due date the instructor's usual collect, grade and feedback steps (coursehub.instructor)
+find the service's results in the gradebook and the grader's records and give the final grades.
+"""
+
+from __future__ import annotations
+
+import argparse
+import itertools
+import os
+import sys
+import threading
+import time
+import traceback
+from pathlib import Path
+
+from autograder import config
+from autograder.release import assignments_in
+from autograder.submit_queue import SubmitQueue
+from coursehub import course as course_settings
+from coursehub import grading_job, inbound, limited_submit
+
+#: Seconds before the feedback that could not be released is tried again.
+RETRY_SECONDS = 30.0
+#: Seconds the feedback of a grading waits for the next one while the workers are busy.
+BATCH_SECONDS = 2.0
+#: Seconds between two publications of the rules for the students' servers (the due dates change
+#: in the gradebook, which is not read every second).
+PUBLISH_SECONDS = 30.0
+
+
+def _log(text: str) -> None:
+    print(f"coursehub.grading_service: {text}", file=sys.stderr, flush=True)
+
+
+class Service:
+    """The threads of the service: one looks at inbound/, `workers` grade, one releases feedback."""
+
+    def __init__(self, course, workers: int = config.SUBMIT_WORKERS, poll_seconds: float = config.SUBMIT_POLL_SECONDS,
+                 rules_file: Path | None = None):
+        """`rules_file`: where the students' servers read the attempts and due dates
+        (coursehub.limited_submit); None: not published."""
+        self.course, self.workers, self.poll_seconds, self.rules_file = course, workers, poll_seconds, rules_file
+        self.queue = SubmitQueue(course.course_dir)
+        self.stopping = threading.Event()
+        self.queued = threading.Semaphore(0)  # one release per row queued (and per recovered row)
+        self.graded = threading.Event()
+        self._rules, self._rules_read = {}, None
+
+    def start(self) -> None:
+        recovered = self.queue.recover()
+        if recovered:
+            _log(f"{recovered} submission(s) whose grading was cut short are queued again")
+        for _ in range(len([r for r in self.queue.all() if r.state == "queued"])):
+            self.queued.release()
+        self.graded.set()  # feedback left unreleased by a stop is released now
+        threads = [threading.Thread(target=self._look, name="grading-inbound", daemon=True),
+                   threading.Thread(target=self._release, name="grading-feedback", daemon=True)]
+        threads += [threading.Thread(target=self._grade, name=f"grading-worker-{n}", daemon=True)
+                    for n in range(self.workers)]
+        for thread in threads:
+            thread.start()
+
+    def rules(self) -> dict[str, config.SubmitRules]:
+        """The assignments graded on submission, read again when nbgrader_config.py changes."""
+        path = self.course.course_dir / "nbgrader_config.py"
+        stamp = path.stat().st_mtime_ns
+        if stamp != self._rules_read:
+            try:
+                self._rules = config.submit_rules(config.load(self.course.course_dir),
+                                                  assignments_in(self.course.course_dir))
+            except ValueError as error:
+                _log(f"{error} Grading on submission waits until it is corrected.")
+                self._rules = {}
+            self._rules_read = stamp
+            self.publish()
+        return self._rules
+
+    def publish(self) -> None:
+        """The attempts and due dates for the students' servers' Submit (coursehub.limited_submit)."""
+        if self.rules_file is not None:
+            due = {name: grading_job.duedate(self.course.course_dir, name) for name in self._rules}
+            limited_submit.write_rules(self.rules_file, {
+                name: {"attempts": rule.attempts, "duedate": f"{due[name]} UTC" if due[name] else None}
+                for name, rule in self._rules.items()})
+
+    def look_once(self) -> int:
+        """Queue the new complete submissions of assignments graded on submission; return how many."""
+        rules = self.rules()
+        folder = inbound.inbound(self.course.exchange, self.course.course_id)
+        entries = [e for e in inbound.new_entries(folder, self.queue.known()) if e.assignment in rules]
+        for entry in entries:
+            row = self.queue.add(entry.name, entry.student, entry.assignment, entry.submitted,
+                                 rules[entry.assignment].attempts,
+                                 grading_job.duedate(self.course.course_dir, entry.assignment))
+            if row.state == "refused":
+                inbound.set_aside(entry, self.course.course_dir)
+                _log(f"refused {entry.name}: {row.message}")
+            else:
+                self.queued.release()
+        return len(entries)
+
+    def _look(self) -> None:
+        published = time.monotonic()
+        while not self.stopping.is_set():
+            try:
+                self.look_once()
+                if time.monotonic() - published > PUBLISH_SECONDS:
+                    self.publish()
+                    published = time.monotonic()
+            except Exception:  # noqa: BLE001 - logged; the next look tries again
+                _log(f"could not read the inbound submissions:\n{traceback.format_exc()}")
+            self.stopping.wait(self.poll_seconds)
+
+    def _grade(self) -> None:
+        while not self.stopping.is_set():
+            if not self.queued.acquire(timeout=self.poll_seconds):
+                continue
+            row = self.queue.claim()
+            if row is None:  # superseded meanwhile
+                continue
+            try:
+                grading_job.grade(self.course, self.queue, row)
+            except Exception:  # noqa: BLE001 - not the student's fault: the instructor's grade run takes it
+                _log(f"could not grade {row.entry}:\n{traceback.format_exc()}")
+                self.queue.failed(row.id, "the grading service ran into an error.")
+            self.graded.set()
+
+    def _release(self) -> None:
+        while not self.stopping.is_set():
+            if not self.graded.wait(self.poll_seconds):
+                continue
+            self.graded.clear()
+            # Quick gradings in a row (the same content handed in by many) make one batch: a batch
+            # costs about a second of processor time whatever its size. A lone one waits not.
+            deadline = time.monotonic() + BATCH_SECONDS
+            while self.queue.busy() and time.monotonic() < deadline and not self.stopping.is_set():
+                self.stopping.wait(0.2)
+            rows = self.queue.waiting_for_feedback()
+            for assignment, group in itertools.groupby(sorted(rows, key=lambda r: r.assignment),
+                                                       key=lambda r: r.assignment):
+                group = list(group)
+                try:
+                    rules = self.rules().get(assignment, config.SubmitRules())
+                    due = grading_job.duedate(self.course.course_dir, assignment)
+                    grading_job.release(self.course, assignment, group, grading_job.scores_only(rules, due))
+                    self.queue.released([r.id for r in group])
+                except Exception:  # noqa: BLE001 - logged; the scores are recorded, the next round tries again
+                    _log(f"could not release the feedback of {assignment} (trying again in "
+                         f"{RETRY_SECONDS:g} s):\n{traceback.format_exc()}")
+                    self.stopping.wait(RETRY_SECONDS)
+                    self.graded.set()
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m coursehub.grading_service", description=__doc__.split("\n")[0])
+    parser.add_argument("--hub-dir", type=Path, default=Path(os.environ.get("COURSEHUB_HUB_DIR",
+                                                                           course_settings.DEFAULT_HUB_DIR)))
+    parser.add_argument("--workers", type=int, default=config.SUBMIT_WORKERS)
+    args = parser.parse_args(argv)
+    from tornado import ioloop
+
+    from coursehub import grading_status
+
+    course = course_settings.load(args.hub_dir)
+    service = Service(course, workers=max(1, args.workers),
+                      rules_file=course.submit_rules)
+    service.start()
+    prefix = os.environ.get("JUPYTERHUB_SERVICE_PREFIX", "/services/grading/")
+    grading_status.application(service.queue, prefix).listen(course.grading_port, "127.0.0.1")
+    _log(f"grading {', '.join(service.rules()) or 'nothing yet (c.GradeOnSubmit.assignments)'} on submission; "
+         f"status at {prefix} (127.0.0.1:{course.grading_port})")
+    try:
+        ioloop.IOLoop.current().start()
+    except KeyboardInterrupt:  # the hub stops its services with SIGINT
+        pass
+    service.stopping.set()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
