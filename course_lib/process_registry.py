@@ -16,7 +16,14 @@ from pathlib import Path
 
 
 def _folder() -> Path:
-    return Path(tempfile.gettempdir()) / f"course_lib-running-{os.getuid()}"
+    """The notes of this user's processes in this process-id namespace. Process ids mean something
+    only in their own namespace: a process in the grader's sandbox (a namespace of its own, with
+    /tmp shared) would take every note of the machine's for one of a process that has ended."""
+    try:
+        namespace = os.readlink("/proc/self/ns/pid").strip("pid:[]")
+    except OSError:
+        namespace = "unknown"
+    return Path(tempfile.gettempdir()) / f"course_lib-running-{os.getuid()}-{namespace}"
 
 
 def _alive(pid) -> bool:

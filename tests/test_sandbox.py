@@ -178,3 +178,23 @@ def _group_of(pid: str) -> int | None:
             return int(handle.read().rsplit(")", 1)[1].split()[2])
     except (OSError, IndexError, ValueError):
         return None
+
+
+@needs_namespaces
+def test_a_process_in_the_sandbox_leaves_the_notes_of_the_machines_named_processes_alone():
+    """course_lib.process_registry's notes hold process ids: the sandbox's own process-id namespace
+    must not take a running process of the machine for one that has ended and delete its note
+    (a clean-clone run lost lesson 02's camera note so, and lesson 03 then did not name it)."""
+    from course_lib import process_registry
+
+    process_registry.record("registry_probe", 7, os.getpid())
+    try:
+        done = _inside("from course_lib import process_registry\n"
+                       "print(process_registry.started_elsewhere('registry_probe', 7))\n",
+                       env={"PYTHONPATH": str(Path(__file__).resolve().parents[1])})
+        assert (done.returncode, done.stdout) == (0, "[]\n"), done.stderr
+        assert [e["pid"] for e in process_registry.started_elsewhere("registry_probe", 7)] == []  # own
+        notes = list(process_registry._folder().glob(f"{os.getpid()}.json"))
+        assert len(notes) == 1, "the sandboxed process deleted the machine's note"
+    finally:
+        process_registry.forget(os.getpid())
