@@ -6,9 +6,8 @@ from course_lib.ros2cli.common import (
     DEFAULT_SPIN_TIME,
     Verb,
     print_names,
-    print_types,
+    print_types_of,
     run_group,
-    wait_for_name,
     wait_for_whole_graph,
     wait_until,
 )
@@ -44,11 +43,7 @@ def _type_arguments(parser) -> None:
 
 
 def _type(args) -> int:
-    def kinds() -> list[str]:
-        return next((kinds for name, kinds in action_pairs() if name == args.action_name), [])
-
-    wait_for_name(lambda: bool(kinds()), DEFAULT_SPIN_TIME)
-    return print_types(kinds())
+    return print_types_of(args.action_name, action_pairs, DEFAULT_SPIN_TIME)
 
 
 # --- ros2 action info --------------------------------------------------------------------

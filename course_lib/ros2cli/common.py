@@ -119,6 +119,21 @@ def print_types(kinds: list[str]) -> int:
     return 0 if kinds else 1
 
 
+def print_types_of(name: str, pairs: typing.Callable[[], list[tuple[str, list[str]]]], spin_time: float) -> int:
+    """ros2cli's type verbs (topic, service, action): wait until `name` shows among the (name,
+    [type, ...]) `pairs()` or discovery has settled (wait_for_name), then print_types of it."""
+    def kinds() -> list[str]:
+        return dict(pairs()).get(name, [])
+
+    wait_for_name(lambda: bool(kinds()), spin_time)
+    return print_types(kinds())
+
+
+def print_names_of_type(pairs: list[tuple[str, list[str]]], type_name: str, count: bool) -> None:
+    """ros2cli's find verbs: the names whose types include `type_name`, or how many (-c)."""
+    print_names([(name, kinds) for name, kinds in pairs if type_name in kinds], False, count)
+
+
 # --- discovery ----------------------------------------------------------------------------
 
 def add_discovery_arguments(parser: argparse.ArgumentParser, daemon: bool = True) -> None:

@@ -9,7 +9,8 @@ from course_lib.ros2cli.common import (
     Verb,
     add_discovery_arguments,
     print_names,
-    print_types,
+    print_names_of_type,
+    print_types_of,
     run_group,
     wait_for_name,
     wait_for_whole_graph,
@@ -58,13 +59,8 @@ def _type_arguments(parser) -> None:
 
 
 def _type(args) -> int:
-    def kinds() -> list[str]:
-        return next((kinds for name, kinds in service_pairs(args.include_hidden_services)
-                     if name == args.service_name), [])
-
     # Like ros2service: an unknown service prints nothing and ends with exit code 1.
-    wait_for_name(lambda: bool(kinds()), DEFAULT_SPIN_TIME)
-    return print_types(kinds())
+    return print_types_of(args.service_name, lambda: service_pairs(args.include_hidden_services), DEFAULT_SPIN_TIME)
 
 
 # --- ros2 service find -------------------------------------------------------------------
@@ -79,12 +75,7 @@ def _find_arguments(parser) -> None:
 
 def _find(args) -> None:
     wait_for_whole_graph(DEFAULT_SPIN_TIME)
-    names = [name for name, kinds in service_pairs(args.include_hidden_services) if args.service_type in kinds]
-    if args.count_services:
-        print(len(names))
-    else:
-        for name in names:
-            print(name)
+    print_names_of_type(service_pairs(args.include_hidden_services), args.service_type, args.count_services)
 
 
 # --- ros2 service call -------------------------------------------------------------------

@@ -11,7 +11,8 @@ from course_lib.ros2cli.common import (
     add_qos_arguments,
     loop_limit,
     print_names,
-    print_types,
+    print_names_of_type,
+    print_types_of,
     qos_from_arguments,
     qos_overridden,
     run_group,
@@ -327,11 +328,9 @@ def _type_arguments(parser) -> None:
 def _type(args) -> int:
     from course_lib import graph
 
-    def kinds() -> list[str]:
-        return dict(graph.topic_list(types=True, include_hidden=args.include_hidden_topics)).get(args.topic_name, [])
-
-    wait_for_name(lambda: bool(kinds()), args.spin_time)
-    return print_types(kinds())
+    return print_types_of(args.topic_name,
+                          lambda: graph.topic_list(types=True, include_hidden=args.include_hidden_topics),
+                          args.spin_time)
 
 
 def _find_arguments(parser) -> None:
@@ -345,9 +344,8 @@ def _find(args) -> None:
     from course_lib import graph
 
     wait_for_whole_graph(args.spin_time)
-    names = [name for name, kinds in graph.topic_list(types=True, include_hidden=args.include_hidden_topics)
-             if args.topic_type in kinds]
-    print(len(names) if args.count_topics else "\n".join(names), end="\n" if args.count_topics or names else "")
+    print_names_of_type(graph.topic_list(types=True, include_hidden=args.include_hidden_topics), args.topic_type,
+                        args.count_topics)
 
 
 # --- ros2 topic info ---------------------------------------------------------------------
