@@ -29,6 +29,9 @@ from course_lib import contract
 
 #: The folder in the grader's work folder that the early build and checks run in.
 FOLDER = "early"
+#: How many times the grading's budget outcome_for waits for the early run at most: a backstop for
+#: a hang of the thread itself, never reached while its steps keep their own limits.
+EARLY_BACKSTOP = 2.0
 
 
 class EarlyRun:
@@ -100,17 +103,18 @@ class EarlyRun:
 
     def outcome_for(self, workdir: Path, names: list[str]):
         """The early (build variables, verdicts of `names`) when the notebook's run left `workdir`
-        with exactly the predicted files, else None (the early run is then stopped). Waits for the
-        early run to end, at most until the grading's deadline."""
+        with exactly the predicted files, else None (the early run is then stopped).
+
+        Waits for the early run to end, however long past the grading's deadline: its build and
+        checks are bounded by their own limits, and the verdicts are the same ones the grader would
+        get by building and checking now, with less of the budget left. (Giving up at the deadline
+        made a busy machine's grading build and check again with a second left: the verdict then
+        depended on the load.) EARLY_BACKSTOP only guards against a thread that hangs."""
         same = notebook_writes.folder_digest(workdir) == self.digest if Path(workdir).is_dir() else False
         if not same:
             self.cancel()
             return None
-        while self._thread.is_alive():  # the deadline moves back when the build was a cold one
-            left = self.g.deadline - time.monotonic()
-            if left <= 0:
-                break
-            self._thread.join(min(left, 0.5))
+        self._thread.join(EARLY_BACKSTOP * self.g.budget)
         if self._thread.is_alive():
             self.cancel()
             return None

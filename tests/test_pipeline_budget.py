@@ -4,10 +4,12 @@ share says how long it was given (issue #14)."""
 from __future__ import annotations
 
 import sys
+import threading
 import time
 
 from autograder import pipeline, report
 from autograder.result import GradeResult
+from autograder.submissions import Submission
 from course_lib import contract, processes
 
 
@@ -74,3 +76,25 @@ def test_the_grader_tells_the_checks_its_load_factor(tmp_path):
     g = pipeline.Grading(sub, tmp_path, 0, GradeResult("s", "brightness", ""), tmp_path, budget=150.0)
     pipeline.choose_environment(g)
     assert g.env[contract.LOAD_FACTOR_ENV] == "2.50"
+
+
+def test_an_early_run_still_going_at_the_deadline_is_waited_for_not_dropped(tmp_path, monkeypatch):
+    """On a machine busier than the budget allows for, the notebook can end while the early build
+    and checks are past the grading's deadline: their verdicts are waited for (their steps bound
+    themselves), not dropped for a build and checks again with a second left."""
+    from autograder import early_checks, hidden_checks, notebook_writes
+
+    building = threading.Event()
+
+    def build(g, folder, run, early):
+        building.wait(10)  # a build still running when the deadline passes
+        return {"BUILT": "1"}
+
+    monkeypatch.setattr(hidden_checks, "run_checks", lambda sub, names, *args, **kwargs: dict.fromkeys(names, "verdict"))
+    sub = Submission("s", "brightness", tmp_path)
+    g = pipeline.Grading(sub, None, 0, GradeResult("s", "brightness", ""), tmp_path, deadline=time.monotonic() - 1)
+    early = early_checks.EarlyRun(g, ["values"], build)
+    early.digest = notebook_writes.folder_digest(tmp_path)  # the notebook wrote what was predicted
+    early._thread.start()
+    threading.Timer(0.5, building.set).start()
+    assert early.outcome_for(tmp_path, ["values"]) == ({"BUILT": "1"}, {"values": "verdict"})
