@@ -2,7 +2,7 @@
 
 One module-scoped grading run (2 workers) is shared by the tests: release the brightness and
 pubsub assignments into a fresh course directory, hand in the zoo (tests/zoo/brightness.py: the
-reference solution, typical mistakes and hostile submissions; tests/zoo/pubsub.py: mistakes in the
+reference solution with a hostile cell, and hostile submissions; tests/zoo/pubsub.py: mistakes in the
 packages), grade, and check each grade, its reason (for the package mistakes on the feedback
 page), the submitted files, leftover processes, and a second (cached) run.
 """
@@ -25,7 +25,7 @@ import zoo  # noqa: E402
 from zoo import brightness as brightness_zoo  # noqa: E402
 from zoo import pubsub as pubsub_zoo  # noqa: E402
 
-# The shared grading run (about 15 submissions, 2 workers) happens in the first test's set-up.
+# The shared grading run (nine submissions, 2 workers) happens in the first test's set-up.
 pytestmark = [pytest.mark.slow, pytest.mark.timeout(1500)]
 
 
@@ -107,9 +107,10 @@ def test_package_mistake_is_graded_down_with_its_reasons_on_the_feedback_page(gr
         assert reason in page, (reason, outputs[-3000:])
 
 
-def test_reference_solution_gets_full_marks(graded):
-    """The reference solution, graded next to hostile submissions, gets every point."""
-    result = graded["results"]["full"]
+def test_reference_solution_gets_full_marks_beside_its_own_hostile_cell(graded):
+    """The reference solution with a hostile cell, graded next to hostile submissions, gets every
+    point: what the cell tries changes nothing."""
+    result = graded["results"]["hostile"]
     assert (result.score, result.max_score) == (11, 11)
 
 

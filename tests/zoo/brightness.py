@@ -119,7 +119,8 @@ def entries(course_dir: str) -> dict[str, dict]:
     mistakes in the module only: tests/test_autograder.py runs the checks on them directly (no
     nbgrader run), which is much cheaper; the rest go through the parallel nbgrader zoo run."""
     return {
-        "full": dict(edits=[], values=4, node=7, reason=THROUGHPUT_VERDICT),
+        # The reference solution with a hostile cell (tests/test_autograder_zoo.py): every point. It
+        # is the brightness reference's run through the whole pipeline in the suite.
         "hostile": dict(edits=[hostile(course_dir)], values=4, node=7, reason="NETWORK: blocked"),
         "float_mean": dict(level="check", edits=[(SUM, "return image.mean()")], values=0, node=None,
                            reason="the contract asks for an int"),
