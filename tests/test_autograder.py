@@ -65,7 +65,8 @@ def test_cell_timeouts_give_graded_cells_longer_and_grow_with_the_load_factor(mo
     """Graded cells get the long timeout, every other cell the short one; both, and the kernel's
     start-up timeout, times the grader's load factor (as the notebook's wall time): a busy machine
     must not cut a cell that runs right (a clean-clone run at load 70 failed a submission whose
-    kernel took longer than nbclient's fixed 60 s to start)."""
+    kernel took longer than nbclient's fixed 60 s to start, and at load 40-60 one whose interrupted
+    cell's last output came later than nbclient's fixed 4 s after its reply)."""
     from traitlets.config import Config
 
     graded = nbformat.v4.new_code_cell("x", metadata={"nbgrader": {"grade": True, "solution": False}})
@@ -76,6 +77,7 @@ def test_cell_timeouts_give_graded_cells_longer_and_grow_with_the_load_factor(mo
         c = Config()
         validate.apply_student(c)
         assert c.Execute.startup_timeout == round(factor * validate.STARTUP_TIMEOUT)
+        assert c.Execute.iopub_timeout == round(factor * validate.IOPUB_TIMEOUT)
 
 
 def test_sandbox_hides_directories_and_keeps_the_command():

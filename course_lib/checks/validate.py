@@ -21,6 +21,12 @@ TEST_CELL_TIMEOUT = 150
 #: Seconds nbclient waits for the kernel to start (nbclient's own default).
 STARTUP_TIMEOUT = 60
 
+#: Seconds nbclient waits, once a cell's reply has come, for the rest of its output and the
+#: kernel's idle status (nbclient's default is 4). nbgrader makes running out of it fail the whole
+#: notebook; a cell interrupted at its timeout (a loop at import) leaves IPython a traceback to
+#: format, which at a load of 40-60 on two cores took longer than 4 s: the submission failed.
+IOPUB_TIMEOUT = 10
+
 
 def scaled(seconds: float) -> int:
     """`seconds` on an idle machine, times the load factor (course_lib.checks.context.scaled: the
@@ -53,4 +59,5 @@ def apply_student(c) -> None:
     c.Execute.timeout = scaled(TEST_CELL_TIMEOUT)
     c.Execute.timeout_func = cell_timeout
     c.Execute.startup_timeout = scaled(STARTUP_TIMEOUT)
+    c.Execute.iopub_timeout = scaled(IOPUB_TIMEOUT)
     c.Execute.interrupt_on_timeout = True
