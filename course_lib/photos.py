@@ -78,7 +78,7 @@ def draw_photo(seed: int = 0, size: tuple[int, int] = (400, 300), corners: str |
     corner_rng = np.random.default_rng(np.random.SeedSequence([_seed_entropy(seed)[0], 556]))
     if kinds == "any":
         kinds = [CORNER_KINDS[int(i)] for i in corner_rng.integers(0, len(CORNER_KINDS), 4)]
-    for (cx, cy), kind in zip(((0, 0), (width, 0), (width, height), (0, height)), kinds):
+    for (cx, cy), kind in zip(((0, 0), (width, 0), (width, height), (0, height)), kinds, strict=True):
         # The corner's kind covers a seeded quarter-disc of the picture and fades out beyond it.
         reach = corner_rng.uniform(0.2, 0.5) * width
         distance = np.hypot(x[None, :] * width - cx, y[:, None] * height - cy) / reach

@@ -109,7 +109,7 @@ def sessions(hub):
     """Everyone logged in over HTTP at once (three servers start side by side): user -> session."""
     users = [hub.instructor, *hub.students]
     with concurrent.futures.ThreadPoolExecutor(len(users)) as pool:
-        return dict(zip(users, (session for session, _ in pool.map(lambda user: log_in(hub, user), users))))
+        return dict(zip(users, (session for session, _ in pool.map(lambda user: log_in(hub, user), users)), strict=True))
 
 
 @pytest.fixture(scope="module")
@@ -174,7 +174,7 @@ def test_talkers_in_two_students_kernels_on_one_domain_never_hear_each_other(hub
     with concurrent.futures.ThreadPoolExecutor(2) as pool:
         said = dict(zip((alice, bob), pool.map(
             lambda user: run_in_kernel(hub, sessions[user], user, TALKER.format(
-                me=user, seconds=6, private=private[user], hidden=hidden)), (alice, bob))))
+                me=user, seconds=6, private=private[user], hidden=hidden)), (alice, bob)), strict=True))
     for user in (alice, bob):
         assert f"heard ['{user}']" in said[user], said
         for path in private[user]:
@@ -236,7 +236,7 @@ def test_students_get_graded_feedback_minutes_after_submit_and_only_their_own(hu
         wait_for_assignment(page, "fetched", ASSIGNMENT, 60)
     # Each student's page of the grading service, behind the hub's login (HubOAuth); closed while
     # the test looks through the same login with requests (a page open reloads itself every 2 s).
-    for user, page in pages.items():
+    for page in pages.values():
         status = page.context.new_page()
         status.goto(f"{hub.url}/services/grading/", wait_until="domcontentloaded")
         assert "No submission yet" in status.inner_text("body"), status.url

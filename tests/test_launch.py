@@ -171,7 +171,7 @@ def parameters_of(node_name: str, names: list[str]) -> dict:
         assert client.wait_for_service(timeout_sec=60), f"{node_name}/get_parameters did not appear"
         future = client.call_async(GetParameters.Request(names=names))
         assert session.wait_for(future.done, timeout=60), f"{node_name} did not answer get_parameters"
-        return {name: parameter_value_to_python(value) for name, value in zip(names, future.result().values)}
+        return {name: parameter_value_to_python(value) for name, value in zip(names, future.result().values, strict=True)}
     finally:
         node.destroy_client(client)
 

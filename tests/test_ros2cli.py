@@ -213,7 +213,7 @@ def test_topic_hz_prints_rates_until_ctrl_c(live):
         hz.kill()
         hz.wait()
     reports = []
-    for average, spread in zip(lines[::2], lines[1::2]):
+    for average, spread in zip(lines[::2], lines[1::2], strict=True):
         assert re.fullmatch(r"average rate: \d+\.\d{3}\n", average), lines
         found = re.fullmatch(r"\tmin: (\d+\.\d{3})s max: (\d+\.\d{3})s std dev: \d+\.\d{5}s window: (\d+)\n", spread)
         assert found, lines

@@ -123,7 +123,7 @@ def _check_scene(ctx, label: str, scene, outcome, show: bool = False) -> None:
 def _run_scenes(ctx, cases, show_first: bool = True) -> None:
     outcomes = ctx.call("crop_pictures", [((scene.frame,), {"size": list(SIZE)}) for _, scene in cases],
                         labels=[f"'{label}'" for label, _ in cases])
-    for index, ((label, scene), outcome) in enumerate(zip(cases, outcomes)):
+    for index, ((label, scene), outcome) in enumerate(zip(cases, outcomes, strict=True)):
         _check_scene(ctx, label, scene, outcome, show=show_first and index == 0)
 
 
@@ -141,7 +141,7 @@ def hard(ctx: Context) -> None:
     from course_lib import scenes
 
     cases = []
-    for attempt in range(40):  # two scenes that show a whole picture, then one of any kind
+    for _attempt in range(40):  # two scenes that show a whole picture, then one of any kind
         seed = _seed(ctx)
         if len(cases) < 2 and not scenes.framed_from(scenes.scene_pose(seed, difficulty="hard")):
             continue  # no picture can be whole in view: drawing the scene would be wasted
@@ -169,7 +169,7 @@ def missing_and_none(ctx: Context) -> None:
     noise = ctx.rng.integers(0, 256, size=(480, 640, 3), dtype=np.uint8)
     outcomes = ctx.call("crop_pictures", [((scene.frame,), {"size": list(SIZE)}) for _, scene in cases]
                         + [((noise,), {"size": list(SIZE)})], labels=[f"'{label}'" for label, _ in cases] + ["noise"])
-    for (label, scene), outcome in zip(cases, outcomes):
+    for (label, scene), outcome in zip(cases, outcomes[:-1], strict=True):
         _check_scene(ctx, label, scene, outcome)
     outcome = outcomes[-1]
     ok = outcome.ok and outcome.value == {}

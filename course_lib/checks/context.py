@@ -234,7 +234,7 @@ class Context:
         labels = labels or [f"input {index + 1}" for index in range(len(calls))]
         server = self.servers.server(self._students, self.module_root, None)
         outcomes = []
-        for (args, kwargs), label in zip(calls, labels):
+        for (args, kwargs), label in zip(calls, labels, strict=True):
             with server.lock:  # the checks of a grading share the server: one may have seen a hang
                 if function in self.servers.hung:
                     outcomes.append(Outcome(error=f"not run: {self.servers.hung[function]}"))

@@ -134,6 +134,27 @@ def _build_state(ws) -> Verdict | None:
     return None
 
 
+def _send_until_answered(probe, process, camera, msg, replies: list, expected: int) -> None:
+    """Publish the frame `msg` on `camera` until the node process answers (into `replies`) or ends;
+    when its first answer is missing or wrong, wait for a right answer or its end, as long as it
+    computes."""
+    from course_lib.checks.student_server import ProcessorTime
+
+    replies.clear()
+    for _ in range(6):  # sent again until answered: the first frames may come before discovery ends
+        camera.publish(msg)
+        if probe.spin_until(lambda: replies or not process.running(), 0.5):
+            break
+    if not replies or replies[0] != expected:
+        # A node that fails on a frame takes a moment to end (publish() with a numpy integer in
+        # UInt8.data even sends 255 before it raises), a busy machine's more: wait until it has
+        # ended, answered right, or waits for frames without answering (processor time, not a
+        # clock, tells).
+        idle = ProcessorTime(process)
+        probe.spin_until(lambda: (replies and replies[0] == expected) or not process.running()
+                         or idle.waiting(), 60.0)
+
+
 def _test_frames():
     """bgr8 frames 80 wide and 60 high whose centre pixels (row 30, column 40) differ, with what the exercise's
     node should answer for each: the first channel (blue) of the centre pixel."""
@@ -193,7 +214,6 @@ def _run_brightness_node(ws) -> Verdict:
 
     from course_lib import images, rosenv, workspace
     from course_lib.checks.probe import RosProbe
-    from course_lib.checks.student_server import ProcessorTime
 
     command = (f"ros2 run {BRIGHTNESS_PACKAGE} {BRIGHTNESS_EXECUTABLE} --ros-args -r /image:={CHECK_CAMERA_TOPIC}")
     with rosenv.reserve_domain_id() as reservation, RosProbe(reservation.domain_id) as probe:
@@ -253,20 +273,7 @@ def _run_brightness_node(ws) -> Verdict:
             probe.wait_for_subscriber(camera, 5.0)
             answers = []
             for frame, expected in _test_frames():
-                msg = images.image_to_msg(frame, "bgr8")
-                replies.clear()
-                for _ in range(6):  # sent again until answered: the first frames may come before discovery ends
-                    camera.publish(msg)
-                    if probe.spin_until(lambda: replies or not process.running(), 0.5):
-                        break
-                if not replies or replies[0] != expected:
-                    # A node that fails on a frame takes a moment to end (publish() with a numpy integer in
-                    # UInt8.data even sends 255 before it raises), a busy machine's more: wait until it has
-                    # ended, answered right, or waits for frames without answering (processor time, not a
-                    # clock, tells).
-                    idle = ProcessorTime(process)
-                    probe.spin_until(lambda: (replies and replies[0] == expected) or not process.running()
-                                     or idle.waiting(), 60.0)
+                _send_until_answered(probe, process, camera, images.image_to_msg(frame, "bgr8"), replies, expected)
                 if not process.running():
                     return _verdict(False, f"The node crashed on the first frame the check sent "
                                            f"({process.describe_exit()}).{_crash_text(process)}")

@@ -239,7 +239,7 @@ def task_picture_corners(function) -> Verdict:
                                            "picture_corners_of", hint, f"the {picture}")
             if problem is not None:
                 return problem
-            for place, marker_id, point, want in zip(places, marker_board.PICTURES[picture], answer, expected):
+            for place, marker_id, point, want in zip(places, marker_board.PICTURES[picture], answer, expected, strict=True):
                 if np.allclose(point, want, atol=1e-2):
                     continue
                 which = [(i, k) for i, corners in markers.items() for k in range(4)
