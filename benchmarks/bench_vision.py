@@ -367,7 +367,8 @@ def main(argv=None) -> int:
     if "c" in args.parts:
         print()
         print(f"(c) frames delivered to a best-effort subscriber in another process, 30 Hz; course set-up: "
-              f"{delivery['setup']}; LARGE_DATA: FASTDDS_BUILTIN_TRANSPORTS={SETUPS['LARGE_DATA']['FASTDDS_BUILTIN_TRANSPORTS']}")
+              f"{delivery['setup']}; LARGE_DATA: "
+              f"FASTDDS_BUILTIN_TRANSPORTS={SETUPS['LARGE_DATA']['FASTDDS_BUILTIN_TRANSPORTS']}")
         print()
         print(f"| frames | sender | sent ({' / '.join(SETUPS)}) | "
               + " | ".join(f"{name}: received of sent" for name in SETUPS) + " |")

@@ -132,7 +132,8 @@ def _corner_paint(rng: np.random.Generator, kind: str, width: int, height: int, 
         return np.float32(rng.uniform(50, 190)) + np.zeros(3, np.float32)
     if kind == "gradient":  # from one colour to another across the corner, at any angle
         angle = rng.uniform(0, 2 * np.pi)
-        xs, ys = np.meshgrid(np.arange(width, dtype=np.float32) - corner[0], np.arange(height, dtype=np.float32) - corner[1])
+        xs, ys = np.meshgrid(np.arange(width, dtype=np.float32) - corner[0],
+                             np.arange(height, dtype=np.float32) - corner[1])
         t = np.clip(0.5 + (xs * np.cos(angle) + ys * np.sin(angle)) / (2 * reach), 0, 1)[:, :, None]
         start, end = rng.uniform(0, 200, 3).astype(np.float32), rng.uniform(0, 255, 3).astype(np.float32)
         return start + t * (end - start)

@@ -77,7 +77,8 @@ def test_every_lesson_ends_with_a_summary_that_links_the_next_lesson_and_names_i
             assert f"]({following.name})" in last, f"{lesson.name} does not link {following.name}"
         else:
             assert "the last lesson" in last, lesson.name
-        assert re.search(r"[*`](pubsub|brightness|catdog_warp)[*`]|has none", last), f"{lesson.name} names no assignment"
+        assert re.search(r"[*`](pubsub|brightness|catdog_warp)[*`]|has none", last), (
+            f"{lesson.name} names no assignment")
 
 
 def test_lesson_02_exercise_uses_the_names_its_self_check_and_the_brightness_assignment_use():

@@ -36,7 +36,8 @@ def test_a_notebook_stopped_at_its_share_names_the_seconds_given_and_the_cells_t
 
 
 def test_the_report_shows_where_the_time_went():
-    result = GradeResult("s", "a", "", steps={"stage_course_root": 0.01, "run_notebook": 5.43, "run_hidden_checks": 6.3})
+    result = GradeResult("s", "a", "",
+                         steps={"stage_course_root": 0.01, "run_notebook": 5.43, "run_hidden_checks": 6.3})
     assert report.step_seconds(result) == "run_notebook=5.4 run_hidden_checks=6.3"
 
 

@@ -103,7 +103,8 @@ def test_recreating_a_node_replaces_it_without_warning_and_keeps_the_graph_right
     session.start(domain_id=domain_id)
     old = session.add_node(Listener())
     new = session.add_node(Listener())
-    with pytest.raises(InvalidHandle, match="destruction was requested"):  # the old node was destroyed when the new one was created
+    # The old node was destroyed when the new one was created.
+    with pytest.raises(InvalidHandle, match="destruction was requested"):
         old.get_fully_qualified_name()
     assert session.nodes() == [new]
     subscribers = [endpoint.node for endpoint in graph.topic_info("/chatter").subscriptions]

@@ -60,7 +60,8 @@ def _test_images(rng: np.random.Generator) -> list[tuple[str, np.ndarray]]:
 def values(ctx: Context) -> None:
     """average_brightness returns the floor of the mean byte, as an int, for colour and grey images."""
     cases = _test_images(ctx.rng)
-    outcomes = ctx.call("average_brightness", [((image,), {}) for _, image in cases], labels=[label for label, _ in cases])
+    outcomes = ctx.call("average_brightness", [((image,), {}) for _, image in cases],
+                        labels=[label for label, _ in cases])
     for (label, image), outcome in zip(cases, outcomes, strict=True):
         expected = ctx.expected("average_brightness", image)
         mean = float(image.mean())
@@ -258,7 +259,7 @@ def _consequences(ctx, cause: str, done: int) -> None:
 
 @check(points=7, timeout=90)
 def node(ctx: Context) -> None:
-    """BrightnessNode: name brightness_node, /image -> /brightness with sensor-data QoS, bgr8 and mono8, 30 Hz at 1080p, remappable."""
+    """BrightnessNode: name brightness_node, /image -> /brightness with sensor-data QoS, bgr8 and mono8, 30 Hz at 1080p, remappable."""  # noqa: E501 (the check's description, one line: registry.check)
     # Every input is drawn first: what is drawn must not depend on how the run goes (the
     # self-check's answers were recorded for exactly these inputs).
     colour = [ctx.rng.integers(0, 256, size=(480, 640, 3), dtype=np.uint8) // int(d) for d in (1, 2, 3)]
@@ -448,8 +449,8 @@ def _throughput(ctx, probe, node, yardstick, publisher, replies, yardstick_repli
                                      and publisher.get_subscription_count() >= 2) or not yardstick.running(),
                             scaled(30.0)) \
             or not yardstick.running():
-        ctx.item(True, f"{label}: not measured, the grader's yardstick node did not start ({yardstick.describe_exit()}); "
-                       "not held against you", weight=2.0)
+        ctx.item(True, f"{label}: not measured, the grader's yardstick node did not start "
+                       f"({yardstick.describe_exit()}); not held against you", weight=2.0)
         return
     frames = [image_msgs.image_to_msg(i, "bgr8") for i in images]
     student, reference = CpuCost(), CpuCost()

@@ -204,7 +204,8 @@ class Context:
                                "(it writes your module)")
         if self.import_hung():
             raise StudentError(f"importing {self.module} did not finish in an earlier check: remove code that "
-                               "runs forever at import (loops, spin()) from the top level of the module; put it in main()")
+                               "runs forever at import (loops, spin()) from the top level of the module; put it in "
+                               "main()")
 
     def import_hung(self) -> bool:
         """Whether importing the student's module did not finish in an earlier check of this grading."""

@@ -119,8 +119,8 @@ def publisher(ctx: Context) -> None:
             types = dict(probe.node.get_topic_names_and_types())
             if not probe.spin_until(lambda: len(messages) > 0 or not proc.running(), scaled(5.0)):
                 types = dict(probe.node.get_topic_names_and_types())
-                ctx.item(False, f"nothing arrived on {TOPIC} within {scaled(5):.0f} s (topics: "
-                                f"{ {t: v for t, v in types.items() if not t.startswith('/rosout') and not t.startswith('/parameter')} }); "
+                shown = {t: v for t, v in types.items() if not t.startswith(('/rosout', '/parameter'))}
+                ctx.item(False, f"nothing arrived on {TOPIC} within {scaled(5):.0f} s (topics: {shown}); "
                                 "publish tutorial_interfaces/msg/MsgTutorial on 'ros_tutorial_msg' from a 0.1 s timer")
                 return
             # Enough stamps for the rate: RATE_MESSAGES, or RATE_SPAN seconds of a slower publisher's.
@@ -130,7 +130,8 @@ def publisher(ctx: Context) -> None:
         proc.stop(timeout=2)
     types = types.get(TOPIC, [])
     wanted = ["tutorial_interfaces/msg/MsgTutorial"]
-    ctx.item(types == wanted, f"{TOPIC} carries {types}" + ("" if types == wanted else f"; the contract says {wanted[0]}"))
+    ctx.item(types == wanted,
+             f"{TOPIC} carries {types}" + ("" if types == wanted else f"; the contract says {wanted[0]}"))
     counters = [msg.data for msg in messages]
     steps = {b - a for a, b in pairwise(counters)}
     ctx.item(steps == {1}, f"data {counters[:4]}...{counters[-2:]}: " +
@@ -150,7 +151,7 @@ def publisher(ctx: Context) -> None:
 
 @check(points=3, timeout=90)
 def subscriber(ctx: Context) -> None:
-    """topic_subscriber: node topic_subscriber hears every MsgTutorial on ros_tutorial_msg and logs its stamp and data."""
+    """topic_subscriber: node topic_subscriber hears every MsgTutorial on ros_tutorial_msg and logs its stamp and data."""  # noqa: E501 (the check's description, one line: registry.check)
     proc = _start(ctx, "topic_subscriber")
     packages.use_interfaces(ctx)
     from tutorial_interfaces.msg import MsgTutorial

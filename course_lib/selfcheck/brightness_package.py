@@ -78,8 +78,8 @@ def _package_files(ws) -> Verdict | None:
         others = [name for name, target in scripts.items() if target == wanted]
         if others:
             return _verdict(False, f"setup.py calls the executable {others[0]!r}; `ros2 run {BRIGHTNESS_PACKAGE} "
-                                   f"{BRIGHTNESS_EXECUTABLE}` needs it to be called {BRIGHTNESS_EXECUTABLE!r} (the name "
-                                   "left of the = in console_scripts).")
+                                   f"{BRIGHTNESS_EXECUTABLE}` needs it to be called {BRIGHTNESS_EXECUTABLE!r} "
+                                   "(the name left of the = in console_scripts).")
         return _verdict(False, f"Not done yet: setup.py has no executable {BRIGHTNESS_EXECUTABLE}. Add an entry for "
                                "it to the list of 'console_scripts': 'executable = module:function', where the "
                                "module is the node file's (package folder, a dot, file name without .py) and the "
@@ -246,8 +246,8 @@ def _run_brightness_node(ws) -> Verdict:
             if CHECK_CAMERA_TOPIC not in subscriptions:
                 topic = next(iter(subscriptions))
                 return _verdict(False, f"Started with -r /image:={CHECK_CAMERA_TOPIC}, the node still subscribes "
-                                       f"{topic}: subscribe the topic 'image' and let the remap (-r /image:=...) choose "
-                                       "the camera's topic, instead of naming the camera's topic in the code.")
+                                       f"{topic}: subscribe the topic 'image' and let the remap (-r /image:=...) "
+                                       "choose the camera's topic, instead of naming the camera's topic in the code.")
             if subscriptions[CHECK_CAMERA_TOPIC] != ["sensor_msgs/msg/Image"]:
                 return _verdict(False, f"The subscription takes {subscriptions[CHECK_CAMERA_TOPIC][0]}; camera "
                                        "frames are sensor_msgs/msg/Image.")
@@ -279,8 +279,8 @@ def _run_brightness_node(ws) -> Verdict:
                                            f"({process.describe_exit()}).{_crash_text(process)}")
                 if not replies:
                     return _verdict(False, "The check sent frames on the remapped topic, but nothing came back on "
-                                           "/brightness, and the node waits for more: does on_image publish a UInt8 with the node's "
-                                           "publisher?")
+                                           "/brightness, and the node waits for more: does on_image publish a UInt8 "
+                                           "with the node's publisher?")
                 if replies[0] != expected:
                     return _verdict(False, f"For a frame 80 wide and 60 high whose centre pixel (row 30, column 40) is "
                                            f"(blue, green, red) = {tuple(int(v) for v in frame[30, 40])}, the node "
