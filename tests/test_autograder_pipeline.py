@@ -29,8 +29,8 @@ FULL_RUN_MISTAKES = {
 
 
 #: References graded through the whole pipeline here. Each assignment's reference goes through it
-#: once in the suite: brightness's in the zoo (tests/test_autograder_zoo.py, "hostile": with a hostile cell), pubsub's in
-#: the term (tests/test_term.py, alice), catdog_warp's here.
+#: once in the suite: brightness's in the zoo (tests/test_autograder_zoo.py, "hostile": with a
+#: hostile cell), pubsub's in the term (tests/test_term.py, alice), catdog_warp's here.
 FULL_RUN_REFERENCES = ["catdog_warp"]
 
 #: A last cell that rewrites the node module with Python instead of %%writefile: the grader

@@ -91,7 +91,8 @@ def test_an_early_run_still_going_at_the_deadline_is_waited_for_not_dropped(tmp_
         building.wait(10)  # a build still running when the deadline passes
         return {"BUILT": "1"}
 
-    monkeypatch.setattr(hidden_checks, "run_checks", lambda sub, names, *args, **kwargs: dict.fromkeys(names, "verdict"))
+    monkeypatch.setattr(hidden_checks, "run_checks",
+                        lambda sub, names, *args, **kwargs: dict.fromkeys(names, "verdict"))
     sub = Submission("s", "brightness", tmp_path)
     g = pipeline.Grading(sub, None, 0, GradeResult("s", "brightness", ""), tmp_path, deadline=time.monotonic() - 1)
     early = early_checks.EarlyRun(g, ["values"], build)
