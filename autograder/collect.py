@@ -68,12 +68,14 @@ def collect(course_dir, assignment: str, archives: list) -> list[str]:
     course = release.prepare_course(course_dir)
     if not (course / "release" / assignment).is_dir():
         raise ValueError(f"{assignment} has not been released in {course}: run python -m autograder release {course} "
-                         f"--assignment {assignment} first (zip_collect compares the names with the released notebooks)")
+                         f"--assignment {assignment} first (zip_collect compares the names with the released "
+                         "notebooks)")
     inbox = course / "downloaded" / assignment / "archive"
     inbox.mkdir(parents=True, exist_ok=True)
     for archive in map(Path, archives):
         if not archive.is_file():
-            raise FileNotFoundError(f"{archive} does not exist: give the path of the LMS download (a .zip or notebooks)")
+            raise FileNotFoundError(f"{archive} does not exist: give the path of the LMS download (a .zip or "
+                                    "notebooks)")
         shutil.copy2(archive, inbox / archive.name)
     before = _files(course, assignment)
     log = nbgrader_cli.run_nbgrader(["zip_collect", assignment, "--force"], course)
@@ -81,7 +83,8 @@ def collect(course_dir, assignment: str, archives: list) -> list[str]:
     students = sorted({path.parent.parent.name for path, stamp in after.items() if before.get(path) != stamp})
     if not students:
         raise ValueError(f"No submission of {assignment} was collected from {inbox}: the file names do not match "
-                         "c.FileNameCollectorPlugin.named_regexp (autograder.collect.LMS_FILE_NAME explains the default); "
+                         "c.FileNameCollectorPlugin.named_regexp (autograder.collect.LMS_FILE_NAME explains the "
+                         "default); "
                          f"nbgrader said:\n{log[-2000:]}")
     with gradebook.open_gradebook(course) as gb:
         roster = {student.id for student in gb.students}

@@ -114,7 +114,8 @@ def submit_rules(course_config, assignments: list[str]) -> dict[str, SubmitRules
         settings = dict(settings or {})
         unknown = sorted(set(settings) - SUBMIT_RULE_KEYS)
         if unknown:
-            raise ValueError(f"{where} has {', '.join(unknown)}: the settings are {', '.join(sorted(SUBMIT_RULE_KEYS))}.")
+            raise ValueError(f"{where} has {', '.join(unknown)}: the settings are "
+                             f"{', '.join(sorted(SUBMIT_RULE_KEYS))}.")
         attempts = settings.get("attempts")
         if attempts is not None and (not isinstance(attempts, int) or isinstance(attempts, bool) or attempts < 1):
             raise ValueError(f"{where}: 'attempts' is {attempts!r}; give a whole number of at least 1, or leave it "
@@ -153,7 +154,8 @@ apply(c, Path(__file__).resolve().parent)
 #: What a new course's settings section holds: the settings an instructor may want, commented out.
 SETTINGS_EXAMPLE = '''\
 # Late penalty per assignment: the fraction of the score lost per started day late, capped.
-# Due dates are in the gradebook: python -m autograder release COURSE_DIR --assignment pubsub --duedate "2025-03-14 23:59 Europe/Berlin"
+# Due dates are in the gradebook:
+#   python -m autograder release COURSE_DIR --assignment pubsub --duedate "2025-03-14 23:59 Europe/Berlin"
 # c.LatePenalty.per_day = {"pubsub": 0.1, "brightness": 0.1, "catdog_warp": 0.1}
 # c.LatePenalty.maximum = 0.5
 # Grading on submission on the course's JupyterHub (its grading service), per assignment: how many

@@ -88,7 +88,7 @@ def grade(course_dir, assignment: str | None = None, workers: int = 1, force: bo
         return result
 
     with ThreadPoolExecutor(max_workers=max(1, workers)) as pool:
-        for sub, result in zip(todo, pool.map(work, todo)):
+        for sub, result in zip(todo, pool.map(work, todo), strict=True):
             results[sub.key] = result
     ordered = [results[s.key] for s in subs]
     report.write_report(course, ordered)

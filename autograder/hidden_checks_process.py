@@ -1,5 +1,6 @@
 """The grader's run of a graded notebook's hidden checks, outside the student's kernel:
-``python -m autograder.hidden_checks_process ASSIGNMENT CHECK... --workdir DIR --out DIR`` (started by autograder.hidden_checks).
+``python -m autograder.hidden_checks_process ASSIGNMENT CHECK... --workdir DIR --out DIR`` (started by
+autograder.hidden_checks).
 
 The checks of a submission share one set of student processes that serve calls
 (course_lib.checks.student_server), and, when the grader gave the submission a network namespace
@@ -107,7 +108,8 @@ class _Run:
     """The checks of one submission: which run, which finished, their results."""
 
     def __init__(self, assignment: str, workdir: Path, out: Path, deadline: float | None, servers: StudentServers):
-        self.assignment, self.workdir, self.out, self.deadline, self.servers = assignment, workdir, out, deadline, servers
+        self.assignment, self.workdir, self.out = assignment, workdir, out
+        self.deadline, self.servers = deadline, servers
         self.students = StudentUid.from_environment()
         self.lock = threading.Lock()
         self.running: dict[str, tuple] = {}  # name -> (Context, seed)

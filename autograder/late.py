@@ -34,7 +34,8 @@ class LatePenalty(LateSubmissionPlugin):
 
     per_day = Dict(value_trait=Float(min=0.0), default_value={},
                    help="Assignment -> fraction of the score lost per started day late (0.1: 10 %)").tag(config=True)
-    maximum = Float(1.0, min=0.0, max=1.0, help="The largest fraction of the score a late penalty takes").tag(config=True)
+    maximum = Float(1.0, min=0.0, max=1.0,
+                    help="The largest fraction of the score a late penalty takes").tag(config=True)
 
     def late_submission_penalty(self, student_id: str, score: float, total_seconds_late: float):
         # nbgrader's AssignLatePenalties creates the plugin with itself as parent, the assignment set.

@@ -20,7 +20,8 @@ def keep_autograded(course: Path, sub: Submission, autograded: Path | None) -> N
     if target.exists():
         shutil.rmtree(target)
     if autograded is not None and autograded.is_dir():
-        shutil.copytree(autograded, target, symlinks=True, ignore=shutil.ignore_patterns("__pycache__", ".autograder-*"))
+        shutil.copytree(autograded, target, symlinks=True,
+                        ignore=shutil.ignore_patterns("__pycache__", ".autograder-*"))
     else:
         target.mkdir(parents=True, exist_ok=True)
 

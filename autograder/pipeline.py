@@ -181,8 +181,9 @@ def choose_environment(g: Grading) -> None:
              contract.LOAD_FACTOR_ENV: f"{g.budget / GRADING_SECONDS:.2f}"}
     if g.result.isolation == "root":
         g.result.kernel_uid = KERNEL_UID_BASE + g.domain_id
-        g.env.update({contract.KERNEL_UID_ENV: str(g.result.kernel_uid), contract.KERNEL_NPROC_ENV: str(contract.MAX_PROCESSES)})
-        g.env.update({contract.STUDENT_UID_ENV: str(g.result.kernel_uid), contract.STUDENT_NPROC_ENV: str(contract.MAX_PROCESSES)})
+        uid, nproc = str(g.result.kernel_uid), str(contract.MAX_PROCESSES)
+        g.env.update({contract.KERNEL_UID_ENV: uid, contract.KERNEL_NPROC_ENV: nproc})
+        g.env.update({contract.STUDENT_UID_ENV: uid, contract.STUDENT_NPROC_ENV: nproc})
         exposure = interpreter_exposure()
         if exposure:
             (work / "stage").mkdir()
@@ -193,7 +194,8 @@ def start_early_checks(g: Grading) -> None:
     """Build and check the files the notebook is predicted to write while it runs
     (autograder.early_checks); build_workspace decides afterwards whether they count."""
     names = graded_checks(g.sub)
-    if os.environ.get(contract.EARLY_CHECKS_ENV, "1") != "0" and names and packages.needed(g.sub.assignment, g.submitted):
+    wanted = os.environ.get(contract.EARLY_CHECKS_ENV, "1") != "0"
+    if wanted and names and packages.needed(g.sub.assignment, g.submitted):
         g.early = early_checks.EarlyRun(g, names, build_for_checks).start()
 
 

@@ -22,7 +22,7 @@ def stage_grader(work: Path) -> Path:
 def private_copy(source: Path, target: Path) -> None:
     """Copy a directory tree readable by root only (other workers' uids cannot read it)."""
     shutil.copytree(source, target, ignore=shutil.ignore_patterns(".ipynb_checkpoints"))
-    for directory, dirs, files in os.walk(target):
+    for directory, _dirs, files in os.walk(target):
         os.chmod(directory, 0o711)
         for name in files:
             os.chmod(os.path.join(directory, name), 0o600)

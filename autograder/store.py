@@ -57,7 +57,9 @@ def recorded_results(course, assignment: str | None = None, student: str | None 
     or one assignment's, one student's; sorted by student and assignment."""
     import glob
 
-    pattern = f"{glob.escape(student) if student else '*'}/{glob.escape(assignment) if assignment else '*'}/{STATE_FILE}"
+    student_part = glob.escape(student) if student else "*"
+    assignment_part = glob.escape(assignment) if assignment else "*"
+    pattern = f"{student_part}/{assignment_part}/{STATE_FILE}"
     results = []
     for path in sorted((Path(course) / "autograder").glob(pattern)):
         try:

@@ -64,8 +64,8 @@ def submission_digest(sub: Submission, course: Path, content_only: bool = False)
     _tree_digest([sub.path], digest, PER_SUBMISSION_FILES if content_only else ())
     _tree_digest([course / "source" / sub.assignment], digest)
     here, checks = Path(__file__).resolve().parent, Path(registry.__file__).resolve().parent
-    code = [here / "kernel.py", here / "config.py", here / "hidden_checks_process.py", here / "student_uid.py", here / "run_as.py",
-            here / "packages.py",
+    code = [here / "kernel.py", here / "config.py", here / "hidden_checks_process.py", here / "student_uid.py",
+            here / "run_as.py", here / "packages.py",
             here / "answers" / f"{sub.assignment}.py",
             *(checks / f"{name}.py" for name in CHECK_MODULES), checks / f"{sub.assignment}.py"]
     _tree_digest([path for path in code if path.exists()], digest)

@@ -91,8 +91,8 @@ def main(argv=None) -> int:
                 best[side] = {row: min(ms, best.get(side, {}).get(row, ms)) for row, ms in rows.items()}
         before, after = np.load(tmp / "before.npy").astype(int), np.load(tmp / "after.npy").astype(int)
 
-    print(f"CPU milliseconds per 640x480 frame, fastest of {args.repeat} ({platform.processor() or platform.machine()}, "
-          f"before = {args.before})")
+    print(f"CPU milliseconds per 640x480 frame, fastest of {args.repeat} "
+          f"({platform.processor() or platform.machine()}, before = {args.before})")
     print(f"{'':14} {'before':>8} {'after':>8} {'after/before':>13}")
     for row in best["before"]:
         b, a = best["before"][row], best["after"][row]

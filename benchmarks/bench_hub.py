@@ -174,8 +174,8 @@ def main() -> int:
                   f"(each: median {statistics.median(times):.1f} s, max {times[-1]:.1f} s)")
             with concurrent.futures.ThreadPoolExecutor(len(others)) as pool:
                 heard = list(pool.map(lambda pair: run_in_kernel(hub, pair[1][0], pair[0], TALKER, timeout=300),
-                                      zip(others, logins)))
-            isolated = sum(said.strip() == f"['{user}']" for user, said in zip(others, heard))
+                                      zip(others, logins, strict=True)))
+            isolated = sum(said.strip() == f"['{user}']" for user, said in zip(others, heard, strict=True))
             print(f"talkers on one domain in {len(others)} kernels at once: {isolated} of {len(others)} heard only "
                   f"themselves" + ("" if isolated == len(others) else f": {heard}"))
             time.sleep(3)

@@ -18,6 +18,7 @@ Rows, per image size (bgr8):
 from __future__ import annotations
 
 import argparse
+import functools
 import os
 import platform
 import shlex
@@ -60,6 +61,9 @@ def main(argv=None) -> int:
         msg.data = image.tobytes()
         return msg
 
+    def receive_raw(msg, height, width):
+        return np.frombuffer(msg.data, np.uint8).reshape(height, width, 3)
+
     list_small = best_seconds(lambda: send_list(small), args.repeat)
 
     rows = []
@@ -69,11 +73,10 @@ def main(argv=None) -> int:
         assert np.array_equal(msg_to_image(msg), image)
         assert send_raw(image).data == msg.data
         scale = image.size / small.size
-        send_ours = best_seconds(lambda: image_to_msg(image), args.repeat)
-        send_bytes = best_seconds(lambda: send_raw(image), args.repeat)
-        recv_ours = best_seconds(lambda: msg_to_image(msg), args.repeat)
-        recv_raw = best_seconds(lambda: np.frombuffer(msg.data, np.uint8).reshape(height, width, 3),
-                                args.repeat)
+        send_ours = best_seconds(functools.partial(image_to_msg, image), args.repeat)
+        send_bytes = best_seconds(functools.partial(send_raw, image), args.repeat)
+        recv_ours = best_seconds(functools.partial(msg_to_image, msg), args.repeat)
+        recv_raw = best_seconds(functools.partial(receive_raw, msg, height, width), args.repeat)
         size = f"{width}x{height}"
         rows += [
             (size, "send: image_to_msg", send_ours, send_ours / send_bytes),

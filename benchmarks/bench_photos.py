@@ -80,7 +80,7 @@ def main(argv=None) -> int:
               + " | ".join(f"{r.recovered} ({r.rate:.1%})" for r in results) + " | "
               + " / ".join(str(r.false) for r in results) + " | "
               + " / ".join(f"{1000 * r.seconds / max(1, r.scenes):.1f}" for r in results) + " |", flush=True)
-        for name, result in zip(names, results):
+        for name, result in zip(names, results, strict=True):
             if result.missed and name != "detector alone":
                 print(f"  {name} missed: {result.missed}", file=sys.stderr)
     return 0

@@ -91,7 +91,7 @@ def main(argv: list[str] | None = None) -> int:
         nodes = [processes.NodeProcess([sys.executable, str(script), name], domain_id=reservation.domain_id).start()
                  for name in ("bench_talker", "bench_listener")]
         try:
-            for process, name in zip(nodes, ("bench_talker", "bench_listener")):
+            for process, name in zip(nodes, ("bench_talker", "bench_listener"), strict=True):
                 process.wait_for_node(name, timeout=60)
             times: dict[str, list[float]] = {label: [] for label, _ in commands(ros2)}
             answers: dict[str, str] = {}

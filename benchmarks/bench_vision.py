@@ -30,6 +30,7 @@ asserting them. Compare the ratios between rows measured at the same time.
 from __future__ import annotations
 
 import argparse
+import functools
 import json
 import os
 import platform
@@ -55,6 +56,13 @@ def average_brightness(image):
     from autograder.answers.brightness import average_brightness as answer
 
     return answer(image)
+
+
+def msg_brightness(msg) -> int:
+    """The brightness of an Image message the numpy way: msg_to_image, then the answer key."""
+    from course_lib import images
+
+    return average_brightness(images.msg_to_image(msg))
 
 
 def python_loop_brightness(data) -> int:
@@ -231,6 +239,11 @@ def measure(roles, seconds, domain_id, *, size, frames=1, rate=0.0, env=None):
             process.stop()
 
 
+def each(function, frames: list) -> list:
+    """function(frame) for each of `frames`: what one timing of a per-frame step runs."""
+    return [function(frame) for frame in frames]
+
+
 def best_seconds(statement, repeat: int, number: int | None = None) -> float:
     timer = timeit.Timer(statement)
     if number is None:
@@ -261,9 +274,9 @@ def measure_brightness(args, domain_id) -> list:
         ]
         frame = publisher_frames(1, (width, height))[0]
         msg = images.image_to_msg(frame)
-        assert python_loop_brightness(msg.data) == average_brightness(images.msg_to_image(msg))
-        loop = best_seconds(lambda: python_loop_brightness(msg.data), 1 if width > 1000 else 3, number=1)
-        vectorised = best_seconds(lambda: average_brightness(images.msg_to_image(msg)), 5)
+        assert python_loop_brightness(msg.data) == msg_brightness(msg)
+        loop = best_seconds(functools.partial(python_loop_brightness, msg.data), 1 if width > 1000 else 3, number=1)
+        vectorised = best_seconds(functools.partial(msg_brightness, msg), 5)
         table += [
             ("a", size, "mean of one frame: numpy (msg_to_image + sum)", format_time(vectorised),
              "1 (reference)"),
@@ -285,8 +298,8 @@ def measure_marker_reader(args, domain_id) -> list:
     webcam = publisher_frames(30, (640, 480))
     hard = [scenes.render_scene(seed, difficulty="hard").frame for seed in range(30)]
     for label, frames in (("webcam frames (CameraPath)", webcam), ("hard scenes", hard)):
-        full = best_seconds(lambda: [crop_pictures(f) for f in frames], 3, number=1) / len(frames)
-        detect = best_seconds(lambda: [find_markers(f) for f in frames], 3, number=1) / len(frames)
+        full = best_seconds(functools.partial(each, crop_pictures, frames), 3, number=1) / len(frames)
+        detect = best_seconds(functools.partial(each, find_markers, frames), 3, number=1) / len(frames)
         table += [
             ("b", "640x480", f"crop_pictures, {label}", f"{1 / full:.1f} frames/s", f"{format_time(full)}"),
             ("b", "640x480", f"  of which find_markers (ArUco detection), {label}", f"{1 / detect:.1f} frames/s",
@@ -354,7 +367,8 @@ def main(argv=None) -> int:
     if "c" in args.parts:
         print()
         print(f"(c) frames delivered to a best-effort subscriber in another process, 30 Hz; course set-up: "
-              f"{delivery['setup']}; LARGE_DATA: FASTDDS_BUILTIN_TRANSPORTS={SETUPS['LARGE_DATA']['FASTDDS_BUILTIN_TRANSPORTS']}")
+              f"{delivery['setup']}; LARGE_DATA: "
+              f"FASTDDS_BUILTIN_TRANSPORTS={SETUPS['LARGE_DATA']['FASTDDS_BUILTIN_TRANSPORTS']}")
         print()
         print(f"| frames | sender | sent ({' / '.join(SETUPS)}) | "
               + " | ".join(f"{name}: received of sent" for name in SETUPS) + " |")

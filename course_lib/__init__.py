@@ -16,9 +16,9 @@ from course_lib import rosenv as _rosenv
 _rosenv.prepare_current_process()
 
 _MODULES = ("ament", "boards", "camera", "camera_views", "colcon", "discovery", "doctor", "graph",
-            "images", "interfaces", "launch", "live", "marker_board", "message_yaml", "parameters", "photos", "pictures",
-            "pkg_create", "processes", "rates", "rosenv", "rqt_graph", "scenes", "selfcheck", "session", "table",
-            "vision", "waiting", "wheelfix", "workspace")
+            "images", "interfaces", "launch", "live", "marker_board", "message_yaml", "parameters", "photos",
+            "pictures", "pkg_create", "processes", "rates", "rosenv", "rqt_graph", "scenes", "selfcheck", "session",
+            "table", "vision", "waiting", "wheelfix", "workspace")
 
 
 def __getattr__(name):

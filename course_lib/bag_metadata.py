@@ -176,7 +176,8 @@ def from_dict(fields: dict) -> BagMetadata:
         duration=int(fields["duration"]["nanoseconds"]),
         starting_time=int(fields["starting_time"]["nanoseconds_since_epoch"]),
         message_count=int(fields["message_count"]), topics=topics, ros_distro=fields.get("ros_distro") or "",
-        compression_format=fields.get("compression_format") or "", compression_mode=fields.get("compression_mode") or "",
+        compression_format=fields.get("compression_format") or "",
+        compression_mode=fields.get("compression_mode") or "",
         custom_data=dict(fields.get("custom_data") or {}))
 
 

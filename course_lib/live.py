@@ -334,7 +334,7 @@ class PlotView(_View):
             self._changed = False
             snapshot = {series: np.array(points, dtype=float).reshape(-1, 2) for series, points in self._points.items()}
         latest = max((points[-1, 0] for points in snapshot.values() if len(points)), default=0.0)
-        for line, series in zip(self._lines, self.series):
+        for line, series in zip(self._lines, self.series, strict=True):
             points = snapshot[series]
             if self.window is not None:
                 points = points[points[:, 0] >= latest - self.window]
@@ -352,7 +352,7 @@ class PlotView(_View):
     def _show_status(self) -> None:
         with self._lock:
             counts = [len(self._points[series]) for series in self.series]
-        parts = [f"{series}: {count} values" for series, count in zip(self.series, counts)]
+        parts = [f"{series}: {count} values" for series, count in zip(self.series, counts, strict=True)]
         if not any(counts) and not self.stopped:
             parts.append("waiting for messages")
         if self.stopped:

@@ -83,7 +83,7 @@ def picture_corners(marker_corners_by_id: Mapping[int, np.ndarray], picture: str
     if picture not in PICTURES:
         raise KeyError(f"Unknown picture {picture!r}: use one of {sorted(PICTURES)}")
     corners = []
-    for marker_id, corner in zip(PICTURES[picture], CORNER_OF_MARKER):
+    for marker_id, corner in zip(PICTURES[picture], CORNER_OF_MARKER, strict=True):
         if marker_id not in marker_corners_by_id:
             return None
         marker = np.asarray(marker_corners_by_id[marker_id], dtype=np.float32).reshape(4, 2)

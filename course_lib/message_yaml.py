@@ -65,7 +65,7 @@ def message_to_dict(msg, truncate_length: int | None = 128, no_arr: bool = False
     """
     if hasattr(msg, "get_fields_and_field_types"):
         return {field: _field_to_plain(getattr(msg, field), slot_type, truncate_length, no_arr, no_str)
-                for field, slot_type in zip(msg.get_fields_and_field_types(), msg.SLOT_TYPES)}
+                for field, slot_type in zip(msg.get_fields_and_field_types(), msg.SLOT_TYPES, strict=True)}
     if isinstance(msg, (bytes, bytearray)):
         text = "".join(chr(byte) for byte in msg[:truncate_length])
         return text + "..." if truncate_length is not None and len(msg) > truncate_length else text
@@ -151,7 +151,7 @@ def _fill(msg, values, setters: list, path: str) -> None:
     if not isinstance(values, dict):
         raise ValueError(f"{path.rstrip('.') or 'The message'} is a {_type_name(msg)} and needs a "
                          f"dictionary of its fields ({', '.join(fields)}), not {values!r}")
-    slots = dict(zip(fields, msg.SLOT_TYPES))
+    slots = dict(zip(fields, msg.SLOT_TYPES, strict=True))
     for field, value in values.items():
         where = path + str(field)
         if field not in fields:
@@ -181,17 +181,18 @@ def _fill(msg, values, setters: list, path: str) -> None:
                 _fill(items[-1], item, setters, f"{where}[{index}].")
             value = items
         elif isinstance(current, array.array):
-            value = _converted(lambda: array.array(current.typecode, value), where, fields[field], value)
+            value = _converted(functools.partial(array.array, current.typecode), where, fields[field], value)
         elif isinstance(current, np.ndarray):
-            value = _converted(lambda: np.array(value, dtype=current.dtype), where, fields[field], value)
+            value = _converted(functools.partial(np.array, dtype=current.dtype), where, fields[field], value)
         elif not isinstance(current, list) and type(value) is not type(current):
-            value = _converted(lambda: type(current)(value), where, fields[field], value)
-        _converted(lambda: setattr(msg, field, value), where, fields[field], value)
+            value = _converted(type(current), where, fields[field], value)
+        _converted(functools.partial(setattr, msg, field), where, fields[field], value)
 
 
 def _converted(convert, where: str, field_type: str, value):
+    """convert(value), or a ValueError that names the field, its type and the value."""
     try:
-        return convert()
+        return convert(value)
     except (AssertionError, TypeError, ValueError, OverflowError) as error:
         raise ValueError(f"{where} is a {field_type} and cannot take {value!r}"
                          f"{': ' + str(error) if str(error) else ''}") from None

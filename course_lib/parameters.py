@@ -156,7 +156,7 @@ def as_yaml_dict(node_name: str, timeout: float = SERVICE_TIMEOUT) -> dict:
     listed = names(full, timeout=timeout)
     found = values(full, listed, timeout) if listed else []
     tree: dict = {}
-    for name, value in zip(listed, found):
+    for name, value in zip(listed, found, strict=True):
         *groups, leaf = name.split(PARAMETER_SEPARATOR_STRING)
         branch = tree
         for group in groups:
@@ -185,4 +185,4 @@ def load(node_name: str, path, use_wildcard: bool = True, timeout: float = SERVI
 
     parameters = list(parameter_dict_from_yaml_file(str(path), use_wildcard).values())
     results = set_parameters(node_name, parameters, timeout)
-    return [(parameter.name, result) for parameter, result in zip(parameters, results)]
+    return [(parameter.name, result) for parameter, result in zip(parameters, results, strict=True)]

@@ -78,7 +78,7 @@ def draw_photo(seed: int = 0, size: tuple[int, int] = (400, 300), corners: str |
     corner_rng = np.random.default_rng(np.random.SeedSequence([_seed_entropy(seed)[0], 556]))
     if kinds == "any":
         kinds = [CORNER_KINDS[int(i)] for i in corner_rng.integers(0, len(CORNER_KINDS), 4)]
-    for (cx, cy), kind in zip(((0, 0), (width, 0), (width, height), (0, height)), kinds):
+    for (cx, cy), kind in zip(((0, 0), (width, 0), (width, height), (0, height)), kinds, strict=True):
         # The corner's kind covers a seeded quarter-disc of the picture and fades out beyond it.
         reach = corner_rng.uniform(0.2, 0.5) * width
         distance = np.hypot(x[None, :] * width - cx, y[:, None] * height - cy) / reach
@@ -132,7 +132,8 @@ def _corner_paint(rng: np.random.Generator, kind: str, width: int, height: int, 
         return np.float32(rng.uniform(50, 190)) + np.zeros(3, np.float32)
     if kind == "gradient":  # from one colour to another across the corner, at any angle
         angle = rng.uniform(0, 2 * np.pi)
-        xs, ys = np.meshgrid(np.arange(width, dtype=np.float32) - corner[0], np.arange(height, dtype=np.float32) - corner[1])
+        xs, ys = np.meshgrid(np.arange(width, dtype=np.float32) - corner[0],
+                             np.arange(height, dtype=np.float32) - corner[1])
         t = np.clip(0.5 + (xs * np.cos(angle) + ys * np.sin(angle)) / (2 * reach), 0, 1)[:, :, None]
         start, end = rng.uniform(0, 200, 3).astype(np.float32), rng.uniform(0, 255, 3).astype(np.float32)
         return start + t * (end - start)

@@ -350,7 +350,7 @@ ament_package()
     _write(package_dir / "CMakeLists.txt", cmake)
     _write(package_dir / "package.xml",
            _package_xml(name, description, maintainer, maintainer_email, license, body, "ament_cmake"))
-    for message, file in zip(messages, files):
+    for message, file in zip(messages, files, strict=True):
         definition = messages[message]
         _write(package_dir / file, definition if definition.endswith("\n") else definition + "\n")
     return package_dir

@@ -267,7 +267,7 @@ def _render(board: Board, pose: Pose, look: Look, size, *, missing, occluded, du
                          border=cv2.BORDER_REFLECT_101)
     image = _composite(image, board.texture(missing), to_super, super_size)
     duplicate_truth = []
-    for index, (marker_id, origin) in enumerate(zip(duplicates, _sticker_places(board, H, size, len(duplicates)))):
+    for marker_id, origin in zip(duplicates, _sticker_places(board, H, size, len(duplicates)), strict=True):
         sticker = _sticker(marker_id)
         image = _composite(image, [(4.0, sticker)], to_super @ _translation(*origin), super_size)
         corners = _square(origin[0] + Board.QUIET, origin[1] + Board.QUIET, Board.MARKER)

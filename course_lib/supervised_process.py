@@ -439,7 +439,8 @@ def _relay_echo(fd: int, on_output: Callable[[str, bytes], None]) -> None:
 
 
 def stop_all(timeout: float = 5.0) -> None:
-    """Stop every supervised process (NodeProcess) this process started: all get SIGINT at once, then each is awaited."""
+    """Stop every supervised process (NodeProcess) this process started: all get SIGINT at once, then each is
+    awaited."""
     stop_together(running_processes(), timeout)
 
 

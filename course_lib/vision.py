@@ -32,7 +32,7 @@ def _as_marker_list(corners, ids) -> list[tuple[int | None, np.ndarray]]:
             if len(id_list) != len(corners):
                 raise ValueError(f"Got {len(corners)} marker corner arrays but {len(id_list)} ids: pass "
                                  "corners and ids exactly as detectMarkers returned them")
-        items = list(zip(id_list, corners))
+        items = list(zip(id_list, corners, strict=True))
     markers = []
     for marker_id, quad in items:
         quad = np.asarray(quad, dtype=np.float64)

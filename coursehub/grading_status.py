@@ -29,7 +29,8 @@ def describe(queue: SubmitQueue, row: Row) -> str:
         reason = f" ({row.message})" if row.message else ""
         if row.state == "graded":
             return f"{score}{reason}; writing its feedback"
-        return f"{score}{reason}; press Fetch Feedback in the Assignments panel (Nbgrader > Assignment List) to read why"
+        return (f"{score}{reason}; press Fetch Feedback in the Assignments panel (Nbgrader > Assignment List) to "
+                "read why")
     if row.state == "failed":
         return f"could not be graded: {row.message} Your instructor will grade it."
     return f"{row.state} (not graded): {row.message}"
@@ -45,7 +46,8 @@ def page(queue: SubmitQueue, student: str) -> str:
         for row in rows)
     return ("<!doctype html><meta charset='utf-8'>" + refresh +
             f"<title>Grading of {html.escape(student)}'s submissions</title>"
-            "<style>body{font-family:sans-serif}td,th{padding:4px 8px;border-top:1px solid #ccc;text-align:left}</style>"
+            "<style>body{font-family:sans-serif}"
+            "td,th{padding:4px 8px;border-top:1px solid #ccc;text-align:left}</style>"
             f"<h1>Your submissions, {html.escape(student)}</h1>"
             + (f"<table><tr><th>Assignment</th><th>Attempt</th><th>Submitted</th><th>Grading</th></tr>{lines}</table>"
                if rows else "<p id='none'>No submission yet: press Submit in the Assignments panel.</p>")

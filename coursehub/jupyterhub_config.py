@@ -32,7 +32,8 @@ c.JupyterHub.spawner_class = "coursehub.spawner.IsolatedSpawner"
 c.IsolatedSpawner.hub_dir = str(course.hub_dir)
 c.Spawner.default_url = "/lab"
 # bash with the course's rc file: ~/.bashrc, then the course's environment first again.
-c.Spawner.args = ["--ServerApp.terminado_settings=" + json.dumps({"shell_command": terminal.shell_command("/bin/bash")})]
+c.Spawner.args = ["--ServerApp.terminado_settings="
+                  + json.dumps({"shell_command": terminal.shell_command("/bin/bash")})]
 # Ten students logging in at once on two cores start in about a minute (README: capacity).
 c.Spawner.start_timeout = 180
 c.Spawner.http_timeout = 180

@@ -450,7 +450,8 @@ _PAGE_STATE_JS = """
   const images = [];
   codeCells.forEach((c, i) => c.querySelectorAll('.jp-OutputArea img').forEach(img =>
       images.push({cell: i, ok: img.complete && img.naturalWidth > 0})));
-  const stderr = panel.querySelectorAll('.jp-OutputArea-output[data-mime-type="application/vnd.jupyter.stderr"]').length;
+  const stderr = panel.querySelectorAll(
+    '.jp-OutputArea-output[data-mime-type="application/vnd.jupyter.stderr"]').length;
   const app = window.jupyterapp;
   if (!app) return {error: 'window.jupyterapp is missing (start the server with expose_app_in_browser)'};
   const widget = app.shell.currentWidget;

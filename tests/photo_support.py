@@ -71,7 +71,8 @@ def recovery(crop_pictures, scene_list) -> Recovery:
         expected = scene.expected_crops()
         visible = set(scene.visible_ids)
         for name, markers in marker_board.PICTURES.items():
-            good = name in crops and marker_board.crop_similarity(crops[name], expected[name]) >= marker_board.SAME_CROP_THRESHOLD
+            good = (name in crops and marker_board.crop_similarity(crops[name], expected[name])
+                    >= marker_board.SAME_CROP_THRESHOLD)
             if name in scene.fully_framed:
                 result.framed += 1
                 result.recovered += good

@@ -22,7 +22,7 @@ def ros2_together(*commands, env, timeout=60):
     started = [subprocess.Popen([str(ROS2), *args], env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                                 text=True, stdin=subprocess.DEVNULL) for args in commands]
     done = []
-    for args, process in zip(commands, started):
+    for args, process in zip(commands, started, strict=True):
         out, err = process.communicate(timeout=timeout)
         done.append(subprocess.CompletedProcess([str(ROS2), *args], process.returncode, out, err))
     return done

@@ -132,14 +132,16 @@ def test_brightness_typical_mistake_gets_its_score_and_reason(tmp_path, monkeypa
 
 WARP = "crop = cv2.warpPerspective(frame, homography, (width, height), flags=cv2.INTER_LINEAR)"
 CATDOG_MISTAKES = {
-    "bgr_swapped": ([(WARP, WARP + "\n        crop = cv2.cvtColor(crop, cv2.COLOR_BGR2RGB)")], "red and blue are swapped"),
+    "bgr_swapped": ([(WARP, WARP + "\n        crop = cv2.cvtColor(crop, cv2.COLOR_BGR2RGB)")],
+                    "red and blue are swapped"),
     "mirrored": ([("target = marker_board.crop_corners((width, height))",
                    "target = np.float32([[width - 1, 0], [0, 0], [0, height - 1], [width - 1, height - 1]])")],
                  "mirrored left-right"),
     # Each marker's corner 0 instead of the corner that touches the picture.
     "corner_order": ([("corners = marker_board.picture_corners(markers, name)",
                        "corners = (np.float32([markers[m][0] for m in marker_board.PICTURES[name]])\n"
-                       "                   if all(m in markers for m in marker_board.PICTURES[name]) else None)")], "similarity"),
+                       "                   if all(m in markers for m in marker_board.PICTURES[name]) else None)")],
+                     "similarity"),
     "size_swapped": ([("(width, height), flags=cv2.INTER_LINEAR)", "(height, width), flags=cv2.INTER_LINEAR)")],
                      "size is (width, height)"),
 }
@@ -171,7 +173,8 @@ def test_catdog_picture_reported_from_its_first_marker_loses_points_in_every_gra
     draw: a crop_pictures that reports a picture whenever its first marker is seen always loses."""
     edits = [("corners = marker_board.picture_corners(markers, name)",
               "first = marker_board.PICTURES[name][0]\n"
-              "        corners = marker_board.picture_corners({m: markers.get(m, markers.get(first)) for m in marker_board.PICTURES[name]}\n"
+              "        corners = marker_board.picture_corners({m: markers.get(m, markers.get(first)) "
+              "for m in marker_board.PICTURES[name]}\n"
               "                                         if first in markers else markers, name)"),
              ("if corners is None or not _is_picture_shape(corners):", "if corners is None:")]
     workdir = _module_dir(tmp_path, "catdog_warp", edits)

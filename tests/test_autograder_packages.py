@@ -16,7 +16,8 @@ def write_interface(ws: Path, name: str = "tutorial_interfaces", msg: str = MSG)
     folder = ws / "src" / name
     (folder / "msg").mkdir(parents=True)
     (folder / "msg" / "MsgTutorial.msg").write_text(msg)
-    (folder / "CMakeLists.txt").write_text("project(x)\nrosidl_generate_interfaces(${PROJECT_NAME} \"msg/MsgTutorial.msg\")\n")
+    (folder / "CMakeLists.txt").write_text(
+        "project(x)\nrosidl_generate_interfaces(${PROJECT_NAME} \"msg/MsgTutorial.msg\")\n")
     (folder / "package.xml").write_text(f"<package format=\"3\"><name>{name}</name>"
                                         "<depend>builtin_interfaces</depend></package>")
     return folder

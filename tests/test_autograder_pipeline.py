@@ -22,14 +22,15 @@ from autograder import grading  # noqa: E402
 #: (edits, the check it costs, a phrase of the verdict); the other typical mistakes are run through
 #: the checks only (tests/test_autograder.py), which is cheaper.
 FULL_RUN_MISTAKES = {
-    "catdog_warp": (CATDOG_MISTAKES[FULL_RUN["catdog_warp"]][0], CATDOG_CHECK, CATDOG_MISTAKES[FULL_RUN["catdog_warp"]][1]),
+    "catdog_warp": (CATDOG_MISTAKES[FULL_RUN["catdog_warp"]][0], CATDOG_CHECK,
+                    CATDOG_MISTAKES[FULL_RUN["catdog_warp"]][1]),
     "pubsub": PUBSUB_MISTAKES[FULL_RUN["pubsub"]],
 }
 
 
 #: References graded through the whole pipeline here. Each assignment's reference goes through it
-#: once in the suite: brightness's in the zoo (tests/test_autograder_zoo.py, "hostile": with a hostile cell), pubsub's in
-#: the term (tests/test_term.py, alice), catdog_warp's here.
+#: once in the suite: brightness's in the zoo (tests/test_autograder_zoo.py, "hostile": with a
+#: hostile cell), pubsub's in the term (tests/test_term.py, alice), catdog_warp's here.
 FULL_RUN_REFERENCES = ["catdog_warp"]
 
 #: A last cell that rewrites the node module with Python instead of %%writefile: the grader
@@ -102,7 +103,8 @@ def test_a_file_the_notebook_writes_otherwise_is_built_and_checked_as_written(co
     assert result.status == "graded", result.reason
     assert result.checked_early is False
     scores = {c["cell"]: c["auto_score"] for c in result.cells}
-    assert scores["check_values"] == 0 and result.score < result.max_score, zoo.graded_outputs(root, "rewriting", "brightness")
+    assert (scores["check_values"] == 0
+            and result.score < result.max_score), zoo.graded_outputs(root, "rewriting", "brightness")
 
 
 @pytest.mark.slow
@@ -113,7 +115,8 @@ def test_typical_mistake_is_graded_down_with_its_reason_in_the_feedback(feedback
     _, results = course
     root, _pages = feedback_pages
     result = results["mistaken", assignment]
-    assert result.status == "graded" and 0 < result.score < result.max_score, zoo.graded_outputs(root, "mistaken", assignment)
+    assert (result.status == "graded"
+            and 0 < result.score < result.max_score), zoo.graded_outputs(root, "mistaken", assignment)
     _edits, check, reason = FULL_RUN_MISTAKES[assignment]
     cell = next(c for c in result.cells if c["cell"] == f"check_{check}")
     assert cell["auto_score"] < cell["max_score"], (cell, zoo.graded_outputs(root, "mistaken", assignment))

@@ -1,5 +1,7 @@
 """Tests for course_lib.boards: the printed board follows the marker convention."""
 
+from itertools import pairwise
+
 import numpy as np
 import pytest
 
@@ -12,7 +14,7 @@ def test_markers_touch_their_picture_corner_and_hide_none_of_it():
         slot = board.picture_slot(name)
         x0, y0 = slot.min(axis=0)
         x1, y1 = slot.max(axis=0)
-        for index, (marker_id, corner) in enumerate(zip(ids, marker_board.CORNER_OF_MARKER)):
+        for index, (marker_id, corner) in enumerate(zip(ids, marker_board.CORNER_OF_MARKER, strict=True)):
             square = board.marker_square(marker_id)
             np.testing.assert_allclose(square[corner], slot[index])
             mx0, my0 = square.min(axis=0)
@@ -38,7 +40,7 @@ def test_a_board_with_markers_missing_is_the_whole_board_with_paper_over_them(go
         assert (missing[0][1][y0:y0 + side, x0:x0 + side] == (*board.PAPER, 255)).all()
     changed = np.any(whole != missing[0][1], axis=2)
     assert changed.any() and not changed[~squares].any()
-    for (_, finer), (_, coarser) in zip(missing, missing[1:]):
+    for (_, finer), (_, coarser) in pairwise(missing):
         assert np.array_equal(coarser, cv2.pyrDown(finer))
 
 

@@ -26,13 +26,14 @@ def brightness_package(ws, node=ANSWER_NODE, setup=None, dependencies=("rclpy", 
 
 @pytest.mark.parametrize("node, setup, dependencies, expected", [
     (None, None, None, "Not done yet: there is no package brightness"),
-    (lesson_answers.lesson_file(LESSON_02, "brightness/brightness_node.py"), SETUP_STUB, None, "Not done yet: brightness_node.py "
-                                                                                "creates no subscription and no publisher"),
+    (lesson_answers.lesson_file(LESSON_02, "brightness/brightness_node.py"), SETUP_STUB, None,
+     "Not done yet: brightness_node.py creates no subscription and no publisher"),
     (ANSWER_NODE, SETUP_STUB, None, "Not done yet: setup.py has no executable brightness_node"),
     (ANSWER_NODE, None, ("rclpy", "sensor_msgs"), "imports std_msgs (line 8), but package.xml does not declare it"),
     (ANSWER_NODE.replace("import rclpy\n", "import numpy\nimport rclpy\n"), None, None,
      "add <depend>python3-numpy</depend>"),
-    (ANSWER_NODE, setup_with("brightness = brightness.brightness_node:main"), None, "needs it to be called 'brightness_node'"),
+    (ANSWER_NODE, setup_with("brightness = brightness.brightness_node:main"), None,
+     "needs it to be called 'brightness_node'"),
     (ANSWER_NODE, setup_with("brightness_node = brightness_node:main"), None,
      "the node file's module is brightness.brightness_node"),
     (ANSWER_NODE, setup_with("brightness_node = brightness.brightness_node.main"), None, "needs a colon"),

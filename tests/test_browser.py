@@ -103,7 +103,8 @@ def lab(tmp_path_factory):
         lesson_line("02_images_and_brightness.ipynb", 'camera = processes.python_node("course_lib.camera:main", '
                                                       '*CAMERA_ARGS, name=')])
     write_notebook(root / "checker" / "lesson03_camera.ipynb", [
-        "from course_lib import processes", lesson_line("03_aruco_and_homography.ipynb", "camera = processes.python_node(")])
+        "from course_lib import processes",
+        lesson_line("03_aruco_and_homography.ipynb", "camera = processes.python_node(")])
     with running_jupyterlab(root, tmp_path_factory.mktemp("lab-state")) as server:
         print(f"\nJupyterLab answered after {server.startup_seconds:.1f} s")
         yield server
@@ -146,7 +147,8 @@ def test_a_long_call_shows_what_it_does_and_for_how_long_while_the_cell_runs(bro
         (lab.root_dir / "checker" / "go").touch()
         page.wait_for_function("""(notebook) => { const cell = document.querySelector(notebook + ' .jp-CodeCell');
             return cell.querySelector('.jp-InputArea-prompt').innerText.trim() === '[1]:'
-              && cell.querySelector('.jp-Cell-outputArea').innerText.includes('waiting for the test: finished after'); }""",
+              && cell.querySelector('.jp-Cell-outputArea').innerText
+                   .includes('waiting for the test: finished after'); }""",
                                arg=NOTEBOOK, timeout=120_000, polling=100)
         shown = page.locator(f"{NOTEBOOK} .jp-CodeCell .jp-Cell-outputArea").first.inner_text().strip()
     finally:

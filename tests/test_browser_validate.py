@@ -3,7 +3,8 @@ Assignments panel, used as a student uses them.
 
 The brightness assignment is released as `make lab` releases the assignments for a student who
 works alone (the real nbgrader CLI): into the lab's own course folder and exchange, .lab/ under the
-lab's root, which the repository's nbgrader_config.py, copied there unchanged, names. Two students work on the released notebook,
+lab's root, which the repository's nbgrader_config.py, copied there unchanged, names. Two students
+work on the released notebook,
 each in a folder of their own under the lab's root (the notebook writes and builds its workspace
 ros2_ws next to itself): ``correct/`` holds the reference solution, ``incorrect/`` the reference with
 ``average_brightness`` returning 0. Each presses Validate; nbgrader saves the notebook, runs it

@@ -62,7 +62,8 @@ def test_declared_dependencies_earn_nothing_by_themselves(tmp_path):
 
 def test_exec_depend_counts_and_workspace_packages_are_ros_packages(tmp_path):
     ctx = Recorder(tmp_path)
-    folder = write_package(tmp_path, ["rclpy", "sensor_msgs"], CODE + "from tutorial_interfaces.msg import MsgTutorial\n")
+    folder = write_package(tmp_path, ["rclpy", "sensor_msgs"],
+                           CODE + "from tutorial_interfaces.msg import MsgTutorial\n")
     (folder / "package.xml").write_text(folder.joinpath("package.xml").read_text().replace(
         "</package>", "<exec_depend>std_msgs</exec_depend></package>"))
     other = tmp_path / "ros2_ws" / "src" / "tutorial_interfaces"

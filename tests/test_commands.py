@@ -32,8 +32,9 @@ def test_make_lab_serves_the_course_and_prints_its_url(tmp_path, tmp_path_factor
     port = free_port()
     log = tmp_path / "lab.log"
     with open(log, "w") as out:
-        lab = subprocess.Popen(["make", "-s", "lab", f"LAB_PORT={port}"], cwd=ROOT, stdout=out, stderr=subprocess.STDOUT,
-                               start_new_session=True, env={**os.environ, "JUPYTER_RUNTIME_DIR": str(tmp_path)})
+        lab = subprocess.Popen(["make", "-s", "lab", f"LAB_PORT={port}"], cwd=ROOT, stdout=out,
+                               stderr=subprocess.STDOUT, start_new_session=True,
+                               env={**os.environ, "JUPYTER_RUNTIME_DIR": str(tmp_path)})
     try:
         url = None
         deadline = time.monotonic() + 300  # a backstop: the loop ends when the URL shows or make lab ends
@@ -43,7 +44,8 @@ def test_make_lab_serves_the_course_and_prints_its_url(tmp_path, tmp_path_factor
             time.sleep(0.5)
         assert url, f"make lab printed no URL:\n{log.read_text()[-2000:]}"
         token = url.rsplit("=", 1)[1]
-        with urllib.request.urlopen(f"http://127.0.0.1:{port}/api/contents/notebooks?token={token}", timeout=30) as reply:
+        listing_url = f"http://127.0.0.1:{port}/api/contents/notebooks?token={token}"
+        with urllib.request.urlopen(listing_url, timeout=30) as reply:
             listing = reply.read().decode()
         assert "00_setup_and_workspace.ipynb" in listing
         # A JupyterLab terminal finds the venv's commands, `ros2` among them (on the pip install).

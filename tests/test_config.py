@@ -46,8 +46,8 @@ def _rules(tmp_path, line: str):
 
 
 def test_grading_on_submission_is_set_per_assignment(tmp_path):
-    rules = _rules(tmp_path, "c.GradeOnSubmit.assignments = {'brightness': {'attempts': 3, 'reasons_before_due': False},"
-                             " 'pubsub': {}}")
+    rules = _rules(tmp_path, "c.GradeOnSubmit.assignments = "
+                             "{'brightness': {'attempts': 3, 'reasons_before_due': False}, 'pubsub': {}}")
     assert rules == {"brightness": config.SubmitRules(attempts=3, reasons_before_due=False),
                      "pubsub": config.SubmitRules(attempts=None, reasons_before_due=True)}
 
@@ -58,7 +58,8 @@ def test_without_rules_no_assignment_is_graded_on_submission(tmp_path):
 
 @pytest.mark.parametrize("line, fix", [
     ("c.GradeOnSubmit.assignments = {'brightnes': {}}", "'brightnes' is no assignment of the course"),
-    ("c.GradeOnSubmit.assignments = {'pubsub': {'tries': 2}}", "has tries: the settings are attempts, reasons_before_due"),
+    ("c.GradeOnSubmit.assignments = {'pubsub': {'tries': 2}}",
+     "has tries: the settings are attempts, reasons_before_due"),
     ("c.GradeOnSubmit.assignments = {'pubsub': {'attempts': 0}}", "a whole number of at least 1"),
     ("c.GradeOnSubmit.assignments = {'pubsub': {'reasons_before_due': 'no'}}", "must be True or False"),
 ])

@@ -109,7 +109,8 @@ def sessions(hub):
     """Everyone logged in over HTTP at once (three servers start side by side): user -> session."""
     users = [hub.instructor, *hub.students]
     with concurrent.futures.ThreadPoolExecutor(len(users)) as pool:
-        return dict(zip(users, (session for session, _ in pool.map(lambda user: log_in(hub, user), users))))
+        sessions = [session for session, _ in pool.map(lambda user: log_in(hub, user), users)]
+        return dict(zip(users, sessions, strict=True))
 
 
 @pytest.fixture(scope="module")
@@ -174,7 +175,7 @@ def test_talkers_in_two_students_kernels_on_one_domain_never_hear_each_other(hub
     with concurrent.futures.ThreadPoolExecutor(2) as pool:
         said = dict(zip((alice, bob), pool.map(
             lambda user: run_in_kernel(hub, sessions[user], user, TALKER.format(
-                me=user, seconds=6, private=private[user], hidden=hidden)), (alice, bob))))
+                me=user, seconds=6, private=private[user], hidden=hidden)), (alice, bob)), strict=True))
     for user in (alice, bob):
         assert f"heard ['{user}']" in said[user], said
         for path in private[user]:
@@ -236,7 +237,7 @@ def test_students_get_graded_feedback_minutes_after_submit_and_only_their_own(hu
         wait_for_assignment(page, "fetched", ASSIGNMENT, 60)
     # Each student's page of the grading service, behind the hub's login (HubOAuth); closed while
     # the test looks through the same login with requests (a page open reloads itself every 2 s).
-    for user, page in pages.items():
+    for page in pages.values():
         status = page.context.new_page()
         status.goto(f"{hub.url}/services/grading/", wait_until="domcontentloaded")
         assert "No submission yet" in status.inner_text("body"), status.url
@@ -279,7 +280,8 @@ def test_students_get_graded_feedback_minutes_after_submit_and_only_their_own(hu
     status[bob].screenshot(path=str(SCREENSHOTS / "hub_grading_status.png"))
     assert "this is your 3rd" in status[bob].inner_text("body")
 
-    assert seen[0].startswith(("queued (", "grading")) and first["says"].startswith(f"graded: {maximum:g} / {maximum:g}"), seen
+    assert seen[0].startswith(("queued (", "grading")), seen
+    assert first["says"].startswith(f"graded: {maximum:g} / {maximum:g}"), seen
     shown = status[alice].inner_text("body")
     assert status[alice].locator("tr.submission").count() == 1 and bob not in shown, shown
     text = _fetch_feedback(pages[alice], hub, alice, 1)
@@ -372,7 +374,8 @@ def test_submissions_at_once_are_each_graded_once_across_a_kill_of_the_service(h
     service = grading_service(hub)
     for student in students[:AT_ONCE]:
         _drop_in_inbound(hub, student, like)
-    at_kill = _wait_for_rows(hub, students, lambda rows: any(r["state"] in ("graded", "released") for r in rows.values()))
+    at_kill = _wait_for_rows(hub, students,
+                             lambda rows: any(r["state"] in ("graded", "released") for r in rows.values()))
     service.kill()
     _wait_until_gone(service)
     left = [s for s, r in _queue_rows(hub, students).items() if r["state"] in ("queued", "grading", "graded")]
@@ -395,7 +398,8 @@ def test_submissions_at_once_are_each_graded_once_across_a_kill_of_the_service(h
     hub.coursehub("grade", ASSIGNMENT, "--student", students[0], "--force")
     plain = store.recorded_results(hub.course_dir, ASSIGNMENT, students[0])[0]
     assert not plain.from_cache and plain.score == graded.score, plain
-    assert [c["auto_score"] for c in plain.cells] == [c["auto_score"] for c in service_cells], (plain.cells, service_cells)
+    assert [c["auto_score"] for c in plain.cells] == [c["auto_score"] for c in service_cells], (
+        plain.cells, service_cells)
 
 
 def test_stopping_the_hub_stops_every_process_of_the_course(hub):

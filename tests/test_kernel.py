@@ -28,7 +28,8 @@ def test_the_graded_kernel_runs_code_and_offers_no_debugger(tmp_path, monkeypatc
         client.wait_for_ready(timeout=60)
         info = client.kernel_info(reply=True, timeout=30)["content"]
         outputs = []
-        client.execute_interactive("import os, sys; print(6 * 7, any(m.startswith(('debugpy.', '_pydevd')) for m in sys.modules), "
+        client.execute_interactive("import os, sys; "
+                                   "print(6 * 7, any(m.startswith(('debugpy.', '_pydevd')) for m in sys.modules), "
                                    "os.path.basename(sys.argv[0]), sys.path[0] == os.getcwd())", timeout=30,
                                    output_hook=lambda msg: outputs.append(msg["content"].get("text", "")))
     finally:

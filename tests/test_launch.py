@@ -171,7 +171,8 @@ def parameters_of(node_name: str, names: list[str]) -> dict:
         assert client.wait_for_service(timeout_sec=60), f"{node_name}/get_parameters did not appear"
         future = client.call_async(GetParameters.Request(names=names))
         assert session.wait_for(future.done, timeout=60), f"{node_name} did not answer get_parameters"
-        return {name: parameter_value_to_python(value) for name, value in zip(names, future.result().values)}
+        return {name: parameter_value_to_python(value)
+                for name, value in zip(names, future.result().values, strict=True)}
     finally:
         node.destroy_client(client)
 
@@ -256,7 +257,8 @@ def test_a_launch_file_error_is_reported_like_ros2_launch_and_starts_nothing(tmp
 def test_a_script_s_background_command_inherits_sigint_ignored(tmp_path, ros_domain):
     """What the next test relies on: sh gives `command &` SIGINT ignored."""
     code = "import signal; print(signal.getsignal(signal.SIGINT) is signal.SIG_IGN)"
-    shell, _ = in_background_of_a_script([sys.executable, "-c", code], tmp_path / "out", rosenv.ros_environment(domain_id=ros_domain))
+    shell, _ = in_background_of_a_script([sys.executable, "-c", code], tmp_path / "out",
+                                         rosenv.ros_environment(domain_id=ros_domain))
     assert shell.wait(timeout=60) == 0
     assert (tmp_path / "out").read_text() == "True\n"
 

@@ -41,7 +41,8 @@ def test_executable_is_prepared_as_launch_s_front_end_tests_read_it(tmp_path, fo
                         value: '1'
         """)
     process, = run_launch_file(path, environment={"PATH": "/bin"}).processes
-    assert (process.command, process.cwd, process.label, process.output) == (["ls", "-l", "-a", "-s"], "/", "my_ls", "log")
+    assert (process.command, process.cwd, process.label, process.output) == (
+        ["ls", "-l", "-a", "-s"], "/", "my_ls", "log")
     assert process.environment == {"PATH": "/bin", "var": "1"}
     assert (process.node_name, process.namespace) == (None, None)  # no node: nothing to wait for in the graph
 

@@ -25,9 +25,9 @@ def image_stats_launch(tmp_path, monkeypatch):
 
     from launch_demo import make_prefix
 
+    params = lesson_answers.lesson_file("02b_packages_launch_parameters.ipynb", "config/dark_fraction.yaml")
     prefix = make_prefix(tmp_path / "install", "image_stats", {"camera": "#!/bin/sh\n", "dark_fraction": "#!/bin/sh\n"},
-                         {"config/dark_fraction.yaml": lesson_answers.lesson_file("02b_packages_launch_parameters.ipynb",
-                                                                   "config/dark_fraction.yaml")})
+                         {"config/dark_fraction.yaml": params})
     monkeypatch.setenv("AMENT_PREFIX_PATH", f"{prefix}{os.pathsep}{os.environ.get('AMENT_PREFIX_PATH', '')}")
     xml = tmp_path / "dark.launch.xml"
     xml.write_text(lesson_answers.lesson_file("02b_packages_launch_parameters.ipynb", "launch/dark.launch.xml"))
@@ -66,8 +66,8 @@ def test_launch_yaml_check_names_a_relative_parameter_file_and_find_pkg_share(im
     found (or did not find) and the XML file's $(find-pkg-share ...), not parameter files' YAML."""
     cwd = tmp_path / "notebooks"
     (cwd / "config").mkdir(parents=True)
-    (cwd / "config" / "dark_fraction.yaml").write_text(lesson_answers.lesson_file("02b_packages_launch_parameters.ipynb",
-                                                                   "config/dark_fraction.yaml"))
+    (cwd / "config" / "dark_fraction.yaml").write_text(
+        lesson_answers.lesson_file("02b_packages_launch_parameters.ipynb", "config/dark_fraction.yaml"))
     monkeypatch.chdir(cwd)
     yaml_file = tmp_path / "dark.launch.yaml"
     yaml_file.write_text(LAUNCH_YAML.replace(SHARED_PARAMS, given))
@@ -77,7 +77,8 @@ def test_launch_yaml_check_names_a_relative_parameter_file_and_find_pkg_share(im
 
 def test_launch_yaml_check_shows_inline_parameters_on_one_line(image_stats_launch, tmp_path):
     yaml_file = tmp_path / "dark.launch.yaml"
-    yaml_file.write_text(LAUNCH_YAML.replace("    - {from: " + SHARED_PARAMS + "}", "    - {name: rate, value: 5.0}", 1))
+    yaml_file.write_text(LAUNCH_YAML.replace("    - {from: " + SHARED_PARAMS + "}",
+                                             "    - {name: rate, value: 5.0}", 1))
     verdict = str(selfcheck.task_launch_yaml(yaml_file, image_stats_launch))
     assert "parameter files are parameters {/**: {ros__parameters: {rate: 5.0}}}, the XML file gives " \
            f"{SHARED_PARAMS}" in verdict and "\n" not in verdict, verdict

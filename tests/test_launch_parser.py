@@ -271,7 +271,8 @@ def test_a_group_that_does_not_forward_keeps_only_what_it_keeps(tmp_path, demo_p
     inside, forwarded, after = run_launch_file(path, environment={}).processes
     assert (inside.command[1:4], inside.namespace, inside.environment) == (["none", "BAR", "BAZ"], None, {})
     assert (forwarded.command[1:3], forwarded.namespace) == (["kept_FOO", "BAR"], "/robot")
-    assert (after.command[1:3], after.namespace, after.environment) == (["FOO", "none"], "/robot", {"COURSE_OUTSIDE": "1"})
+    assert (after.command[1:3], after.namespace, after.environment) == (
+        ["FOO", "none"], "/robot", {"COURSE_OUTSIDE": "1"})
 
 
 @BOTH
@@ -369,7 +370,8 @@ def test_args_split_like_launch_splits_command_lines(text, expected):
      2, r"Unexpected attribute\(s\) found in `arg`: \{'whats_this'\}$"),
     ("xml", "<launch>\n  <arg name='a' default='asd'>\n    <whats_this/>\n  </arg>\n</launch>",
      3, r"Unexpected nested tag\(s\) found in `arg`: \{'whats_this'\}$"),
-    ("yaml", "launch:\n- arg: {name: a, whats_this: hello}", 2, r"Unexpected key\(s\) found in `arg`: \{'whats_this'\}$"),
+    ("yaml", "launch:\n- arg: {name: a, whats_this: hello}",
+     2, r"Unexpected key\(s\) found in `arg`: \{'whats_this'\}$"),
     ("xml", "<launch>\n  <node pkg='demo' exec='talker' respawn='true'/>\n</launch>",
      2, r"<node> attribute 'respawn' is not supported here; <node> supports: pkg, exec, name"),
     ("yaml", "launch:\n- node:\n    pkg: demo\n    exec: talker\n    namepsace: x",
@@ -378,8 +380,10 @@ def test_args_split_like_launch_splits_command_lines(text, expected):
      3, r"Unexpected nested tag\(s\) found in `node`: \{'parameter'\} \(did you mean 'param'\?\)$"),
     ("xml", "<launch>\n  <arg name='a'>\n    <choice value='x' valeu='y'/>\n  </arg>\n</launch>",
      3, r"Unexpected attribute\(s\) found in `choice`: \{'valeu'\} \(did you mean 'value'\?\)$"),
-    ("xml", "<launch>\n  <group>\n    <keep name='a'/>\n  </group>\n</launch>", 3, "<keep> needs the attribute 'value'"),
-    ("xml", "<launch>\n  <arg name='a' default='$(command ls)'/>\n</launch>", 2, r"\$\(command\) is not supported here"),
+    ("xml", "<launch>\n  <group>\n    <keep name='a'/>\n  </group>\n</launch>",
+     3, "<keep> needs the attribute 'value'"),
+    ("xml", "<launch>\n  <arg name='a' default='$(command ls)'/>\n</launch>",
+     2, r"\$\(command\) is not supported here"),
     ("xml", "<launch>\n  <node pkg='demo'/>\n</launch>", 2, "<node> needs the attribute 'exec'"),
     ("xml", "<launch>\n  <node pkg='demo' exec='talker'\n</launch>", 3, "not well-formed XML"),
     ("yaml", "launch:\n- node: {pkg: demo, exec: [talker\n", 3, "not valid YAML"),

@@ -54,7 +54,8 @@ def test_missing_values_are_errors_that_name_them(text, message):
     ("$(evn HOME)", r"\$\(evn\) is not a launch substitution \(did you mean 'env'\?\)"),
     # launch's words (the parse methods of LaunchConfiguration, ThisLaunchFileDir, NotSubstitution,
     # PythonExpression, IfElseSubstitution), then how to write it
-    ("$(var)", r"3: var substitution expects 1 or 2 arguments \(got 0 in '\$\(var\)'\): write \$\(var NAME \[DEFAULT\]\)$"),
+    ("$(var)",
+     r"3: var substitution expects 1 or 2 arguments \(got 0 in '\$\(var\)'\): write \$\(var NAME \[DEFAULT\]\)$"),
     ("$(dirname x)", r"3: dirname substitution doesn't expect arguments \(got 1 in"),
     ("$(not a b)", r"3: not substitution expects 1 argument \(got 2 in"),
     ("$(eval)", r"3: eval substitution expects 1 or 2 arguments \(got 0 in"),
@@ -124,8 +125,8 @@ def test_boolean_substitutions_in_let_as_launch_xml_and_launch_yaml_test_them(tm
         for kind in ("and", "or") for a in ("true", "false") for b in ("true", "false")]
     xml = "<launch>\n<let name='true_value' value='true'/>\n<let name='false_value' value='false'/>\n" + "".join(
         f"<let name='{name}' value='{value}'/>\n" for name, value in names) + "</launch>"
-    yaml_text = "launch:\n- let: {name: true_value, value: 'true'}\n- let: {name: false_value, value: 'false'}\n" + "".join(
-        f"- let: {{name: {name}, value: '{value}'}}\n" for name, value in names)
+    yaml_text = ("launch:\n- let: {name: true_value, value: 'true'}\n- let: {name: false_value, value: 'false'}\n"
+                 + "".join(f"- let: {{name: {name}, value: '{value}'}}\n" for name, value in names))
     configurations = run_launch_file(write(tmp_path, form, xml, yaml_text)).configurations
     assert {name: configurations[name] for name, _ in names} == {
         "not_true": "false", "not_false": "true",

@@ -190,7 +190,8 @@ def test_create_and_build_commands(built):
 
 
 def start(command: str, env: dict) -> processes.NodeProcess:
-    return processes.NodeProcess(["bash", "-c", f"exec {command}"], name="-".join(command.split()[1:4]), env=env).start()
+    return processes.NodeProcess(["bash", "-c", f"exec {command}"], name="-".join(command.split()[1:4]),
+                                 env=env).start()
 
 
 @pytest.mark.slow
@@ -233,7 +234,8 @@ def test_lesson_00_commands(tmp_path):
     """The lesson's package built as the lesson builds it, its node running: the ! lines print what it shows."""
     ws = tmp_path / "ros2_ws"
     pkg_create.create_package(ws, "my_package", dependencies=["rclpy"], node_name="my_node")
-    (ws / "src/my_package/my_package/my_node.py").write_text(lesson_answers.lesson_files(LESSON_00)["ros2_ws/src/my_package/my_package/my_node.py"])
+    node_file = "ros2_ws/src/my_package/my_package/my_node.py"
+    (ws / "src/my_package/my_package/my_node.py").write_text(lesson_answers.lesson_files(LESSON_00)[node_file])
     colcon.build(ws, ["my_package"])
     env = workspace.workspace_environment(ws)
     node = workspace.run(ws, "my_package", "my_node")

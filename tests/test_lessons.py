@@ -5,6 +5,7 @@
 
 import ast
 import re
+from itertools import pairwise
 from pathlib import Path
 
 import nbformat
@@ -69,14 +70,15 @@ def test_lesson_02_states_the_light_period_of_its_camera():
 
 def test_every_lesson_ends_with_a_summary_that_links_the_next_lesson_and_names_its_assignment():
     lessons = sorted(NOTEBOOKS.glob("*.ipynb"))
-    for lesson, following in zip(lessons, lessons[1:] + [None]):
+    for lesson, following in zip(lessons, lessons[1:] + [None], strict=True):
         last = _cells(lesson, "markdown")[-1]
         assert last.startswith("## Summary"), lesson.name
         if following is not None:
             assert f"]({following.name})" in last, f"{lesson.name} does not link {following.name}"
         else:
             assert "the last lesson" in last, lesson.name
-        assert re.search(r"[*`](pubsub|brightness|catdog_warp)[*`]|has none", last), f"{lesson.name} names no assignment"
+        assert re.search(r"[*`](pubsub|brightness|catdog_warp)[*`]|has none", last), (
+            f"{lesson.name} names no assignment")
 
 
 def test_lesson_02_exercise_uses_the_names_its_self_check_and_the_brightness_assignment_use():
@@ -105,7 +107,7 @@ def test_no_lesson_prints_a_count_times_a_number_that_reads_as_hexadecimal():
                 continue
             for node in ast.walk(ast.parse(_python(source))):
                 if isinstance(node, ast.JoinedStr):
-                    for value, text in zip(node.values, node.values[1:]):
+                    for value, text in pairwise(node.values):
                         assert not (isinstance(value, ast.FormattedValue) and isinstance(text, ast.Constant)
                                     and re.match(r"x\d", text.value)), f"{lesson.name}: {ast.unparse(node)}"
 

@@ -28,7 +28,8 @@ def _submit(tmp_path, rules: dict, earlier: list[str]):
         (tmp_path / "cache" / COURSE / f"ann+brightness+{stamp}").mkdir(parents=True, exist_ok=True)
     (tmp_path / "rules.json").write_text(json.dumps(rules))
     c = Config()
-    c.CourseDirectory.course_id, c.CourseDirectory.assignment_id, c.CourseDirectory.student_id = COURSE, "brightness", "ann"
+    c.CourseDirectory.course_id, c.CourseDirectory.assignment_id = COURSE, "brightness"
+    c.CourseDirectory.student_id = "ann"
     c.Exchange.root, c.Exchange.cache = str(tmp_path / "exchange"), str(tmp_path / "cache")
     c.Exchange.assignment_dir = str(tmp_path / "work")
     c.LimitedSubmit.rules_file = str(tmp_path / "rules.json")

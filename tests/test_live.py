@@ -203,7 +203,8 @@ def test_array_elements_are_plotted_by_index():
     name, topic, cls, read = live.resolve_field_path(None, "/scan/ranges[1]", msg_type=LaserScan)
     assert (name, topic, cls) == ("/scan/ranges[1]", "/scan", LaserScan)
     assert read(LaserScan(ranges=[1.0, 2.5])) == 2.5
-    with pytest.raises(ValueError, match=r"is an array \(sequence<float>\): plot one element, e\.g\. /scan/ranges\[0\]"):
+    with pytest.raises(ValueError,
+                       match=r"is an array \(sequence<float>\): plot one element, e\.g\. /scan/ranges\[0\]"):
         live.resolve_field_path(None, "/scan/ranges", msg_type=LaserScan)
 
 

@@ -50,7 +50,8 @@ def test_photographs_have_dark_corners_and_are_the_same_for_the_same_seed():
 
 def test_corners_are_of_the_kinds_asked_for_and_the_same_for_the_same_seed():
     photo = photos.draw_photo(1, corners=("near_black", "light", "brown", "navy"))
-    tl, tr, br, bl = (photo[y:y + 4, x:x + 4].reshape(-1, 3).mean(axis=0) for y, x in ((0, 0), (0, 396), (296, 396), (296, 0)))
+    tl, tr, br, bl = (photo[y:y + 4, x:x + 4].reshape(-1, 3).mean(axis=0)
+                      for y, x in ((0, 0), (0, 396), (296, 396), (296, 0)))
     assert tl.max() < 40 and tr.min() > 130, (tl, tr)
     assert br[2] > br[1] > br[0] and 40 < br.mean() < 130, f"brown (BGR) {br}"
     assert bl[0] > bl[2] and bl[0] > bl[1] and bl.mean() < 100, f"navy (BGR) {bl}"

@@ -36,7 +36,8 @@ def test_a_notebook_stopped_at_its_share_names_the_seconds_given_and_the_cells_t
 
 
 def test_the_report_shows_where_the_time_went():
-    result = GradeResult("s", "a", "", steps={"stage_course_root": 0.01, "run_notebook": 5.43, "run_hidden_checks": 6.3})
+    result = GradeResult("s", "a", "",
+                         steps={"stage_course_root": 0.01, "run_notebook": 5.43, "run_hidden_checks": 6.3})
     assert report.step_seconds(result) == "run_notebook=5.4 run_hidden_checks=6.3"
 
 
@@ -90,7 +91,8 @@ def test_an_early_run_still_going_at_the_deadline_is_waited_for_not_dropped(tmp_
         building.wait(10)  # a build still running when the deadline passes
         return {"BUILT": "1"}
 
-    monkeypatch.setattr(hidden_checks, "run_checks", lambda sub, names, *args, **kwargs: dict.fromkeys(names, "verdict"))
+    monkeypatch.setattr(hidden_checks, "run_checks",
+                        lambda sub, names, *args, **kwargs: dict.fromkeys(names, "verdict"))
     sub = Submission("s", "brightness", tmp_path)
     g = pipeline.Grading(sub, None, 0, GradeResult("s", "brightness", ""), tmp_path, deadline=time.monotonic() - 1)
     early = early_checks.EarlyRun(g, ["values"], build)

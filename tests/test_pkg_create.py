@@ -108,8 +108,9 @@ def test_create_interface_package_lists_services_and_actions_in_their_folders(tm
     """ROS 2's "Creating custom msg and srv files" and "Creating an action" tutorials: srv/X.srv and
     action/X.action in rosidl_generate_interfaces, and action_msgs as a dependency for actions."""
     package = pkg_create.create_interface_package(
-        tmp_path, "tutorial_interfaces", {"Num": "int64 num", "AddThreeInts.srv": "int64 a\n---\nint64 sum",
-                                          "Fibonacci.action": "int32 order\n---\nint32[] sequence\n---\nint32[] partial"})
+        tmp_path, "tutorial_interfaces",
+        {"Num": "int64 num", "AddThreeInts.srv": "int64 a\n---\nint64 sum",
+         "Fibonacci.action": "int32 order\n---\nint32[] sequence\n---\nint32[] partial"})
     cmake = (package / "CMakeLists.txt").read_text()
     assert re.search(r'"msg/Num.msg"\s+"srv/AddThreeInts.srv"\s+"action/Fibonacci.action"\s+'
                      r"DEPENDENCIES builtin_interfaces action_msgs\s*\)", cmake), cmake

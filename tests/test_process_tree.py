@@ -11,7 +11,8 @@ from course_lib import process_tree
 
 def _group(token: str, code: str) -> subprocess.Popen:
     """A python group leader (its own session) running `code`, with a sleeping child in its group."""
-    child = f"import subprocess, sys; subprocess.Popen([sys.executable, '-S', '-c', 'import time; time.sleep(60)', {token!r}]); "
+    child = ("import subprocess, sys; "
+             f"subprocess.Popen([sys.executable, '-S', '-c', 'import time; time.sleep(60)', {token!r}]); ")
     return subprocess.Popen([sys.executable, "-S", "-c", child + code, token], start_new_session=True,
                             stdout=subprocess.PIPE, text=True)
 
@@ -26,7 +27,8 @@ def test_signal_tree_reaches_the_whole_group(token):
 
 
 def test_stop_group_escalates_past_a_leader_that_ignores_sigint(token):
-    code = "import signal, time; signal.signal(signal.SIGINT, signal.SIG_IGN); print('ready', flush=True); time.sleep(60)"
+    code = ("import signal, time; signal.signal(signal.SIGINT, signal.SIG_IGN); print('ready', flush=True); "
+            "time.sleep(60)")
     leader = _group(token, code)
     assert leader.stdout.readline() == "ready\n"
     steps = ((signal.SIGINT, 0.3), (signal.SIGTERM, 5.0), (signal.SIGKILL, 5.0))

@@ -203,10 +203,10 @@ def test_log_survives_stop_and_its_files_are_removed():
 
 
 def test_context_manager_stops_the_child_on_an_exception(token):
-    with pytest.raises(ZeroDivisionError):
+    with pytest.raises(ZeroDivisionError, match="inside the block"):
         with NodeProcess(sleeper(token)).start():
             assert wait_until(lambda: processes_with(token))
-            1 / 0
+            raise ZeroDivisionError("inside the block")
     assert processes_with(token) == []
 
 

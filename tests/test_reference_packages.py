@@ -237,10 +237,14 @@ def test_marker_reader_accepts_bgr_rgb_mono_and_skips_bad_images(built_ws, domai
         executor.add_node(reader)
         executor.add_node(tester)
         assert spin_until(executor, lambda: publisher.get_subscription_count() > 0), "reader never matched"
+
+        def deliver(msg, frames_before: int) -> bool:
+            """One image at a time (the reader keeps the last few only), sent again if one was lost."""
+            return spin_until(executor, lambda: reader.frames_received > frames_before,
+                              every=lambda: publisher.publish(msg))
+
         for index, (_, msg) in enumerate(sequence):
-            # One at a time (the reader keeps the last few images only), again if one was lost.
-            assert spin_until(executor, lambda: reader.frames_received > index,
-                              every=lambda: publisher.publish(msg)), f"image {index} never arrived"
+            assert deliver(msg, index), f"image {index} never arrived"
         assert spin_until(executor, lambda: all(len(received[n]) >= 3 for n in received)), received
         executor.shutdown()
         reader.destroy_node()

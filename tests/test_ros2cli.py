@@ -213,7 +213,7 @@ def test_topic_hz_prints_rates_until_ctrl_c(live):
         hz.kill()
         hz.wait()
     reports = []
-    for average, spread in zip(lines[::2], lines[1::2]):
+    for average, spread in zip(lines[::2], lines[1::2], strict=True):
         assert re.fullmatch(r"average rate: \d+\.\d{3}\n", average), lines
         found = re.fullmatch(r"\tmin: (\d+\.\d{3})s max: (\d+\.\d{3})s std dev: \d+\.\d{5}s window: (\d+)\n", spread)
         assert found, lines
@@ -338,7 +338,8 @@ def test_interface_verbs():
 @pytest.mark.parametrize("name, words", [
     # ros2interface's test_cli.py: test_show_not_a_package, test_show_not_an_interface (rosidl_runtime_py)
     ("not_a_package/msg/String", "Unknown package 'not_a_package'\n"),
-    ("std_msgs/msg/NotAMessageTypeName", r"Could not find the interface '/.+/share/std_msgs/msg/NotAMessageTypeName\.idl'\n"),
+    ("std_msgs/msg/NotAMessageTypeName",
+     r"Could not find the interface '/.+/share/std_msgs/msg/NotAMessageTypeName\.idl'\n"),
     ("std_msgs/String", "Invalid name 'std_msgs/String'. Expected three parts separated by '/'\n"),  # show.py
 ])
 def test_interface_show_of_what_is_not_there_says_it_in_ros2clis_words(name, words):

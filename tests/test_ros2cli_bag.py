@@ -40,7 +40,8 @@ class BagNode(Node):
 
     def __init__(self):
         super().__init__('bag_node')
-        self.latched = self.create_publisher(Int32, 'latched', QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL))
+        self.latched = self.create_publisher(Int32, 'latched',
+                                             QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL))
         self.latched.publish(Int32(data=42))
         self.chatter = self.create_publisher(String, 'chatter', 10)
         self.create_subscription(String, 'played', lambda msg: print(f'heard {msg.data}', flush=True), 10)

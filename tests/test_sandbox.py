@@ -97,7 +97,8 @@ def test_interpreter_below_a_closed_folder_is_reachable_for_another_uid_and_noth
     blocked = exposure["AUTOGRADER_BLOCKED"]
     command = sandbox.sandbox_command(
         ["setpriv", "--reuid=61999", "--regid=61999", "--clear-groups", "--", sys.executable, "-I", "-c",
-         f"import os, sys; print(os.getuid(), os.listdir({blocked!r}) == [{Path(sys.base_prefix).relative_to(blocked).parts[0]!r}])"],
+         f"import os, sys; print(os.getuid(), os.listdir({blocked!r}) == "
+         f"[{Path(sys.base_prefix).relative_to(blocked).parts[0]!r}])"],
         [])
     done = subprocess.run(command, capture_output=True, text=True, timeout=60,
                           env={**os.environ, **exposure, "AUTOGRADER_STAGE": str(stage)})

@@ -17,7 +17,7 @@ def reference_crops(frame, size=marker_board.DEFAULT_SIZE):
     """Detect the markers, then warp each picture whose four markers were found exactly once."""
     corners, ids, _ = marker_board.detector().detectMarkers(frame)
     seen = {}
-    for marker, marker_id in zip(corners, [] if ids is None else ids.ravel()):
+    for marker, marker_id in zip(corners, [] if ids is None else ids.ravel(), strict=True):
         seen.setdefault(int(marker_id), []).append(marker.reshape(4, 2))
     unique = {marker_id: found[0] for marker_id, found in seen.items() if len(found) == 1}
     crops = {}
@@ -99,7 +99,7 @@ def test_detected_corners_in_clean_frames_match_the_ground_truth():
     for seed in range(20):
         scene = scenes.render_scene(seed, look=camera_views.Look())
         corners, ids, _ = marker_board.detector(parameters).detectMarkers(scene.frame)
-        found = {int(i): c.reshape(4, 2) for c, i in zip(corners, ids.ravel())}
+        found = {int(i): c.reshape(4, 2) for c, i in zip(corners, ids.ravel(), strict=True)}
         assert scene.visible_ids == BOARD_IDS, f"seed {seed}: easy scenes show the whole board"
         assert sorted(found) == list(scene.visible_ids), f"seed {seed}"
         for marker_id in scene.visible_ids:

@@ -16,7 +16,8 @@ def test_the_checks_verdicts_are_replaced_and_the_students_outputs_kept():
     nb = nbformat.v4.new_notebook()
     answer = nbformat.v4.new_code_cell("print(7)", outputs=[nbformat.v4.new_output("stream", text="7\n")])
     answer.metadata["nbgrader"] = {"solution": True, "grade": False, "grade_id": "answer"}
-    check = nbformat.v4.new_code_cell("grade()", outputs=[nbformat.v4.new_output("stream", text="✘ returned 255, expected 127\n")])
+    check = nbformat.v4.new_code_cell(
+        "grade()", outputs=[nbformat.v4.new_output("stream", text="✘ returned 255, expected 127\n")])
     check.metadata["nbgrader"] = {"solution": False, "grade": True, "grade_id": "check", "points": 4}
     nb.cells = [answer, check]
     ScoresOnly().preprocess(nb, {})

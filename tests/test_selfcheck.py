@@ -161,7 +161,7 @@ def corners_using(marker_corner):
     from course_lib import marker_board
 
     def picture_corners_of(markers, picture):
-        return np.array([markers[m][c] for m, c in zip(marker_board.PICTURES[picture], marker_corner)])
+        return np.array([markers[m][c] for m, c in zip(marker_board.PICTURES[picture], marker_corner, strict=True)])
     return picture_corners_of
 
 

@@ -6,6 +6,7 @@ import threading
 
 import pytest
 import rclpy
+from rclpy.exceptions import InvalidHandle
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 
@@ -79,7 +80,7 @@ def test_readding_a_node_replaces_the_old_one(domain_id, quick_graph):
     assert session.wait_for(lambda: old.ticks >= 2, timeout=10)
     new = session.add_node(Counter())
     assert session.nodes() == [new]
-    with pytest.raises(Exception):  # the old node was destroyed
+    with pytest.raises(InvalidHandle, match="destruction was requested"):  # the old node was destroyed
         old.get_fully_qualified_name()
     assert session.wait_for(lambda: graph.node_list().count("/counter") == 1, timeout=30), \
         graph.node_list()
@@ -102,7 +103,8 @@ def test_recreating_a_node_replaces_it_without_warning_and_keeps_the_graph_right
     session.start(domain_id=domain_id)
     old = session.add_node(Listener())
     new = session.add_node(Listener())
-    with pytest.raises(Exception):  # the old node was destroyed when the new one was created
+    # The old node was destroyed when the new one was created.
+    with pytest.raises(InvalidHandle, match="destruction was requested"):
         old.get_fully_qualified_name()
     assert session.nodes() == [new]
     subscribers = [endpoint.node for endpoint in graph.topic_info("/chatter").subscriptions]
@@ -232,7 +234,7 @@ def test_remove_node_by_plain_name(domain_id):
     second = session.add_node(Counter("second"))
     session.remove_node("first")
     assert session.nodes() == [second]
-    with pytest.raises(Exception):
+    with pytest.raises(InvalidHandle, match="destruction was requested"):
         first.get_fully_qualified_name()
     session.remove_node(second)
     assert session.nodes() == []

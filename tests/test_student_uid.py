@@ -28,7 +28,8 @@ def test_the_students_process_runs_as_the_uid_with_a_home_it_owns(tmp_path, monk
     process = StudentUid(UID, max_processes=64).start(["sh", "-c", REPORT], name="student-test", cwd="/",
                                                       domain_id=0, wall_seconds=30)
     process.wait(timeout=30)
-    assert process.log.split() == [str(UID), str(UID), "True", str(UID), "64", str(contract.STUDENT_MEMORY_MB), "None"], process.log
+    assert process.log.split() == [str(UID), str(UID), "True", str(UID), "64", str(contract.STUDENT_MEMORY_MB),
+                                   "None"], process.log
 
 
 @needs_root

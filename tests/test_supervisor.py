@@ -13,7 +13,8 @@ from course_lib.processes import Limits, NodeProcess
 
 
 def test_child_that_ignores_sigint_is_killed_after_the_timeout(token):
-    code = "import signal, time; signal.signal(signal.SIGINT, signal.SIG_IGN); print('ready', flush=True); time.sleep(100)"
+    code = ("import signal, time; signal.signal(signal.SIGINT, signal.SIG_IGN); print('ready', flush=True); "
+            "time.sleep(100)")
     process = NodeProcess([sys.executable, "-c", code, token]).start()
     assert wait_until(lambda: "ready" in process.log), process.log
     assert process.stop(timeout=0.5) == -signal.SIGKILL
@@ -24,7 +25,8 @@ def test_child_that_ignores_sigint_is_killed_after_the_timeout(token):
 def test_send_signal_passes_one_signal_on_and_the_exit_counts_as_stopped(token):
     """A caller that paces its own stop (ros2 launch) signals through the supervisor: SIGINT is
     ignored here, SIGTERM ends the child, and the supervisor kills nothing on its own."""
-    code = "import signal, time; signal.signal(signal.SIGINT, signal.SIG_IGN); print('ready', flush=True); time.sleep(100)"
+    code = ("import signal, time; signal.signal(signal.SIGINT, signal.SIG_IGN); print('ready', flush=True); "
+            "time.sleep(100)")
     process = NodeProcess([sys.executable, "-c", code, token]).start()
     assert wait_until(lambda: "ready" in process.log), process.log
     process.send_signal(signal.SIGINT)

@@ -38,7 +38,8 @@ DUE = "2025-03-14 23:59:00 UTC"
 ON_TIME, LATE = "2025-03-14-20-15-00", "2025-03-16-09-30-00"  # LATE: 1 d 9.5 h late, 2 started days
 PER_DAY = 0.1
 #: bob's subscriber raises in its constructor: the publisher's points only, and a traceback of his module.
-BROKEN_SUBSCRIBER = [("        self.subscription = self.create_subscription(\n            MsgTutorial, TOPIC, self.on_message, QUEUE_DEPTH)",
+BROKEN_SUBSCRIBER = [("        self.subscription = self.create_subscription(\n"
+                       "            MsgTutorial, TOPIC, self.on_message, QUEUE_DEPTH)",
                       "        raise RuntimeError('subscriber not written yet')")]
 ROSTER = "id,first_name,last_name,email,Section\nalice,Alice,Ang,alice@example.org,A\nbob,Bob,\"Baker, Jr.\",,A\n" \
          "carol,Carol,Chen,,B\ndave,Dave,Dunn,,B\n"

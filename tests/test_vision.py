@@ -19,7 +19,7 @@ def test_draw_markers_draws_on_a_copy_and_leaves_the_input_alone():
 def test_draw_markers_colours_each_corner_number_differently():
     annotated = vision.draw_markers(np.zeros((100, 120), np.uint8), {3: SQUARE})
     assert annotated.ndim == 3, "a grey frame comes back as BGR so the colours show"
-    for corner, colour in zip(SQUARE.astype(int), vision.CORNER_COLOURS):
+    for corner, colour in zip(SQUARE.astype(int), vision.CORNER_COLOURS, strict=True):
         assert tuple(annotated[corner[1], corner[0]]) == colour
 
 

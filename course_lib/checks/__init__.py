@@ -4,7 +4,8 @@
   ``catdog_warp``). A notebook imports one as ``checks`` and calls ``checks.selfcheck("values")``.
 - ``registry`` (what a check is), ``runner`` (how it runs: its own process, ``check_process``),
   ``context`` (what a check gets), ``student_server``/``student_calls``/``student_processes`` (the
-  student's code in another process, one per module serving many calls), ``probe`` (the checker's ROS node), ``result`` (the verdict).
+  student's code in another process, one per module serving many calls), ``probe`` (the checker's
+  ROS node), ``result`` (the verdict).
 - ``answers``: where a check's expected answers come from: the grader's answer key when graded
   (instructor side: the folder the grader hands over, contract.ANSWER_KEYS_ENV), answers
   recorded from it in a self-check.

@@ -119,7 +119,8 @@ publishes generated frames and compares what comes back with the right answer. E
 what is right and what is wrong; at grading the same checks run again with frames you have not seen.
 """
 
-BRIGHTNESS_NODE_CHECK = """The check starts your node as `ros2 run brightness brightness_node` (build first) in a ROS domain of
+BRIGHTNESS_NODE_CHECK = """\
+The check starts your node as `ros2 run brightness brightness_node` (build first) in a ROS domain of
 its own, publishes frames on `/image` and reads `/brightness`. A Python loop over every byte is too
 slow for 30 frames of 1920×1080 per second: let numpy do the sum.
 """

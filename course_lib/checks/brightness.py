@@ -60,8 +60,9 @@ def _test_images(rng: np.random.Generator) -> list[tuple[str, np.ndarray]]:
 def values(ctx: Context) -> None:
     """average_brightness returns the floor of the mean byte, as an int, for colour and grey images."""
     cases = _test_images(ctx.rng)
-    outcomes = ctx.call("average_brightness", [((image,), {}) for _, image in cases], labels=[label for label, _ in cases])
-    for (label, image), outcome in zip(cases, outcomes):
+    outcomes = ctx.call("average_brightness", [((image,), {}) for _, image in cases],
+                        labels=[label for label, _ in cases])
+    for (label, image), outcome in zip(cases, outcomes, strict=True):
         expected = ctx.expected("average_brightness", image)
         mean = float(image.mean())
         if not outcome.ok:
@@ -146,6 +147,23 @@ def _node_names(probe) -> set[str]:
     return {name for name, _ns in probe.node.get_node_names_and_namespaces()}
 
 
+def _send_until_answered(ctx, probe, node, publisher, replies: list, msg, expected: int, earlier: set) -> None:
+    """Publish the frame `msg` until the node answers `expected` (collected in `replies`), ends,
+    gives WRONG_ANSWERS wrong answers or computes without answering (ctx.no_answer_coming).
+
+    Resent every 0.3 s (best effort may drop a frame). `earlier` holds the right answers of all
+    frames sent before: a slow node's late answers to them are not wrong answers to this one.
+    """
+    replies.clear()
+    gave_up = ctx.no_answer_coming(node, 4.0)
+
+    def done() -> bool:
+        return (expected in replies or not node.running()
+                or _wrong(replies, earlier - {expected}) >= WRONG_ANSWERS or gave_up())
+
+    probe.resend_until(publisher, msg, done, scaled(4.0))
+
+
 def _exchange(ctx, probe, node, publisher, replies: list, frames, encoding: str, label: str,
               earlier: set) -> bool | None:
     """Publish each frame until its brightness comes back; record one item for all frames.
@@ -157,14 +175,8 @@ def _exchange(ctx, probe, node, publisher, replies: list, frames, encoding: str,
 
     for image in frames:
         expected = ctx.expected("average_brightness", image)
-        msg = images.image_to_msg(image, encoding)
-        replies.clear()
-        # Resent every 0.3 s (best effort may drop a frame); WRONG_ANSWERS wrong answers end the
-        # wait early. `earlier` collects the right answers of all frames sent before.
-        wrong = lambda: _wrong(replies, earlier - {expected}) >= WRONG_ANSWERS  # noqa: E731
-        gave_up = ctx.no_answer_coming(node, 4.0)
-        probe.resend_until(publisher, msg, lambda: expected in replies or not node.running() or wrong() or gave_up(),
-                           scaled(4.0))
+        _send_until_answered(ctx, probe, node, publisher, replies, images.image_to_msg(image, encoding), expected,
+                             earlier)
         earlier.add(expected)
         if not node.running():
             return None
@@ -247,7 +259,7 @@ def _consequences(ctx, cause: str, done: int) -> None:
 
 @check(points=7, timeout=90)
 def node(ctx: Context) -> None:
-    """BrightnessNode: name brightness_node, /image -> /brightness with sensor-data QoS, bgr8 and mono8, 30 Hz at 1080p, remappable."""
+    """BrightnessNode: name brightness_node, /image -> /brightness with sensor-data QoS, bgr8 and mono8, 30 Hz at 1080p, remappable."""  # noqa: E501 (the check's description, one line: registry.check)
     # Every input is drawn first: what is drawn must not depend on how the run goes (the
     # self-check's answers were recorded for exactly these inputs).
     colour = [ctx.rng.integers(0, 256, size=(480, 640, 3), dtype=np.uint8) // int(d) for d in (1, 2, 3)]
@@ -328,11 +340,14 @@ def _burst(probe, publisher, replies: list, yardstick_replies: list, frames: lis
         publisher.publish(frames[index % 2])
         probe.spin_until(lambda: False, max(0.0, start + (index + 1) / THROUGHPUT_RATE - time.monotonic()))
     end = time.monotonic() + 2.0
-    while time.monotonic() < end:
-        before = len(replies) + len(yardstick_replies)
-        probe.spin_until(lambda: len(replies) + len(yardstick_replies) > before, 0.3)
-        if len(replies) + len(yardstick_replies) == before:
-            break
+    while time.monotonic() < end and _answer_comes(probe, (replies, yardstick_replies), 0.3):
+        pass  # each answer gives the next one another 0.3 s
+
+
+def _answer_comes(probe, answers: tuple, seconds: float) -> bool:
+    """Spin `probe` until one of the lists `answers` grows, at most `seconds`; whether one did."""
+    before = sum(map(len, answers))
+    return probe.spin_until(lambda: sum(map(len, answers)) > before, seconds)
 
 
 def _replies(probe, topic: str) -> list:
@@ -434,8 +449,8 @@ def _throughput(ctx, probe, node, yardstick, publisher, replies, yardstick_repli
                                      and publisher.get_subscription_count() >= 2) or not yardstick.running(),
                             scaled(30.0)) \
             or not yardstick.running():
-        ctx.item(True, f"{label}: not measured, the grader's yardstick node did not start ({yardstick.describe_exit()}); "
-                       "not held against you", weight=2.0)
+        ctx.item(True, f"{label}: not measured, the grader's yardstick node did not start "
+                       f"({yardstick.describe_exit()}); not held against you", weight=2.0)
         return
     frames = [image_msgs.image_to_msg(i, "bgr8") for i in images]
     student, reference = CpuCost(), CpuCost()

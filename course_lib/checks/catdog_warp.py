@@ -93,7 +93,8 @@ def _check_scene(ctx, label: str, scene, outcome, show: bool = False) -> None:
     from course_lib import marker_board
 
     if not outcome.ok:
-        hint = " (replace `raise NotImplementedError()` with your code)" if outcome.error.startswith("NotImplementedError") else ""
+        stub = outcome.error.startswith("NotImplementedError")
+        hint = " (replace `raise NotImplementedError()` with your code)" if stub else ""
         ctx.item(False, f"{label}: crop_pictures failed: {outcome.error}{hint}")
         return
     result = outcome.value
@@ -123,7 +124,7 @@ def _check_scene(ctx, label: str, scene, outcome, show: bool = False) -> None:
 def _run_scenes(ctx, cases, show_first: bool = True) -> None:
     outcomes = ctx.call("crop_pictures", [((scene.frame,), {"size": list(SIZE)}) for _, scene in cases],
                         labels=[f"'{label}'" for label, _ in cases])
-    for index, ((label, scene), outcome) in enumerate(zip(cases, outcomes)):
+    for index, ((label, scene), outcome) in enumerate(zip(cases, outcomes, strict=True)):
         _check_scene(ctx, label, scene, outcome, show=show_first and index == 0)
 
 
@@ -141,7 +142,7 @@ def hard(ctx: Context) -> None:
     from course_lib import scenes
 
     cases = []
-    for attempt in range(40):  # two scenes that show a whole picture, then one of any kind
+    for _attempt in range(40):  # two scenes that show a whole picture, then one of any kind
         seed = _seed(ctx)
         if len(cases) < 2 and not scenes.framed_from(scenes.scene_pose(seed, difficulty="hard")):
             continue  # no picture can be whole in view: drawing the scene would be wasted
@@ -163,18 +164,20 @@ def missing_and_none(ctx: Context) -> None:
     cases = []
     for k in range(4):
         gone = [ids[k] for ids in marker_board.PICTURES.values()]
-        cases.append((f"markers {gone} missing", scenes.render_scene(_seed(ctx), difficulty="easy", missing_markers=gone)))
+        cases.append((f"markers {gone} missing",
+                      scenes.render_scene(_seed(ctx), difficulty="easy", missing_markers=gone)))
     cases.append(("no markers on the board", scenes.render_scene(_seed(ctx), difficulty="easy",
                                                                  missing_markers=list(range(1, 9)))))
     noise = ctx.rng.integers(0, 256, size=(480, 640, 3), dtype=np.uint8)
     outcomes = ctx.call("crop_pictures", [((scene.frame,), {"size": list(SIZE)}) for _, scene in cases]
                         + [((noise,), {"size": list(SIZE)})], labels=[f"'{label}'" for label, _ in cases] + ["noise"])
-    for (label, scene), outcome in zip(cases, outcomes):
+    for (label, scene), outcome in zip(cases, outcomes[:-1], strict=True):
         _check_scene(ctx, label, scene, outcome)
     outcome = outcomes[-1]
     ok = outcome.ok and outcome.value == {}
+    got = sorted(outcome.value) if outcome.ok and isinstance(outcome.value, dict) else outcome.value
     ctx.item(ok, "noise: returns {}" if ok else "noise: expected {}, got " +
-             (outcome.error if not outcome.ok else f"keys {sorted(outcome.value) if isinstance(outcome.value, dict) else outcome.value}"))
+             (outcome.error if not outcome.ok else f"keys {got}"))
 
 
 @check(points=1, timeout=60)
@@ -235,7 +238,8 @@ def _single_node_items(ctx: Context, proc, message_type) -> bool:
         with ctx.probe() as probe:
             got: dict[str, list] = {"cat": [], "dog": []}
             # Reliable publisher and best-effort subscriptions match every QoS the student may pick.
-            pub = probe.node.create_publisher(Image, "image", QoSProfile(depth=5, reliability=ReliabilityPolicy.RELIABLE))
+            pub = probe.node.create_publisher(Image, "image",
+                                              QoSProfile(depth=5, reliability=ReliabilityPolicy.RELIABLE))
             numbers = {number: name for name, number in PICTURE_NUMBERS.items()}
             probe.node.create_subscription(
                 message_type, "cropped_img",
@@ -250,8 +254,9 @@ def _single_node_items(ctx: Context, proc, message_type) -> bool:
             if not proc.running():
                 ctx.item(False, f"the node process ended ({proc.describe_exit()}):\n{clip(proc.log_tail(6))}")
                 return False
-            if not ctx.precondition("marker_reader" in names(), "node marker_reader runs" if "marker_reader" in names() else
-                            f"no node named marker_reader (nodes: {sorted(names())})"):
+            running = "marker_reader" in names()
+            if not ctx.precondition(running, "node marker_reader runs" if running else
+                                    f"no node named marker_reader (nodes: {sorted(names())})"):
                 return False
             gave_up = ctx.no_answer_coming(proc, 8.0)
             probe.resend_until(pub, msg, lambda: bool(got["cat"] and got["dog"]) or not proc.running() or gave_up(),
@@ -266,13 +271,15 @@ def _single_node_items(ctx: Context, proc, message_type) -> bool:
             seen = types.get("/cropped_img")
             ctx.item(False, f"no {name} (picture = {PICTURE_NUMBERS[name]}) arrived on /cropped_img" +
                      (f" (it carries {seen}; the contract says {wanted[0]})" if seen and seen != wanted else
-                      "" if seen else f" (topics: {sorted(t for t in types if not t.startswith(('/rosout', '/parameter')))})") +
+                      "" if seen else
+                      f" (topics: {sorted(t for t in types if not t.startswith(('/rosout', '/parameter')))})") +
                      "; the node's output:\n" + clip(proc.log_tail(4)))
             continue
         try:
             crop = images.compressed_to_image(got[name][-1], want="bgr8")
         except Exception as error:  # what the student sent is not a decodable image
-            ctx.item(False, f"{topic}: the message does not decode ({error}); use images.image_to_compressed(crop, 'png')")
+            ctx.item(False, f"{topic}: the message does not decode ({error}); "
+                            "use images.image_to_compressed(crop, 'png')")
             continue
         compare_crop(ctx, topic, crop, expected[name], show=True)
     return True
@@ -313,7 +320,9 @@ def _launch_item(ctx: Context, message_type) -> tuple[bool, str]:
             reader: dict = {}
 
             def reader_gave_up() -> bool:
-                if "gave_up" not in reader and "marker_reader" in {n for n, _ in probe.node.get_node_names_and_namespaces()}:
+                if "gave_up" in reader:
+                    return reader["gave_up"]()
+                if "marker_reader" in {n for n, _ in probe.node.get_node_names_and_namespaces()}:
                     member = launch.member("marker_reader")
                     if member is not None:
                         reader["gave_up"] = ctx.no_answer_coming(member, 8.0)

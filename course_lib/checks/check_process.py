@@ -42,12 +42,14 @@ def run_in_this_process(assignment: str, name: str, seed: int, workdir: Path, ou
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m course_lib.checks.check_process", description="Run one graded check.")
+    parser = argparse.ArgumentParser(prog="python -m course_lib.checks.check_process",
+                                     description="Run one graded check.")
     sub = parser.add_subparsers(dest="command", required=True)
     run = sub.add_parser("run")
     run.add_argument("assignment")
     run.add_argument("check")
-    run.add_argument("--seed", type=int, default=None, help=f"default: ${contract.CHECK_SEED_ENV}, else {SELFCHECK_SEED}")
+    run.add_argument("--seed", type=int, default=None,
+                     help=f"default: ${contract.CHECK_SEED_ENV}, else {SELFCHECK_SEED}")
     run.add_argument("--workdir", default=".")
     run.add_argument("--out", required=True)
     args = parser.parse_args(argv)

@@ -204,7 +204,8 @@ class Context:
                                "(it writes your module)")
         if self.import_hung():
             raise StudentError(f"importing {self.module} did not finish in an earlier check: remove code that "
-                               "runs forever at import (loops, spin()) from the top level of the module; put it in main()")
+                               "runs forever at import (loops, spin()) from the top level of the module; put it in "
+                               "main()")
 
     def import_hung(self) -> bool:
         """Whether importing the student's module did not finish in an earlier check of this grading."""
@@ -234,7 +235,7 @@ class Context:
         labels = labels or [f"input {index + 1}" for index in range(len(calls))]
         server = self.servers.server(self._students, self.module_root, None)
         outcomes = []
-        for (args, kwargs), label in zip(calls, labels):
+        for (args, kwargs), label in zip(calls, labels, strict=True):
             with server.lock:  # the checks of a grading share the server: one may have seen a hang
                 if function in self.servers.hung:
                     outcomes.append(Outcome(error=f"not run: {self.servers.hung[function]}"))

@@ -20,6 +20,7 @@ the workspace first); the checker's own node uses the reference MsgTutorial.
 from __future__ import annotations
 
 import re
+from itertools import pairwise
 
 from course_lib import waiting
 from course_lib.checks import packages, runner
@@ -118,8 +119,8 @@ def publisher(ctx: Context) -> None:
             types = dict(probe.node.get_topic_names_and_types())
             if not probe.spin_until(lambda: len(messages) > 0 or not proc.running(), scaled(5.0)):
                 types = dict(probe.node.get_topic_names_and_types())
-                ctx.item(False, f"nothing arrived on {TOPIC} within {scaled(5):.0f} s (topics: "
-                                f"{ {t: v for t, v in types.items() if not t.startswith('/rosout') and not t.startswith('/parameter')} }); "
+                shown = {t: v for t, v in types.items() if not t.startswith(('/rosout', '/parameter'))}
+                ctx.item(False, f"nothing arrived on {TOPIC} within {scaled(5):.0f} s (topics: {shown}); "
                                 "publish tutorial_interfaces/msg/MsgTutorial on 'ros_tutorial_msg' from a 0.1 s timer")
                 return
             # Enough stamps for the rate: RATE_MESSAGES, or RATE_SPAN seconds of a slower publisher's.
@@ -129,13 +130,14 @@ def publisher(ctx: Context) -> None:
         proc.stop(timeout=2)
     types = types.get(TOPIC, [])
     wanted = ["tutorial_interfaces/msg/MsgTutorial"]
-    ctx.item(types == wanted, f"{TOPIC} carries {types}" + ("" if types == wanted else f"; the contract says {wanted[0]}"))
+    ctx.item(types == wanted,
+             f"{TOPIC} carries {types}" + ("" if types == wanted else f"; the contract says {wanted[0]}"))
     counters = [msg.data for msg in messages]
-    steps = {b - a for a, b in zip(counters, counters[1:])}
+    steps = {b - a for a, b in pairwise(counters)}
     ctx.item(steps == {1}, f"data {counters[:4]}...{counters[-2:]}: " +
              ("one more per message" if steps == {1} else f"steps {sorted(steps)[:5]}; add one per message"))
     stamps = [_stamp_seconds(m.stamp) for m in messages]
-    increasing = all(b > a for a, b in zip(stamps, stamps[1:]))
+    increasing = all(b > a for a, b in pairwise(stamps))
     ctx.item(increasing, "stamps increase" if increasing else
              "stamps do not increase: set msg.stamp = self.get_clock().now().to_msg() when publishing")
     if len(stamps) >= 3 and stamps[-1] > stamps[0]:
@@ -149,7 +151,7 @@ def publisher(ctx: Context) -> None:
 
 @check(points=3, timeout=90)
 def subscriber(ctx: Context) -> None:
-    """topic_subscriber: node topic_subscriber hears every MsgTutorial on ros_tutorial_msg and logs its stamp and data."""
+    """topic_subscriber: node topic_subscriber hears every MsgTutorial on ros_tutorial_msg and logs its stamp and data."""  # noqa: E501 (the check's description, one line: registry.check)
     proc = _start(ctx, "topic_subscriber")
     packages.use_interfaces(ctx)
     from tutorial_interfaces.msg import MsgTutorial
@@ -204,7 +206,7 @@ def together(ctx: Context) -> None:
         sub.stop(timeout=2)
         pub.stop(timeout=2)
     heard = [d for _, d in _heard(sub.log)]
-    steps = {b - a for a, b in zip(heard, heard[1:])}
+    steps = {b - a for a, b in pairwise(heard)}
     ok = len(heard) >= 15 and steps == {1}
     ctx.item(ok, f"the subscriber heard {len(heard)} messages, data {heard[:3]}...{heard[-2:]}" +
              ("" if ok else ": expected at least 15 consecutive values within 20 s"))

@@ -127,7 +127,8 @@ def execute(assignment: str, name: str, seed: int, workdir=None, mode: str = "se
                "--workdir", str(workdir), "--out", str(out)]
     limits = processes.Limits(wall_seconds=spec.timeout + 10, grace_seconds=2.0)
     proc = processes.NodeProcess(command, name=f"autograder-check-{name}", cwd=out, limits=limits,
-                                 env={"PYTHONPATH": child_pythonpath(), contract.CHECK_SEED_ENV: str(seed), contract.ANSWERS_ENV: mode})
+                                 env={"PYTHONPATH": child_pythonpath(), contract.CHECK_SEED_ENV: str(seed),
+                                      contract.ANSWERS_ENV: mode})
     try:
         with progress.Progress(f"check {name!r}") as shown:  # a line under the notebook's cell
             shown.step(spec.description)

@@ -42,7 +42,8 @@ def _encode(value, arrays: dict, prefix: str) -> dict:
         arrays[key] = value
         return {"type": "array", "pytype": pytype, "key": key}
     if isinstance(value, dict):
-        items = {str(key): _encode(item, arrays, f"{prefix}_{index}") for index, (key, item) in enumerate(value.items())}
+        items = {str(key): _encode(item, arrays, f"{prefix}_{index}")
+                 for index, (key, item) in enumerate(value.items())}
         return {"type": "dict", "pytype": pytype, "items": items}
     return {"type": "other", "pytype": pytype, "repr": repr(value)[:200]}
 

@@ -39,7 +39,8 @@ MALLOC_ENV = {"MALLOC_MMAP_THRESHOLD_": str(32 * 1024 * 1024), "MALLOC_TRIM_THRE
 class StudentProcesses:
     """Starts a check's student processes as the check's own user (see the module docstring)."""
 
-    def start(self, command: list[str], *, name: str, cwd, domain_id: int, wall_seconds: float, env: dict | None = None):
+    def start(self, command: list[str], *, name: str, cwd, domain_id: int, wall_seconds: float,
+              env: dict | None = None):
         """Start `command` (the student's code) and return its running course_lib.processes.NodeProcess;
         `env`: variables on top of student_env() (a sourced workspace, course_lib.checks.packages)."""
         from course_lib import processes

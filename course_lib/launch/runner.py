@@ -125,7 +125,8 @@ class Launch:
 
     def __repr__(self) -> str:
         states = []
-        for name, process in zip(self.names, self.processes):
+        # strict=False: start() in another thread may have appended a name but not yet its process.
+        for name, process in zip(self.names, self.processes, strict=False):
             state = f"running (pid {process.pid})" if process.running() else process.describe_exit()
             states.append(f"{name} {state}")
         return f"<Launch {self.path.name}: {', '.join(states) or 'no processes'}>"
@@ -266,7 +267,8 @@ class Launch:
             TimeoutError, RuntimeError: as NodeProcess.wait_for_node (with the node's log tail).
         """
         deadline = time.monotonic() + timeout
-        for node, process in zip(self._to_start, self.processes):
+        # strict=False: before start() (or while it runs) there are fewer processes than nodes to start.
+        for node, process in zip(self._to_start, self.processes, strict=False):
             if node.node_name is not None and process.pid is not None:
                 process.wait_for_node(node.node_name, timeout=max(0.1, deadline - time.monotonic()),
                                       namespace=node.namespace)
@@ -322,7 +324,8 @@ class Launch:
         for sent, before, after_text in steps:
             if after_text is not None and self._done.wait(max(0.0, started + float(after_text) - time.monotonic())):
                 return
-            for name, process in zip(self.names, self.processes):
+            # strict=False: a stop() from another thread may come while start() appends a name and its process.
+            for name, process in zip(self.names, self.processes, strict=False):
                 if not process.running():
                     continue
                 if before is not None:

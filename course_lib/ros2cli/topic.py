@@ -336,7 +336,8 @@ def _type(args) -> int:
 def _find_arguments(parser) -> None:
     add_discovery_arguments(parser)
     parser.add_argument("topic_type", help="Name of the ROS topic type to filter for (e.g. 'std_msg/msg/String')")
-    parser.add_argument("-c", "--count-topics", action="store_true", help="Only display the number of topics discovered")
+    parser.add_argument("-c", "--count-topics", action="store_true",
+                        help="Only display the number of topics discovered")
     parser.add_argument("--include-hidden-topics", action="store_true", help="Consider hidden topics as well")
 
 

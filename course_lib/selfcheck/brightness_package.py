@@ -78,8 +78,8 @@ def _package_files(ws) -> Verdict | None:
         others = [name for name, target in scripts.items() if target == wanted]
         if others:
             return _verdict(False, f"setup.py calls the executable {others[0]!r}; `ros2 run {BRIGHTNESS_PACKAGE} "
-                                   f"{BRIGHTNESS_EXECUTABLE}` needs it to be called {BRIGHTNESS_EXECUTABLE!r} (the name "
-                                   "left of the = in console_scripts).")
+                                   f"{BRIGHTNESS_EXECUTABLE}` needs it to be called {BRIGHTNESS_EXECUTABLE!r} "
+                                   "(the name left of the = in console_scripts).")
         return _verdict(False, f"Not done yet: setup.py has no executable {BRIGHTNESS_EXECUTABLE}. Add an entry for "
                                "it to the list of 'console_scripts': 'executable = module:function', where the "
                                "module is the node file's (package folder, a dot, file name without .py) and the "
@@ -132,6 +132,27 @@ def _build_state(ws) -> Verdict | None:
                                    f"was built without --symlink-install, so build again after every change "
                                    f"({build}).")
     return None
+
+
+def _send_until_answered(probe, process, camera, msg, replies: list, expected: int) -> None:
+    """Publish the frame `msg` on `camera` until the node process answers (into `replies`) or ends;
+    when its first answer is missing or wrong, wait for a right answer or its end, as long as it
+    computes."""
+    from course_lib.checks.student_server import ProcessorTime
+
+    replies.clear()
+    for _ in range(6):  # sent again until answered: the first frames may come before discovery ends
+        camera.publish(msg)
+        if probe.spin_until(lambda: replies or not process.running(), 0.5):
+            break
+    if not replies or replies[0] != expected:
+        # A node that fails on a frame takes a moment to end (publish() with a numpy integer in
+        # UInt8.data even sends 255 before it raises), a busy machine's more: wait until it has
+        # ended, answered right, or waits for frames without answering (processor time, not a
+        # clock, tells).
+        idle = ProcessorTime(process)
+        probe.spin_until(lambda: (replies and replies[0] == expected) or not process.running()
+                         or idle.waiting(), 60.0)
 
 
 def _test_frames():
@@ -193,7 +214,6 @@ def _run_brightness_node(ws) -> Verdict:
 
     from course_lib import images, rosenv, workspace
     from course_lib.checks.probe import RosProbe
-    from course_lib.checks.student_server import ProcessorTime
 
     command = (f"ros2 run {BRIGHTNESS_PACKAGE} {BRIGHTNESS_EXECUTABLE} --ros-args -r /image:={CHECK_CAMERA_TOPIC}")
     with rosenv.reserve_domain_id() as reservation, RosProbe(reservation.domain_id) as probe:
@@ -226,8 +246,8 @@ def _run_brightness_node(ws) -> Verdict:
             if CHECK_CAMERA_TOPIC not in subscriptions:
                 topic = next(iter(subscriptions))
                 return _verdict(False, f"Started with -r /image:={CHECK_CAMERA_TOPIC}, the node still subscribes "
-                                       f"{topic}: subscribe the topic 'image' and let the remap (-r /image:=...) choose "
-                                       "the camera's topic, instead of naming the camera's topic in the code.")
+                                       f"{topic}: subscribe the topic 'image' and let the remap (-r /image:=...) "
+                                       "choose the camera's topic, instead of naming the camera's topic in the code.")
             if subscriptions[CHECK_CAMERA_TOPIC] != ["sensor_msgs/msg/Image"]:
                 return _verdict(False, f"The subscription takes {subscriptions[CHECK_CAMERA_TOPIC][0]}; camera "
                                        "frames are sensor_msgs/msg/Image.")
@@ -253,27 +273,14 @@ def _run_brightness_node(ws) -> Verdict:
             probe.wait_for_subscriber(camera, 5.0)
             answers = []
             for frame, expected in _test_frames():
-                msg = images.image_to_msg(frame, "bgr8")
-                replies.clear()
-                for _ in range(6):  # sent again until answered: the first frames may come before discovery ends
-                    camera.publish(msg)
-                    if probe.spin_until(lambda: replies or not process.running(), 0.5):
-                        break
-                if not replies or replies[0] != expected:
-                    # A node that fails on a frame takes a moment to end (publish() with a numpy integer in
-                    # UInt8.data even sends 255 before it raises), a busy machine's more: wait until it has
-                    # ended, answered right, or waits for frames without answering (processor time, not a
-                    # clock, tells).
-                    idle = ProcessorTime(process)
-                    probe.spin_until(lambda: (replies and replies[0] == expected) or not process.running()
-                                     or idle.waiting(), 60.0)
+                _send_until_answered(probe, process, camera, images.image_to_msg(frame, "bgr8"), replies, expected)
                 if not process.running():
                     return _verdict(False, f"The node crashed on the first frame the check sent "
                                            f"({process.describe_exit()}).{_crash_text(process)}")
                 if not replies:
                     return _verdict(False, "The check sent frames on the remapped topic, but nothing came back on "
-                                           "/brightness, and the node waits for more: does on_image publish a UInt8 with the node's "
-                                           "publisher?")
+                                           "/brightness, and the node waits for more: does on_image publish a UInt8 "
+                                           "with the node's publisher?")
                 if replies[0] != expected:
                     return _verdict(False, f"For a frame 80 wide and 60 high whose centre pixel (row 30, column 40) is "
                                            f"(blue, green, red) = {tuple(int(v) for v in frame[30, 40])}, the node "

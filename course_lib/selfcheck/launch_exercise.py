@@ -4,6 +4,8 @@ compared without starting anything.
 
 from __future__ import annotations
 
+from itertools import pairwise
+
 from course_lib.selfcheck.verdicts import Verdict, _verdict
 
 #: What ros2 launch (launch_ros) logs, and skips, for a <param from=...> that is no file.
@@ -44,7 +46,7 @@ def _launch_nodes(path) -> tuple[list[dict], list[str]]:
             command = list(node.command)
             ros_args = command[command.index("--ros-args") + 1:] if "--ros-args" in command else []
             remaps, params = [], []
-            for flag, value in zip(ros_args, ros_args[1:]):
+            for flag, value in pairwise(ros_args):
                 if flag == "-r" and not value.startswith("__"):
                     remaps.append(value)
                 elif flag == "--params-file":
@@ -88,7 +90,7 @@ def task_launch_yaml(yaml_file, xml_file) -> Verdict:
                                + (f" The XML file names {by_package[0]}: {why}." if by_package else ""))
     if len(given) != len(wanted):
         return _verdict(False, f"Your launch file starts {len(given)} node(s); the XML file starts {len(wanted)}.")
-    for index, (mine, theirs) in enumerate(zip(given, wanted), start=1):
+    for index, (mine, theirs) in enumerate(zip(given, wanted, strict=True), start=1):
         if mine["executable"] != theirs["executable"]:
             return _verdict(False, f"Node {index} runs {mine['executable']}; the XML file's node {index} runs "
                                    f"{theirs['executable']} (pkg and exec, in the same order).")

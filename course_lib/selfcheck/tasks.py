@@ -58,7 +58,8 @@ def task2_echo(messages, topic: str = "/chatter", text_prefix: str = "Hello Worl
 
 
 def task3_brightness_on_change(function) -> Verdict:
-    """Task 3 (lesson 02): should_publish(last_sent, current, threshold), true when the change is more than threshold."""
+    """Task 3 (lesson 02): should_publish(last_sent, current, threshold), true when the change is more than
+    threshold."""
     import numpy as np
 
     hint = ("Write should_publish(last_sent, current, threshold) so that it returns True when nothing was "
@@ -132,7 +133,8 @@ def _four_points(function, args, function_name: str, hint: str, case: str, array
 
 
 def task4_order_corners(function) -> Verdict:
-    """Task 4 (lesson 03): order_corners(points) returns four points as top-left, top-right, bottom-right, bottom-left."""
+    """Task 4 (lesson 03): order_corners(points) returns four points as top-left, top-right, bottom-right,
+    bottom-left."""
     import math
 
     import numpy as np
@@ -239,7 +241,8 @@ def task_picture_corners(function) -> Verdict:
                                            "picture_corners_of", hint, f"the {picture}")
             if problem is not None:
                 return problem
-            for place, marker_id, point, want in zip(places, marker_board.PICTURES[picture], answer, expected):
+            for place, marker_id, point, want in zip(places, marker_board.PICTURES[picture], answer, expected,
+                                                     strict=True):
                 if np.allclose(point, want, atol=1e-2):
                     continue
                 which = [(i, k) for i, corners in markers.items() for k in range(4)

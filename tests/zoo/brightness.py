@@ -115,8 +115,8 @@ def entries(course_dir: str) -> dict[str, dict]:
     (low, high) range when fresh seeds decide how many items fail, or None: not asserted) and a
     phrase the autograded notebook's outputs must contain, or a tuple of phrases one of which it
     must contain (optional: `first_failure`, a phrase of the
-    first ✘ line of a check's verdict, and `absent`, phrases it must not contain). Entries with level="check" are typical
-    mistakes in the module only: tests/test_autograder.py runs the checks on them directly (no
+    first ✘ line of a check's verdict, and `absent`, phrases it must not contain). Entries with
+    level="check" are typical mistakes in the module only: tests/test_autograder.py runs the checks on them directly (no
     nbgrader run), which is much cheaper; the rest go through the parallel nbgrader zoo run."""
     return {
         # The reference solution with a hostile cell (tests/test_autograder_zoo.py): every point. It
@@ -126,7 +126,9 @@ def entries(course_dir: str) -> dict[str, dict]:
                            reason="the contract asks for an int"),
         "rounding": dict(level="check", edits=[(SUM, "return int(round(image.mean()))")], values=(0, 3.2), node=None,
                          reason="rounded to nearest"),
-        "reliable_qos": dict(level="check", edits=[('self.create_subscription(Image, "/image", self.on_image, qos_profile_sensor_data)',
+        "reliable_qos": dict(level="check",
+                             edits=[('self.create_subscription(Image, "/image", self.on_image, '
+                                     'qos_profile_sensor_data)',
                                      'self.create_subscription(Image, "/image", self.on_image, 10)')],
                              values=None, node=1.0, reason="incompatible QoS",
                              # The cause comes first; what follows from it says so and guesses nothing.
@@ -135,21 +137,26 @@ def entries(course_dir: str) -> dict[str, dict]:
         # numpy's uint64 is no Python int: check 1 says so, and the node's crash in publish() is named.
         "numpy_int": dict(level="check", edits=[(SUM, "return image.sum() // image.size")], values=0, node=2.0,
                           reason="put a Python int in it", first_failure="the node process ended"),
-        "wrong_topic": dict(level="check", edits=[('UInt8, "/brightness"', 'UInt8, "/image_brightness"')], values=None, node=(0, 6.2),
+        "wrong_topic": dict(level="check", edits=[('UInt8, "/brightness"', 'UInt8, "/image_brightness"')], values=None,
+                            node=(0, 6.2),
                             reason="does not publish /brightness"),
-        "python_loop": dict(level="check", edits=[(SUM, "total = 0\n    for value in image.reshape(-1):\n        total += int(value)\n"
-                                         "    return total // image.size")], values=None, node=5.0,
+        "python_loop": dict(level="check", edits=[(SUM, "total = 0\n    for value in image.reshape(-1):\n"
+                                                        "        total += int(value)\n"
+                                                        "    return total // image.size")], values=None, node=5.0,
                             reason="too slow"),
         # Points come from the grader's own run of the checks, not from what the kernel reports;
         # and the grader's answer key is out of the student's reach (else values would be 4).
         "cheater": dict(edits=[(SUM, STEAL_ANSWER), cheater], values=0, node=None, reason="returned 0, expected"),
         # The classic slip of a module that spins at import instead of in main(): the import never
         # returns (it waits, as a spin does, rather than burning a core for the whole time limit).
-        "import_loop": dict(edits=[(IMPORTS, IMPORTS + "rclpy.init()\nrclpy.spin(rclpy.create_node('spun_at_import'))\n")],
+        "import_loop": dict(edits=[(IMPORTS,
+                                    IMPORTS + "rclpy.init()\nrclpy.spin(rclpy.create_node('spun_at_import'))\n")],
                             values=0, node=0, reason="did not finish within"),
         # A callback that computes with Python's sum() over msg.data: right answers, 6-9 times the
         # processor time per frame of the grader's yardstick (the throughput item allows 3).
-        "slow_callback": dict(level="check", edits=[(CALLBACK, "        self.publisher.publish(UInt8(data=sum(msg.data) // len(msg.data)))")],
+        "slow_callback": dict(level="check",
+                              edits=[(CALLBACK,
+                                      "        self.publisher.publish(UInt8(data=sum(msg.data) // len(msg.data)))")],
                               values=None, node=5.0, reason="too slow"),
         # A callback that never returns: the endpoints' points only; what needs answers is named
         # as following from the unanswered frames (run through the checks: no kernel involved).
@@ -161,18 +168,21 @@ def entries(course_dir: str) -> dict[str, dict]:
         "segfault": dict(edits=[(SUM, "import ctypes; ctypes.string_at(0)")], values=0, node=0,
                          reason="kernel died", failed=True),
         # The same crash only in the grader's processes (not in the kernel): the checks say how.
-        "segfault_in_node": dict(level="check", edits=[(CALLBACK, "        import ctypes; ctypes.string_at(0)")], values=None, node=(0, 5),
-                                 reason="SIGSEGV"),
+        "segfault_in_node": dict(level="check", edits=[(CALLBACK, "        import ctypes; ctypes.string_at(0)")],
+                                 values=None, node=(0, 5), reason="SIGSEGV"),
         "memory_hog": dict(edits=[(SUM, "hog = np.ones(10**10, np.uint8); return int(hog[0])")], values=0, node=None,
                            reason="MemoryError"),
         # Gated to the grader's student processes (not the notebook kernel), to keep the zoo short.
-        "fork_bomb": dict(edits=[(SUM, "import os, sys\n    while 'ipykernel' not in sys.argv[0]:\n        os.fork()\n    "
-                                       + SUM)], values=0, node=None,
+        "fork_bomb": dict(edits=[(SUM, "import os, sys\n    while 'ipykernel' not in sys.argv[0]:\n"
+                                       "        os.fork()\n    " + SUM)], values=0, node=None,
                           reason="average_brightness failed"),
         # 256 MB of output from each of the grader's student processes, 800 times what the grader
         # keeps of a log (course_lib.bounded_log): neither memory nor disk fills, the answers count.
-        "prints_flood": dict(edits=[(SUM, "import sys\n    if 'ipykernel' not in sys.argv[0] and not getattr(average_brightness, 'printed', False):\n"
+        "prints_flood": dict(edits=[(SUM, "import sys\n"
+                                          "    if 'ipykernel' not in sys.argv[0] "
+                                          "and not getattr(average_brightness, 'printed', False):\n"
                                           "        average_brightness.printed = True\n"
-                                          "        for _ in range(256):\n            sys.stdout.write('x' * 2**20)\n    "
-                                          + SUM)], values=4, node=None, reason=THROUGHPUT_VERDICT),
+                                          "        for _ in range(256):\n"
+                                          "            sys.stdout.write('x' * 2**20)\n    " + SUM)],
+                             values=4, node=None, reason=THROUGHPUT_VERDICT),
     }

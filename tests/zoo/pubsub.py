@@ -17,7 +17,8 @@ def entries() -> dict[str, dict]:
         # package again, CMake and C compilers, a third of the zoo's processor time.)
         "pubsub_packaging": dict(
             edits=[("  <depend>tutorial_interfaces</depend>\n", ""),
-                   ("'topic_subscriber = pubsub.topic_subscriber:main'", "'subscriber = pubsub.topic_subscriber:main'")],
+                   ("'topic_subscriber = pubsub.topic_subscriber:main'",
+                    "'subscriber = pubsub.topic_subscriber:main'")],
             scores={"publisher": (3, 4.5), "subscriber": 0, "together": 0},
             reasons=["add &lt;depend&gt;tutorial_interfaces&lt;/depend&gt;",
                      "has no executable 'topic_subscriber'"]),

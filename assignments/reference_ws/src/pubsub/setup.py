@@ -15,7 +15,8 @@ setup(
     zip_safe=True,
     maintainer='ROS 2 and OpenCV course',
     maintainer_email='course@example.com',
-    description='The pubsub assignment: a publisher and a subscriber of tutorial_interfaces/MsgTutorial on ros_tutorial_msg.',
+    description=('The pubsub assignment: a publisher and a subscriber of tutorial_interfaces/MsgTutorial '
+                 'on ros_tutorial_msg.'),
     license='Apache-2.0',
     extras_require={'test': ['pytest']},
     entry_points={

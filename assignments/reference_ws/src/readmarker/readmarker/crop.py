@@ -52,7 +52,7 @@ def find_markers(frame, detector=None):
     found = {}
     if ids is None:
         return found
-    for marker, marker_id in zip(corners, ids.ravel()):
+    for marker, marker_id in zip(corners, ids.ravel(), strict=True):
         marker = np.asarray(marker, dtype=np.float32).reshape(4, 2)
         marker_id = int(marker_id)
         area = abs(cv2.contourArea(marker))
