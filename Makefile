@@ -43,8 +43,8 @@ setup: $(VENV)/.setup-done
 # jsonschema's optional IRI checker rfc3987-syntax (pulled in by jupyter-events) compiles ~30
 # Lark parsers at import: 2-4 s of CPU in every process that imports nbformat (nbgrader, nbclient,
 # Jupyter, the test workers). Nothing here validates IRIs, so the override leaves it out.
-$(VENV)/.setup-done: Makefile environment.txt pyproject.toml course_lib/wheelfix.py course_lib/ros2cli/install.py \
-                     course_lib/underlay.py
+$(VENV)/.setup-done: Makefile environment.txt pyproject.toml course_lib/ros/wheelfix.py course_lib/ros2cli/install.py \
+                     course_lib/ros/underlay.py
 	@$(PYTHON) -c 'import sys; v = sys.version_info[:2]; ok = (3, 10) <= v <= (3, 13); \
 	print("Using Python %d.%d from %s" % (v + (sys.executable,))) if ok else \
 	sys.exit("Python %d.%d found, but the ROS 2 Jazzy wheels exist for CPython 3.10-3.13 only. " \
@@ -67,22 +67,22 @@ ALLOW_ROOT := $(if $(filter 0,$(shell id -u)),--allow-root)
 
 # The server gets the notebook session's ROS variables (Fast DDS set-up for camera frames,
 # discovery range, ament index), so JupyterLab's terminals and `!` commands have them too, and the
-# venv's local_setup.sh (course_lib/underlay.py): its bin/ first on PATH, so they find its commands
+# venv's local_setup.sh (course_lib/ros/underlay.py): its bin/ first on PATH, so they find its commands
 # (`ros2` on the pip install, python, colcon) as in an activated venv, and what colcon needs to
 # build message packages. Terminals run $SHELL without -l (a login shell would read /etc/profile,
 # which sets PATH anew); bash reads ~/.bashrc and then local_setup.bash again
-# (course_lib/student_lab/terminal.py), in case ~/.bashrc puts pyenv or conda first.
-# JUPYTER_CONFIG_PATH: a student's lab shows nbgrader's student side only (course_lib/student_lab).
+# (course_lib/notebook/student_lab/terminal.py), in case ~/.bashrc puts pyenv or conda first.
+# JUPYTER_CONFIG_PATH: a student's lab shows nbgrader's student side only (course_lib/notebook/student_lab).
 # A student alone fetches the assignments in Nbgrader > Assignment List from the lab's own exchange
 # (.lab/, git-ignored), where the course's grader releases them, again when their source changed
-# (course_lib/student_lab/exchange.py).
+# (course_lib/notebook/student_lab/exchange.py).
 lab: setup
 	$(PY) -m autograder release-lab
 	eval "$$($(PY) -m course_lib env)" && . "$(CURDIR)/$(VENV)/local_setup.sh" && \
-	JUPYTER_CONFIG_PATH="$(CURDIR)/course_lib/student_lab$${JUPYTER_CONFIG_PATH:+:$$JUPYTER_CONFIG_PATH}" \
+	JUPYTER_CONFIG_PATH="$(CURDIR)/course_lib/notebook/student_lab$${JUPYTER_CONFIG_PATH:+:$$JUPYTER_CONFIG_PATH}" \
 	exec $(VENV)/bin/jupyter lab --no-browser --ip=127.0.0.1 --port=$(LAB_PORT) $(ALLOW_ROOT) \
 	  --ServerApp.root_dir="$(CURDIR)" --LabApp.default_url=/lab/tree/notebooks \
-	  --ServerApp.terminado_settings="$$($(PY) -m course_lib.student_lab.terminal)"
+	  --ServerApp.terminado_settings="$$($(PY) -m course_lib.notebook.student_lab.terminal)"
 
 # Browser tests need Debian's chromium. Install it when we may (root with apt); otherwise the
 # browser tests skip and say why.

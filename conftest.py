@@ -8,7 +8,8 @@ import os
 
 import pytest
 
-from course_lib import contract, rosenv
+from course_lib import contract
+from course_lib.ros import rosenv
 
 _reservation = rosenv.reserve_domain_id()
 os.environ["ROS_DOMAIN_ID"] = str(_reservation.domain_id)
@@ -28,9 +29,9 @@ def pytest_addoption(parser, pluginmanager):
 
 @pytest.fixture(scope="module")
 def session_domain():
-    """A ROS domain reserved for one test module, with the notebook session (course_lib.session,
+    """A ROS domain reserved for one test module, with the notebook session (course_lib.ros.session,
     which graph's tool node uses) started on it and stopped at the end."""
-    from course_lib import session
+    from course_lib.ros import session
 
     with rosenv.reserve_domain_id() as reservation:
         session.stop()

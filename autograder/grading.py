@@ -49,7 +49,7 @@ def grade(course_dir, assignment: str | None = None, workers: int = 1, force: bo
     Returns the results of the submissions found, in (student, assignment) order.
     """
     from autograder import export, late, report
-    from course_lib import rosenv
+    from course_lib.ros import rosenv
 
     course = prepare_course(course_dir)
     course_config = config.load(course)

@@ -53,7 +53,7 @@ def run_checks(sub: Submission, names: list[str], out: Path, workdir: Path, doma
     """Run the checks `names` against `workdir` in one sandboxed grader process (see
     grade_outside) and return {name: Result}; `out` (new) gets their JSON; `run` is
     autograder.sandbox.run_sandboxed or a wrapper of it."""
-    from course_lib import processes
+    from course_lib.ros import processes
 
     checks = registry.checks_of(sub.assignment)
     out.mkdir(mode=0o700)

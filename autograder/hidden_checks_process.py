@@ -45,7 +45,7 @@ def budget_from_environment() -> float | None:
 def own_domains() -> int | None:
     """The ROS domain the grader reserved for the submission when its checks run in a network
     namespace of their own (autograder.sandbox: then every domain is theirs), else None."""
-    from course_lib import rosenv
+    from course_lib.ros import rosenv
 
     domain = os.environ.get("ROS_DOMAIN_ID")
     return int(domain) if rosenv.under_grading() and domain and _only_loopback() else None
@@ -90,7 +90,7 @@ def run_outside(assignment: str, names: list[str], workdir, out: Path, budget: f
         run.servers.close()
         return
     run.time_is_up(names, budget)
-    from course_lib import processes
+    from course_lib.ros import processes
 
     processes.stop_all(timeout=0.5)
     run.servers.close()

@@ -41,8 +41,9 @@ import time
 import xml.etree.ElementTree as ElementTree
 from pathlib import Path
 
-from course_lib import colcon, contract, package_files, workspace
+from course_lib import contract
 from course_lib.checks.assignments import ASSIGNMENTS, WORKSPACE
+from course_lib.ros import colcon, package_files, workspace
 
 #: Seconds one colcon build may take (an interface package takes 10-40 s on a busy machine).
 BUILD_SECONDS = 240.0
@@ -499,7 +500,7 @@ def build_for_checks(assignment: str, course: Path, work: Path, workdir: Path, u
             kernel of the same uid could change the build).
     """
     from autograder import run_as
-    from course_lib import processes
+    from course_lib.ros import processes
 
     scratch = work / f"{prefix}colcon"
     scratch.mkdir(mode=0o711, exist_ok=True)

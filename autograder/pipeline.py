@@ -6,7 +6,7 @@ are listed in :data:`STEPS`):
 1. A private work directory gets a course root of its own: nbgrader_config.py, a copy of the
    gradebook (root-only, 0600: it holds the hidden tests) and a copy of the submission. The
    submitted files themselves are only read.
-2. ``nbgrader autograde`` runs there, through course_lib.processes (wall time per notebook,
+2. ``nbgrader autograde`` runs there, through course_lib.ros.processes (wall time per notebook,
    address space, file size; every descendant is killed at the end) and, as root, inside
    ``unshare --net --mount``: a network namespace with only loopback (no connection leaves the
    machine; DDS traffic stays in it), a private /dev/shm (Fast DDS shared memory), and the course
@@ -50,9 +50,10 @@ from autograder.result import GradeResult
 from autograder.sandbox import HIDDEN_FROM_STUDENTS, interpreter_exposure, isolation, run_sandboxed
 from autograder.staging import private_copy, stage_grader
 from autograder.submissions import Submission, submission_digest
-from course_lib import contract, rosenv
+from course_lib import contract
 from course_lib.checks import context
 from course_lib.checks.result import round_points
+from course_lib.ros import rosenv
 
 #: Seconds one submission's grading may take on an idle machine, every step included (issue #14:
 #: a hostile submission must not stall the class). Each step gets at most what is left of it.
@@ -99,7 +100,7 @@ class Grading:
     result: GradeResult
     work: Path                 # the private work folder, removed at the end
     env: dict = dataclasses.field(default_factory=dict)  # for every sandboxed process
-    notebook_run: object = None  # the nbgrader autograde process (course_lib.processes.NodeProcess)
+    notebook_run: object = None  # the nbgrader autograde process (course_lib.ros.processes.NodeProcess)
     deadline: float = 0.0      # time.monotonic() by which the grading must end (grading_budget)
     budget: float = GRADING_SECONDS  # the seconds the grading was given
     notebook_seconds: float = 0.0  # the wall time the notebook run was given
@@ -201,7 +202,7 @@ def start_early_checks(g: Grading) -> None:
 
 def run_notebook(g: Grading) -> None:
     """``nbgrader autograde`` in the sandbox, within the notebook's limits."""
-    from course_lib import processes
+    from course_lib.ros import processes
 
     command = [sys.executable, "-m", "nbgrader", "autograde", g.sub.assignment, "--student", g.sub.student,
                "--force", f"--CourseDirectory.root={g.root}"]

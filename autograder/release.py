@@ -59,13 +59,13 @@ def release_to_exchange(course_dir, exchange, assignments: list[str]) -> None:
 
 def release_for_lab(lab_root=REPO, assignments: list[str] | None = None) -> list[str]:
     """Release the repository's assignments into the exchange of the lab served from lab_root (what
-    ``make lab`` does for a student who works alone; course_lib.student_lab.exchange). An assignment
+    ``make lab`` does for a student who works alone; course_lib.notebook.student_lab.exchange). An assignment
     whose source is as at its last release, and which is in the exchange, is left as it is.
 
     Returns:
         the assignments released now.
     """
-    from course_lib.student_lab.exchange import local_course, local_exchange
+    from course_lib.notebook.student_lab.exchange import local_course, local_exchange
 
     course, exchange = local_course(lab_root), local_exchange(lab_root)
     names = assignments or [p.name for p in sorted(REPO_SOURCE.iterdir()) if any(p.glob("*.ipynb"))]

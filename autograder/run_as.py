@@ -8,7 +8,7 @@ passwd entry) with no supplementary groups and at most `max_processes` processes
 
 The wrapper is this file, run as a script by a fresh ``python -I -S`` (standard library only, no
 site-packages, so it starts in a few milliseconds). It is started by the supervisor of a
-course_lib.processes.NodeProcess, as root, after the supervisor put it in the node's process
+course_lib.ros.processes.NodeProcess, as root, after the supervisor put it in the node's process
 group and set its resource limits; it then
 
 - drops to the uid and gid (setgroups, setgid, setuid; the kernel refuses it unless root),

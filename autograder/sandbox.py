@@ -6,7 +6,7 @@ course directory and the repository's instructor folders hidden under empty tmpf
 
 :func:`sandbox_command` wraps a command in ``unshare`` and autograder/sandbox_entry.py, which
 runs first inside the new namespaces: it brings loopback up, makes the mounts and execs the
-command. Limits (time, memory, processes) are not the sandbox's job: course_lib.processes applies
+command. Limits (time, memory, processes) are not the sandbox's job: course_lib.ros.processes applies
 them to the sandboxed command (:func:`run_sandboxed`).
 
 Not root: ``unshare --user --map-root-user --net --mount`` when unprivileged user namespaces are
@@ -76,9 +76,9 @@ def interpreter_exposure() -> dict:
 def run_sandboxed(command: list[str], hide: list[Path], name: str, domain_id: int, env: dict, cwd: Path, limits,
                   on_start=None):
     """Run a command in the sandbox (sandbox_command) to its end or its wall time; return the
-    stopped course_lib.processes.NodeProcess (its log, returncode, describe_exit()). `on_start`
+    stopped course_lib.ros.processes.NodeProcess (its log, returncode, describe_exit()). `on_start`
     gets the process once it runs (another thread may stop it)."""
-    from course_lib import processes
+    from course_lib.ros import processes
 
     proc = processes.NodeProcess(sandbox_command(command, hide), name=name, domain_id=domain_id, env=env, cwd=cwd,
                                  limits=limits)

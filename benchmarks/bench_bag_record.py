@@ -21,7 +21,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from course_lib import bag_files, processes, rosenv
+from course_lib.ros import bag_files, processes, rosenv
 
 #: The sender: publishes the frames once the recorder has matched, then says how many it sent.
 SENDER = r"""

@@ -11,7 +11,7 @@ them at the end).
 3. Login to JupyterLab of one student alone: the login form's POST to the lab page's 200
    (the server starts in between, in its namespaces).
 4. Memory (PSS, shared pages split among their users) of that idle server, and of a kernel
-   with a running ROS session (course_lib.session with the virtual camera at 30 Hz, 640x480, and
+   with a running ROS session (course_lib.ros.session with the virtual camera at 30 Hz, 640x480, and
    a subscriber), measured by the kernel itself.
 5. All other students log in at once: the wall time until every lab answers, each one's time,
    then every student's kernel runs a talker and a listener on one domain (isolation: each must
@@ -42,7 +42,7 @@ from hub_support import course_processes, log_in, run_in_kernel, running_hub, wh
 ROS_SESSION = '''
 import time, psutil
 from course_lib import session
-from course_lib.camera import WebcamNode
+from course_lib.imaging.camera import WebcamNode
 from sensor_msgs.msg import Image
 session.start()
 camera = session.add_node(WebcamNode())

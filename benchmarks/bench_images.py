@@ -1,4 +1,4 @@
-"""How fast course_lib.images converts, next to the obvious alternatives, measured in one run.
+"""How fast course_lib.imaging.images converts, next to the obvious alternatives, measured in one run.
 
 Not a test: timings depend on the machine, so this prints numbers instead of asserting them.
 Ratios between rows measured side by side in the same run are what to compare.
@@ -7,11 +7,11 @@ Ratios between rows measured side by side in the same run are what to compare.
 
 Rows, per image size (bgr8):
 
-- send, image_to_msg: numpy -> Image through course_lib.images;
+- send, image_to_msg: numpy -> Image through course_lib.imaging.images;
 - send, raw tobytes: ``msg.data = arr.tobytes()``, the shortest correct hand-written way;
 - send, naive list: ``msg.data = arr.ravel().tolist()``, timed on a 160x120 image and scaled by
   the pixel count (it is linear in the pixels, and timing it at 1080p would take seconds);
-- receive, msg_to_image: Image -> numpy through course_lib.images;
+- receive, msg_to_image: Image -> numpy through course_lib.imaging.images;
 - receive, raw frombuffer: ``np.frombuffer(msg.data, np.uint8).reshape(h, w, 3)``.
 """
 
@@ -46,7 +46,7 @@ def main(argv=None) -> int:
     import numpy as np
     from sensor_msgs.msg import Image
 
-    from course_lib.images import image_to_msg, msg_to_image
+    from course_lib.imaging.images import image_to_msg, msg_to_image
 
     rng = np.random.default_rng(0)
     small = rng.integers(0, 256, (120, 160, 3), dtype=np.uint8)

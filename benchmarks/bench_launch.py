@@ -33,7 +33,8 @@ sys.path.insert(0, str(ROOT / "tests"))
 
 from launch_demo import CHATTER_NODE, make_prefix  # noqa: E402
 
-from course_lib import launch, rosenv  # noqa: E402
+from course_lib import launch  # noqa: E402
+from course_lib.ros import rosenv  # noqa: E402
 
 TWO_NODES = """<launch>
   <node pkg="bench_demo" exec="talker" name="talker"/>

@@ -55,7 +55,7 @@ def main(argv=None) -> int:
     parser.add_argument("--before", help="also run the reference crop.py of this git revision")
     args = parser.parse_args(argv)
 
-    from course_lib import photos
+    from course_lib.imaging import photos
 
     crop = reference_crop()
     functions = {"detector alone": lambda frame: crop.crop_pictures(frame, second_look=False),

@@ -32,7 +32,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from course_lib import processes, rosenv  # noqa: E402
+from course_lib.ros import processes, rosenv  # noqa: E402
 
 NODES = '''
 import sys

@@ -19,9 +19,9 @@ asserting them. Compare the ratios between rows measured at the same time.
     frames as fast as it can, the node crops them, a counter counts frames and cat crops.
 (c) Frame delivery at 640x480 and 1920x1080, 30 Hz: the share of the frames sent that reach a
     best-effort subscriber in another process, with Fast DDS's defaults, with its LARGE_DATA
-    builtin transports, and with the course's set-up (course_lib.rosenv.large_data_environment),
+    builtin transports, and with the course's set-up (course_lib.ros.rosenv.large_data_environment),
     one after the other in the same run. Two senders: the camera node itself
-    (course_lib.camera.WebcamNode, rendering every frame, so its rate is what the machine can
+    (course_lib.imaging.camera.WebcamNode, rendering every frame, so its rate is what the machine can
     draw) and a 30 Hz timer sending pre-rendered webcam frames. Frames are matched by their
     header stamps, counted from the first one that arrived.
 (a) and (b) run with the course's set-up, as every process course_lib starts.
@@ -60,7 +60,7 @@ def average_brightness(image):
 
 def msg_brightness(msg) -> int:
     """The brightness of an Image message the numpy way: msg_to_image, then the answer key."""
-    from course_lib import images
+    from course_lib.imaging import images
 
     return average_brightness(images.msg_to_image(msg))
 
@@ -81,7 +81,7 @@ def run_role(args) -> int:
     from sensor_msgs.msg import CompressedImage, Image
     from std_msgs.msg import UInt8
 
-    from course_lib import images
+    from course_lib.imaging import images
 
     start, end = args.start, args.start + args.seconds
     counts: dict[str, int] = {}
@@ -136,7 +136,7 @@ def run_role(args) -> int:
     elif args.role == "camera":
         from rclpy.parameter import Parameter
 
-        from course_lib.camera import WebcamNode
+        from course_lib.imaging.camera import WebcamNode
 
         width, height = (int(v) for v in args.size.split("x"))
         node.destroy_node()
@@ -197,7 +197,7 @@ def run_role(args) -> int:
 
 def publisher_frames(count, size):
     """Frames of the simulated webcam (what image_publisher sends), `count` of them 1/30 s apart."""
-    from course_lib import scenes
+    from course_lib.imaging import scenes
 
     path = scenes.CameraPath(seed=0, size=size)
     return [path.scene_at(i / 30).frame for i in range(count)]
@@ -210,7 +210,7 @@ def measure(roles, seconds, domain_id, *, size, frames=1, rate=0.0, env=None):
 
     env: variables for the processes on top of this one's (None removes one), as NodeProcess takes.
     """
-    from course_lib import processes
+    from course_lib.ros import processes
 
     start = time.time() + WARMUP
     running = []
@@ -253,7 +253,7 @@ def best_seconds(statement, repeat: int, number: int | None = None) -> float:
 
 def measure_brightness(args, domain_id) -> list:
     """Part (a): the brightness pipeline against the bare transport, and numpy against a loop."""
-    from course_lib import images
+    from course_lib.imaging import images
 
     table = []
     for width, height in ((640, 480), (1920, 1080)):
@@ -288,7 +288,7 @@ def measure_brightness(args, domain_id) -> list:
 
 def measure_marker_reader(args, domain_id) -> list:
     """Part (b): crop_pictures in this process, and the marker_reader node end to end."""
-    from course_lib import scenes
+    from course_lib.imaging import scenes
 
     sys.path.insert(0, str(READMARKER))
     from readmarker.crop import crop_pictures, find_markers
@@ -341,7 +341,7 @@ def main(argv=None) -> int:
     import numpy as np
     from sensor_msgs.msg import Image  # noqa: F401  (fail early when ROS is missing)
 
-    from course_lib import rosenv
+    from course_lib.ros import rosenv
 
     table = []  # (part, size, what, value, ratio)
     with rosenv.reserve_domain_id() as reservation:
@@ -395,14 +395,14 @@ def measure_delivery(seconds, domain_id) -> dict:
     Frames are matched by their stamps, counted from the first one that arrived (a receiver that
     discovered the sender late loses nothing to this measurement).
     """
-    from course_lib import rosenv
+    from course_lib.ros import rosenv
 
     chosen = rosenv.large_data_environment({})
     setup = f"FASTRTPS_DEFAULT_PROFILES_FILE={os.path.relpath(chosen['FASTRTPS_DEFAULT_PROFILES_FILE'])}" \
         if chosen else "none (/dev/shm is too small: the course keeps the defaults)"
     rows = []
     for size in ("640x480", "1920x1080"):
-        for sender, label in (("camera", "camera node (course_lib.camera, rate 30)"),
+        for sender, label in (("camera", "camera node (course_lib.imaging.camera, rate 30)"),
                               ("publisher", "30 Hz timer, pre-rendered frames")):
             row = [size, label]
             rates = []

@@ -24,19 +24,19 @@ def main(argv: list[str] | None = None) -> int:
         return 0 if argv else 2
     command, rest = argv[0], argv[1:]
     if command == "doctor":
-        from course_lib import doctor
+        from course_lib.notebook import doctor
         return doctor.main(rest)
     if command == "build":
-        from course_lib import colcon
+        from course_lib.ros import colcon
         return colcon.main_build(rest)
     if command == "env":
-        from course_lib import rosenv
+        from course_lib.ros import rosenv
         return rosenv.main_env(rest)
     if command == "repair-wheels":
-        from course_lib import wheelfix
+        from course_lib.ros import wheelfix
         return wheelfix.main(rest)
     if command == "underlay":
-        from course_lib import underlay
+        from course_lib.ros import underlay
         return underlay.main(rest)
     if command == "install-ros2":
         from course_lib.ros2cli import install

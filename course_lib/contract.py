@@ -14,7 +14,7 @@ COURSE_ID = "ros2-jazzy-opencv"
 
 # --- who runs: grading, the test suite ---------------------------------------------------------
 
-#: "1" in every process of a grading run (course_lib.rosenv.under_grading).
+#: "1" in every process of a grading run (course_lib.ros.rosenv.under_grading).
 GRADING_ENV = "COURSE_LIB_GRADING"
 #: "1" under the test suite and CI's notebook runs: loops that would run for ever live are bounded.
 UNDER_TEST_ENV = "COURSE_LIB_UNDER_TEST"

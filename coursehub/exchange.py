@@ -44,7 +44,7 @@ def write_settings(course) -> Path:
 
 def write_student_settings(home: Path, user: str) -> None:
     """A student's ~/.jupyter: no prompt about Jupyter's news (the server's namespace has no network
-    to fetch them). The instructor's nbgrader extensions are off through course_lib/student_lab on
+    to fetch them). The instructor's nbgrader extensions are off through course_lib/notebook/student_lab on
     the student's JUPYTER_CONFIG_PATH (coursehub.sandbox.user_environment), as in `make lab`."""
     jupyter = home / ".jupyter"
     notification = jupyter / "lab" / "user-settings" / "@jupyterlab" / "apputils-extension"

@@ -31,7 +31,7 @@ from coursehub.accounts import chown_tree
 def grade(course, queue: SubmitQueue, row: Row) -> None:
     """Collect, grade (or reuse a grading of the same content) and record one claimed row."""
     from autograder.pipeline import grade_submission
-    from course_lib import rosenv
+    from course_lib.ros import rosenv
 
     course_dir = course.course_dir
     entry = inbound.parse(inbound.inbound(course.exchange, course.course_id) / row.entry)

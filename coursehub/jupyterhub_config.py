@@ -6,7 +6,7 @@ import os
 import sys
 from pathlib import Path
 
-from course_lib.student_lab import terminal
+from course_lib.notebook.student_lab import terminal
 from coursehub import course as course_settings
 
 c = get_config()  # noqa: F821 (provided by JupyterHub)

@@ -32,14 +32,14 @@ def as_user(course, user: str, command: list[str]) -> list[str]:
 def user_environment(course, user: str, base: dict) -> dict:
     """`base` completed for a course user's process: home, the course's Python and nbgrader settings."""
     from autograder import sandbox
-    from course_lib import student_lab
+    from course_lib.notebook import student_lab
 
     account = pwd.getpwnam(user)
     env = dict(base)
     bindir = str(Path(sys.executable).parent)
     env.update(
         USER=user, HOME=account.pw_dir, SHELL=account.pw_shell or "/bin/bash",
-        # A student's lab shows nbgrader's student side only, as in `make lab` (course_lib/student_lab).
+        # A student's lab shows nbgrader's student side only, as in `make lab` (course_lib/notebook/student_lab).
         JUPYTER_CONFIG_PATH=os.pathsep.join(
             ([] if user == course.instructor else [str(student_lab.CONFIG_DIR)]) + [str(course.jupyter_config_dir)]),
         PYTHONPATH=str(REPO),

@@ -47,8 +47,8 @@ SWEEP_SECONDS = 60.0
 def _sweep_shared_memory(interval: float = SWEEP_SECONDS) -> None:
     """A kernel killed with a ROS session open (restarted while stuck in a call, or out of memory)
     cannot close its Fast DDS segments: up to 32 MB each stay in the namespace's private /dev/shm
-    until the server stops. Remove them every `interval` seconds (course_lib.doctor)."""
-    from course_lib import doctor
+    until the server stops. Remove them every `interval` seconds (course_lib.notebook.doctor)."""
+    from course_lib.notebook import doctor
 
     while True:
         time.sleep(interval)
@@ -65,7 +65,7 @@ def main() -> int:
     if failed or not ready.is_set():
         print(f"coursehub.singleuser: could not open the namespace's sockets: {failed}", file=sys.stderr)
         return 1
-    from course_lib import rosenv
+    from course_lib.ros import rosenv
 
     # Kernels, terminals and `!` commands inherit these, as under `make lab`.
     rosenv.prepare_current_process()

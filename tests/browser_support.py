@@ -189,10 +189,10 @@ def running_jupyterlab(root_dir: Path, state_dir: Path, timeout: float = 120):
         target = settings_dir / name
         target.parent.mkdir(parents=True, exist_ok=True)
         target.write_text(json.dumps(values))
-    from course_lib import student_lab
+    from course_lib.notebook import student_lab
 
     env = dict(os.environ,
-               # As `make lab` does: nbgrader's student side only (course_lib/student_lab).
+               # As `make lab` does: nbgrader's student side only (course_lib/notebook/student_lab).
                JUPYTER_CONFIG_PATH=os.pathsep.join(filter(None, [str(student_lab.CONFIG_DIR),
                                                                   os.environ.get("JUPYTER_CONFIG_PATH")])),
                JUPYTERLAB_SETTINGS_DIR=str(settings_dir),

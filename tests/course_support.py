@@ -79,7 +79,7 @@ def seed_lab_exchange(tmp_path_factory, lab_root: Path) -> None:
     exchange, from this run's shared release, unless it already is: ``make lab``'s release-lab
     then finds nothing to do (its own release is tested in tests/test_browser_validate.py)."""
     from autograder import release
-    from course_lib.student_lab.exchange import local_course, local_exchange
+    from course_lib.notebook.student_lab.exchange import local_course, local_exchange
 
     course, exchange = local_course(lab_root), local_exchange(lab_root)
     if all(release.released_as_is(course, exchange, name) for name in ASSIGNMENTS):

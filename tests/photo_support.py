@@ -12,7 +12,7 @@ import sys
 import time
 from pathlib import Path
 
-from course_lib import marker_board, photos, scenes
+from course_lib.imaging import marker_board, photos, scenes
 
 READMARKER = Path(__file__).resolve().parents[1] / "assignments" / "reference_ws" / "src" / "readmarker"
 

@@ -1,10 +1,10 @@
-"""course_lib.ament: packages, prefixes and executables from the ament index."""
+"""course_lib.ros.ament: packages, prefixes and executables from the ament index."""
 
 import os
 
 import pytest
 
-from course_lib import ament
+from course_lib.ros import ament
 
 
 def test_installed_message_packages_are_listed_with_their_prefix():

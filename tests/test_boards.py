@@ -1,11 +1,11 @@
-"""Tests for course_lib.boards: the printed board follows the marker convention."""
+"""Tests for course_lib.imaging.boards: the printed board follows the marker convention."""
 
 from itertools import pairwise
 
 import numpy as np
 import pytest
 
-from course_lib import boards, marker_board
+from course_lib.imaging import boards, marker_board
 
 
 def test_markers_touch_their_picture_corner_and_hide_none_of_it():

@@ -1,9 +1,9 @@
-"""Tests for course_lib.bounded_log: a node's log keeps its head and its tail, in bounded space."""
+"""Tests for course_lib.supervision.bounded_log: a node's log keeps its head and its tail, in bounded space."""
 
 import sys
 
-from course_lib import bounded_log
-from course_lib.processes import NodeProcess
+from course_lib.ros.processes import NodeProcess
+from course_lib.supervision import bounded_log
 
 
 def test_loud_child_does_not_block_and_its_log_is_bounded():

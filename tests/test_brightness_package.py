@@ -4,7 +4,8 @@ built and run as ros2 run."""
 import lesson_answers
 import pytest
 
-from course_lib import colcon, pkg_create, selfcheck
+from course_lib import selfcheck
+from course_lib.ros import colcon, pkg_create
 
 LESSON_02 = "02_images_and_brightness.ipynb"
 ANSWER_NODE = lesson_answers.brightness_node()

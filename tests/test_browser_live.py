@@ -1,4 +1,4 @@
-"""The live image view (course_lib.live) in JupyterLab: the picture changes while the camera runs.
+"""The live image view (course_lib.notebook.live) in JupyterLab: the picture changes while the camera runs.
 
 A small notebook, written by the test into a scratch root, starts the virtual camera as a process
 and shows /image with live.image_view; headless Chromium opens it, runs all cells, then watches
@@ -25,7 +25,7 @@ pytestmark = pytest.mark.browser
 
 LIVE_NOTEBOOK = [
     "from course_lib import live, processes\n"
-    f"camera = processes.python_node('course_lib.camera:main', '--ros-args', '-p', 'width:={CAMERA_SIZE[0]}', "
+    f"camera = processes.python_node('course_lib.imaging.camera:main', '--ros-args', '-p', 'width:={CAMERA_SIZE[0]}', "
     f"'-p', 'height:={CAMERA_SIZE[1]}',\n"
     "                               '-p', 'rate:=10.0', name='camera')\n"
     "camera.wait_for_node('image_publisher', timeout=60)",

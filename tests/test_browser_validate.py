@@ -70,7 +70,7 @@ def course(lab_root):
     """The lab's own course folder, brightness released from it into the lab's exchange, as `make
     lab` releases the assignments (python -m autograder release-lab)."""
     from autograder import release
-    from course_lib.student_lab.exchange import local_course
+    from course_lib.notebook.student_lab.exchange import local_course
 
     assert release.release_for_lab(lab_root, [ASSIGNMENT]) == [ASSIGNMENT]
     return local_course(lab_root)
@@ -146,7 +146,7 @@ def test_validate_on_a_lesson_points_at_its_self_checks_at_once_and_leaves_no_ke
     """A lesson has no graded cells: Validate answers with the fix first, in a few short lines (no
     traceback), without running the lesson in a kernel that outlives it (each press used to leave
     one running)."""
-    from course_lib.student_lab.validate import LESSON_ANSWER
+    from course_lib.notebook.student_lab.validate import LESSON_ANSWER
 
     result = validate_in_lab(browser, lab, LESSON, "validate_lesson.png")
     assert (result.title, result.error) == ("Validation Results", True), said(result, lab)
@@ -161,7 +161,7 @@ def test_make_lab_releases_into_the_labs_exchange_once_per_source(course, lab_ro
     once the second time); the release is in the exchange the lab's nbgrader_config.py names."""
     from autograder import release
     from course_lib.contract import COURSE_ID
-    from course_lib.student_lab.exchange import local_exchange
+    from course_lib.notebook.student_lab.exchange import local_exchange
 
     assert release.release_for_lab(lab_root, [ASSIGNMENT]) == []
     assert (local_exchange(lab_root) / COURSE_ID / "outbound" / ASSIGNMENT / f"{ASSIGNMENT}.ipynb").is_file()

@@ -1,4 +1,4 @@
-"""Tests for course_lib.camera: the webcam node publishes real Images over Fast DDS."""
+"""Tests for course_lib.imaging.camera: the webcam node publishes real Images over Fast DDS."""
 
 import time
 
@@ -13,8 +13,8 @@ from rclpy.parameter import Parameter
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import Image
 
-from course_lib import camera, marker_board
-from course_lib.images import msg_to_image
+from course_lib.imaging import camera, marker_board
+from course_lib.imaging.images import msg_to_image
 
 
 def receive_frames(domain_id, count, **parameters):

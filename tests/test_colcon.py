@@ -1,4 +1,4 @@
-"""Tests for course_lib.colcon: the real colcon build, its errors and its command line.
+"""Tests for course_lib.ros.colcon: the real colcon build, its errors and its command line.
 
 The builds of a working workspace are tested in tests/test_workspace.py, which builds one once
 per test run for all its tests.
@@ -9,7 +9,7 @@ import sys
 
 import pytest
 
-from course_lib import colcon, pkg_create, rosenv
+from course_lib.ros import colcon, pkg_create, rosenv
 
 
 def test_build_without_src_names_the_fix(tmp_path):

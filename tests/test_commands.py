@@ -12,7 +12,7 @@ import course_support
 import pytest
 from browser_support import free_port
 
-from course_lib import process_tree
+from course_lib.supervision import process_tree
 
 ROOT = Path(__file__).resolve().parents[1]
 

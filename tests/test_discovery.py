@@ -1,10 +1,10 @@
-"""course_lib.discovery: the wait for discovery ends once the graph has stopped changing, not
+"""course_lib.ros.discovery: the wait for discovery ends once the graph has stopped changing, not
 after a fixed time (the rule with a made-up clock and graph; then against a real process, where
 the rule, not the backstop, ends a wait for a name that never shows)."""
 
 import sys
 
-from course_lib import discovery, processes, session
+from course_lib.ros import discovery, processes, session
 
 
 def settling(minimum=0.5, quiet=0.2, complete_within=4.0):

@@ -1,10 +1,11 @@
-"""Tests for course_lib.doctor: it passes here, and each failure it can find names the fix."""
+"""Tests for course_lib.notebook.doctor: it passes here, and each failure it can find names the fix."""
 
 import os
 import subprocess
 import sys
 
-from course_lib import doctor, rosenv
+from course_lib.notebook import doctor
+from course_lib.ros import rosenv
 
 
 def run_doctor(*args, **env_changes):

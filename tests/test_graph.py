@@ -1,4 +1,4 @@
-"""Tests for course_lib.graph: the ros2 CLI's node/topic introspection, from a notebook."""
+"""Tests for course_lib.ros.graph: the ros2 CLI's node/topic introspection, from a notebook."""
 
 import math
 import os
@@ -13,7 +13,7 @@ from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
 from std_msgs.msg import String
 
-from course_lib import discovery, graph, message_yaml, rosenv, session
+from course_lib.ros import discovery, graph, message_yaml, rosenv, session
 
 # A talker in another process: a 10 Hz timer publishing "hello N" on /far_chatter.
 FAR_TALKER = """

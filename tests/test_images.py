@@ -1,4 +1,4 @@
-"""Tests for course_lib.images: Image/CompressedImage <-> numpy without cv_bridge."""
+"""Tests for course_lib.imaging.images: Image/CompressedImage <-> numpy without cv_bridge."""
 
 import array
 import sys
@@ -9,7 +9,7 @@ import pytest
 import sensor_msgs.msg._image as generated_image_module
 from sensor_msgs.msg import CompressedImage, Image
 
-from course_lib.images import (
+from course_lib.imaging.images import (
     ENCODINGS,
     compressed_to_image,
     convert_encoding,

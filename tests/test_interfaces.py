@@ -1,8 +1,8 @@
-"""Tests for course_lib.interfaces: `ros2 interface show/package/packages` from the installed files."""
+"""Tests for course_lib.ros.interfaces: `ros2 interface show/package/packages` from the installed files."""
 
 import pytest
 
-from course_lib import interfaces
+from course_lib.ros import interfaces
 
 
 def test_show_expands_nested_types_like_the_cli():
@@ -41,7 +41,7 @@ def test_bad_names_get_ros2_interface_shows_words(name, message):
 
 def test_inside_a_kernel_a_notebook_hint_follows(monkeypatch):
     """Only where interfaces.packages() can be called is it named."""
-    from course_lib import node_logs
+    from course_lib.ros import node_logs
 
     monkeypatch.setattr(node_logs, "in_kernel", lambda: True)
     with pytest.raises(LookupError, match=r"^Unknown package 'no_such_msgs' \(in a notebook: interfaces\.packages"):

@@ -3,7 +3,7 @@
 The package course_demo lives in a temporary prefix with an ament index marker (launch_demo.py):
 two small rclpy nodes (chatter_a, chatter_b) and a few shell executables, its launch files and a
 parameter file in share/. `ros2 launch` is run as `python -m course_lib.launch` (what the ros2 command
-calls); the graph is read with course_lib.graph and the parameters through the nodes' own
+calls); the graph is read with course_lib.ros.graph and the parameters through the nodes' own
 parameter services. Leftover processes are found by the prefix's path, which is in the command
 line of every process a launch starts (nodes and their supervisors).
 """
@@ -23,7 +23,9 @@ import pytest
 from launch_demo import CHATTER_NODE, CHATTER_SOURCE, make_prefix
 from process_support import in_background_of_a_script
 
-from course_lib import colcon, graph, launch, pkg_create, rosenv, rqt_graph, session, workspace
+from course_lib import launch
+from course_lib.notebook import rqt_graph
+from course_lib.ros import colcon, graph, pkg_create, rosenv, session, workspace
 
 EVERY_TAG = """\
 <launch>

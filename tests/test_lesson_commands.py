@@ -19,7 +19,7 @@ from pathlib import Path
 import lesson_answers
 import pytest
 
-from course_lib import colcon, pkg_create, processes, rosenv, session, workspace
+from course_lib.ros import colcon, pkg_create, processes, rosenv, session, workspace
 
 NOTEBOOKS = Path(__file__).resolve().parents[1] / "notebooks"
 LESSON = "02b_packages_launch_parameters.ipynb"

@@ -11,7 +11,8 @@ from pathlib import Path
 import nbformat
 from rclpy.qos import ReliabilityPolicy
 
-from course_lib import scenes, session
+from course_lib.imaging import scenes
+from course_lib.ros import session
 
 NOTEBOOKS = Path(__file__).resolve().parents[1] / "notebooks"
 LESSON_02 = NOTEBOOKS / "02_images_and_brightness.ipynb"

@@ -1,6 +1,6 @@
-"""Tests for course_lib.live: live image views (rqt_image_view) and plots (rqt_plot) on real topics.
+"""Tests for course_lib.notebook.live: live image views (rqt_image_view) and plots (rqt_plot) on real topics.
 
-One camera process (course_lib.camera) and one in-session publisher of numbers and known frames
+One camera process (course_lib.imaging.camera) and one in-session publisher of numbers and known frames
 serve the whole module, in a ROS domain of its own.
 """
 
@@ -16,7 +16,9 @@ from rclpy.qos import qos_profile_sensor_data
 from sensor_msgs.msg import Image
 from std_msgs.msg import Float64, UInt8
 
-from course_lib import graph, images, live, processes, rosenv, session
+from course_lib.imaging import images
+from course_lib.notebook import live
+from course_lib.ros import graph, processes, rosenv, session
 
 CAMERA_SIZE = (320, 240)
 
@@ -48,7 +50,7 @@ def ros(session_domain):
     try:
         session.add_node(Numbers())
         width, height = CAMERA_SIZE
-        with processes.python_node("course_lib.camera:main", "--ros-args", "-p", f"width:={width}", "-p",
+        with processes.python_node("course_lib.imaging.camera:main", "--ros-args", "-p", f"width:={width}", "-p",
                                    f"height:={height}", "-p", "rate:=15.0", name="live-test-camera",
                                    domain_id=session_domain) as camera:
             camera.wait_for_node("image_publisher", timeout=60)

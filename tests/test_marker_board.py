@@ -1,10 +1,10 @@
-"""Tests for course_lib.marker_board: the marker convention, crop corners and crop similarity."""
+"""Tests for course_lib.imaging.marker_board: the marker convention, crop corners and crop similarity."""
 
 import cv2
 import numpy as np
 import pytest
 
-from course_lib import marker_board, pictures, scenes
+from course_lib.imaging import marker_board, pictures, scenes
 
 BOARD_IDS = (1, 2, 3, 4, 5, 6, 7, 8)
 

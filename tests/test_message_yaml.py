@@ -1,10 +1,10 @@
-"""Tests for course_lib.message_yaml: messages printed like ros2 topic echo, filled like ros2 topic pub."""
+"""Tests for course_lib.ros.message_yaml: messages printed like ros2 topic echo, filled like ros2 topic pub."""
 
 import pytest
 from sensor_msgs.msg import Image
 from std_msgs.msg import String
 
-from course_lib import message_yaml
+from course_lib.ros import message_yaml
 
 
 def test_format_message_prints_like_ros2_topic_echo():

@@ -7,7 +7,8 @@ import pytest
 from rclpy.node import Node
 from std_msgs.msg import Header
 
-from course_lib import discovery, selfcheck, session
+from course_lib import selfcheck
+from course_lib.ros import discovery, session
 
 
 def _announcer(period=0.5, topic="announcements", text="Announcement {}", msg_type=None, timer=True, depth=10,

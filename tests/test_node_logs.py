@@ -1,11 +1,11 @@
-"""Tests for course_lib.node_logs: in a kernel, a node's log lines stay under the cell that added it."""
+"""Tests for course_lib.ros.node_logs: in a kernel, a node's log lines stay under the cell that added it."""
 
 import nbformat
 from builtin_interfaces.msg import Time
 from nbclient import NotebookClient
 from rcl_interfaces.msg import Log
 
-from course_lib import node_logs
+from course_lib.ros import node_logs
 
 CELLS = [
     """from rclpy.node import Node

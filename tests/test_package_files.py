@@ -1,11 +1,11 @@
-"""course_lib.package_files: a package's own files read without building or importing it."""
+"""course_lib.ros.package_files: a package's own files read without building or importing it."""
 
 import ast
 import xml.etree.ElementTree as ElementTree
 
 import pytest
 
-from course_lib import package_files
+from course_lib.ros import package_files
 
 PACKAGE_XML = """<?xml version="1.0"?>
 <package format="3">

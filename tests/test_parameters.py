@@ -1,11 +1,11 @@
-"""Tests for course_lib.parameters: a running node's parameters through its parameter services."""
+"""Tests for course_lib.ros.parameters: a running node's parameters through its parameter services."""
 
 import pytest
 import yaml
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.node import Node
 
-from course_lib import discovery, parameters, session
+from course_lib.ros import discovery, parameters, session
 
 
 class Tunable(Node):

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 from photo_support import photo_scenes, recovery, reference_crop
 
-from course_lib import marker_board, photos
+from course_lib.imaging import marker_board, photos
 
 crop = reference_crop()
 

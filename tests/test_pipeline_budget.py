@@ -10,7 +10,8 @@ import time
 from autograder import pipeline, report
 from autograder.result import GradeResult
 from autograder.submissions import Submission
-from course_lib import contract, processes
+from course_lib import contract
+from course_lib.ros import processes
 
 
 def test_each_step_gets_what_is_left_of_the_budget_less_what_it_keeps_for_later():

@@ -1,4 +1,4 @@
-"""Tests for course_lib.pkg_create: the package layouts ros2 pkg create writes."""
+"""Tests for course_lib.ros.pkg_create: the package layouts ros2 pkg create writes."""
 
 import ast
 import re
@@ -6,7 +6,7 @@ import xml.etree.ElementTree as ElementTree
 
 import pytest
 
-from course_lib import pkg_create
+from course_lib.ros import pkg_create
 
 #: The classic tutorial message (as in tests/test_workspace.py, which builds it).
 MSG_TUTORIAL = "builtin_interfaces/Time stamp\nint32 data\n"

@@ -1,4 +1,4 @@
-"""Tests for course_lib.process_tree, the one way the course ends a process tree."""
+"""Tests for course_lib.supervision.process_tree, the one way the course ends a process tree."""
 
 import signal
 import subprocess
@@ -6,7 +6,7 @@ import sys
 
 from process_support import processes_with, wait_until
 
-from course_lib import process_tree
+from course_lib.supervision import process_tree
 
 
 def _group(token: str, code: str) -> subprocess.Popen:
@@ -47,7 +47,7 @@ def test_signalling_a_group_that_has_gone_does_nothing():
 def test_cpu_seconds_counts_the_whole_tree_and_what_it_reaped():
     """A parent that burns 0.3 s of processor time, a child of a second thread that burns 0.4 s and
     stays, and a reaped child that burned 0.2 s: all of it counts; a process that sleeps adds
-    nothing; a grandchild whose parent exited (re-parented to init: course_lib.supervisor is a
+    nothing; a grandchild whose parent exited (re-parented to init: course_lib.supervision.supervisor is a
     subreaper so that a node's such leftovers stay in its tree) is no longer part of it."""
     code = """
 import os, sys, threading, time

@@ -1,4 +1,4 @@
-"""Tests for course_lib.processes: real node processes over real DDS, and no orphans ever.
+"""Tests for course_lib.ros.processes: real node processes over real DDS, and no orphans ever.
 
 Orphans are found by a unique marker in the command line (psutil), so a test only sees the
 processes it started itself.
@@ -12,8 +12,8 @@ import sys
 import pytest
 from process_support import marker, processes_with, sleeper, wait_until
 
-from course_lib import processes
-from course_lib.processes import Limits, NodeProcess, python_node
+from course_lib.ros import processes
+from course_lib.ros.processes import Limits, NodeProcess, python_node
 
 TALKER = '''
 import rclpy
@@ -82,7 +82,7 @@ def test_node_in_another_namespace_is_not_mistaken(talker_dir, domain_id):
 def test_wait_for_node_warns_when_another_program_runs_a_node_of_that_name(talker_dir, domain_id, capsys):
     """A camera the previous lesson's kernel left running makes two nodes of one name: the new
     one's wait_for_node says so plainly; a node that replaced its own earlier copy does not."""
-    from course_lib import session
+    from course_lib.ros import session
 
     session.start(domain_id=domain_id)
     try:
@@ -105,7 +105,7 @@ def test_wait_for_node_warns_when_another_program_runs_a_node_of_that_name(talke
 def test_a_node_is_not_taken_for_an_earlier_one_when_its_wait_comes_late(talker_dir, domain_id, capsys):
     """The nodes that ran before are the ones the session saw when start() began: a talker that the
     session already sees when wait_for_node is called (a later cell) is not a second talker."""
-    from course_lib import graph, session
+    from course_lib.ros import graph, session
 
     session.start(domain_id=domain_id)
     try:
@@ -119,7 +119,7 @@ def test_a_node_is_not_taken_for_an_earlier_one_when_its_wait_comes_late(talker_
 
 LEFT_RUNNING = """
 import sys, time
-from course_lib.processes import NodeProcess
+from course_lib.ros.processes import NodeProcess
 NodeProcess([sys.executable, "-c", "import time; time.sleep(60)", sys.argv[1]], name="camera").start()
 print("started", flush=True)
 time.sleep(60)

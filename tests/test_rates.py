@@ -1,9 +1,9 @@
-"""Tests for course_lib.rates: ros2 topic hz's statistics of arrival times."""
+"""Tests for course_lib.ros.rates: ros2 topic hz's statistics of arrival times."""
 
 import numpy as np
 import pytest
 
-from course_lib import rates
+from course_lib.ros import rates
 
 
 def test_rate_statistics_of_known_arrival_times():

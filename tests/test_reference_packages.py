@@ -26,8 +26,9 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 from sensor_msgs.msg import Image
 
-from course_lib import images, marker_board, pictures, rosenv, scenes, workspace
 from course_lib.checks import assignments
+from course_lib.imaging import images, marker_board, pictures, scenes
+from course_lib.ros import rosenv, workspace
 
 SOURCE = Path(__file__).resolve().parents[1] / "assignments" / "reference_ws" / "src"
 PACKAGES = ("webcam", "readmarker")

@@ -14,7 +14,7 @@ import yaml
 from process_support import in_background_of_a_script, wait_until
 from ros2cli_support import ROS2, node_script, ros2, ros2_together
 
-from course_lib import colcon, processes, rosenv, workspace
+from course_lib.ros import colcon, processes, rosenv, workspace
 from course_lib.ros2cli.common import FULL_INSTALL
 
 # Two nodes, each in a process of its own: `python live_nodes.py talker|listener [ros args]`.

@@ -10,7 +10,7 @@ import pytest
 import yaml
 from ros2cli_support import node_script, ros2, ros2_together
 
-from course_lib import processes, rosenv
+from course_lib.ros import processes, rosenv
 
 # ros2action's test/fixtures/fibonacci_action_server.py, written anew: feedback after each new
 # number, then the sequence as the result.

@@ -1,4 +1,4 @@
-"""``ros2 bag record|info|play`` (course_lib/ros2cli/bag.py, course_lib.bag_files), run as the
+"""``ros2 bag record|info|play`` (course_lib/ros2cli/bag.py, course_lib.ros.bag_files), run as the
 installed ``.venv/bin/ros2`` against a node in a process of its own, with bags going both ways
 between the course and rosbags (PyPI), whose rosbag2 and MCAP code is its own: rosbags reads
 what the course recorded, and the course shows and plays what rosbags wrote. Held to rosbag2's
@@ -19,7 +19,7 @@ from rosbags.interfaces import Qos, QosDurability, QosHistory, QosLiveliness, Qo
 from rosbags.rosbag2 import StoragePlugin, Writer
 from rosbags.typesys import Stores, get_typestore
 
-from course_lib import bag_metadata, processes, rosenv
+from course_lib.ros import bag_metadata, processes, rosenv
 from course_lib.ros2cli.bag import play_messages
 
 BAG_NODE = node_script('''

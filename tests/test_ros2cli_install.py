@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from course_lib import rosenv
+from course_lib.ros import rosenv
 from course_lib.ros2cli import install
 
 

@@ -8,7 +8,7 @@ import sys
 import pytest
 from ros2cli_support import ros2
 
-from course_lib import colcon, pkg_create, workspace
+from course_lib.ros import colcon, pkg_create, workspace
 
 # Comments say at which nesting level they are, as in ros2cli_test_interfaces.
 INTERFACES = {

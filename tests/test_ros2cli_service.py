@@ -10,7 +10,7 @@ import types
 import pytest
 from ros2cli_support import ROS2, node_script, ros2, ros2_together
 
-from course_lib import processes, rosenv
+from course_lib.ros import processes, rosenv
 
 # ros2service's test/fixtures/echo_server.py, written anew: answers a BasicTypes request with
 # the same values.

@@ -11,7 +11,7 @@ import types
 import pytest
 from ros2cli_support import ROS2, node_script, ros2_together
 
-from course_lib import processes, rosenv
+from course_lib.ros import processes, rosenv
 
 STAMPED_TALKER = node_script('''
 import sys

@@ -1,4 +1,4 @@
-"""Tests for course_lib.rosenv: install detection, child environments, domain reservations."""
+"""Tests for course_lib.ros.rosenv: install detection, child environments, domain reservations."""
 
 import os
 import subprocess
@@ -12,7 +12,7 @@ from rclpy.node import Node
 from rclpy.qos import qos_profile_sensor_data
 from sensor_msgs.msg import Image
 
-from course_lib import processes, rosenv, session
+from course_lib.ros import processes, rosenv, session
 
 
 def test_pip_wheels_are_detected_in_the_project_environment():
@@ -145,7 +145,7 @@ def test_full_size_camera_frames_reach_a_notebook_session_from_another_process(d
         received = []  # the video's frame number of each frame received
         node.create_subscription(Image, "image", lambda m: received.append(round(m.data[0] / 10)),
                                  qos_profile_sensor_data)
-        with processes.python_node("course_lib.camera:main", "--ros-args", "-p", "width:=1920", "-p",
+        with processes.python_node("course_lib.imaging.camera:main", "--ros-args", "-p", "width:=1920", "-p",
                                    "height:=1080", "-p", f"rate:={1 / period}", "-p", f"source:={video}",
                                    domain_id=domain_id) as camera:
             camera.wait_for_node("image_publisher", timeout=60)

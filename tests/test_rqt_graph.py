@@ -1,4 +1,4 @@
-"""Tests for course_lib.rqt_graph: the picture of the ROS graph, rqt_graph's stand-in."""
+"""Tests for course_lib.notebook.rqt_graph: the picture of the ROS graph, rqt_graph's stand-in."""
 
 import pytest
 from matplotlib.figure import Figure
@@ -6,7 +6,8 @@ from matplotlib.text import Annotation
 from rclpy.node import Node
 from std_msgs.msg import String
 
-from course_lib import discovery, rqt_graph, session
+from course_lib.notebook import rqt_graph
+from course_lib.ros import discovery, session
 
 
 @pytest.fixture

@@ -8,7 +8,7 @@ import pytest
 from process_support import processes_with, wait_until
 
 from autograder import run_as
-from course_lib.processes import NodeProcess
+from course_lib.ros.processes import NodeProcess
 
 needs_root = pytest.mark.skipif(os.geteuid() != 0, reason="dropping to another user needs root")
 

@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 from autograder import sandbox
-from course_lib import processes
+from course_lib.ros import processes
 
 needs_namespaces = pytest.mark.skipif(sandbox.isolation() == "none",
                                       reason="no namespaces here (not root, no user namespaces): "
@@ -183,10 +183,10 @@ def _group_of(pid: str) -> int | None:
 
 @needs_namespaces
 def test_a_process_in_the_sandbox_leaves_the_notes_of_the_machines_named_processes_alone():
-    """course_lib.process_registry's notes hold process ids: the sandbox's own process-id namespace
+    """course_lib.supervision.process_registry's notes hold process ids: the sandbox's own process-id namespace
     must not take a running process of the machine for one that has ended and delete its note
     (a clean-clone run lost lesson 02's camera note so, and lesson 03 then did not name it)."""
-    from course_lib import process_registry
+    from course_lib.supervision import process_registry
 
     process_registry.record("registry_probe", 7, os.getpid())
     try:

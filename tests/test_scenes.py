@@ -1,4 +1,4 @@
-"""Tests for course_lib.scenes: rendered scenes, their ground truth, the moving camera.
+"""Tests for course_lib.imaging.scenes: rendered scenes, their ground truth, the moving camera.
 
 The reference detect + warp below is test-only on purpose: it is the solution of the crop
 assignment, so it must never move into course_lib (students have course_lib).
@@ -8,7 +8,7 @@ import cv2
 import numpy as np
 import pytest
 
-from course_lib import boards, camera_views, marker_board, pictures, scenes
+from course_lib.imaging import boards, camera_views, marker_board, pictures, scenes
 
 BOARD_IDS = (1, 2, 3, 4, 5, 6, 7, 8)
 

@@ -5,7 +5,8 @@ import pytest
 from rclpy.node import Node
 from std_msgs.msg import Int32, String
 
-from course_lib import discovery, selfcheck, session
+from course_lib import selfcheck
+from course_lib.ros import discovery, session
 
 
 @pytest.fixture
@@ -158,7 +159,7 @@ def corners_using(marker_corner):
     """A picture_corners_of that takes corner marker_corner[k] of the k-th marker of the picture."""
     import numpy as np
 
-    from course_lib import marker_board
+    from course_lib.imaging import marker_board
 
     def picture_corners_of(markers, picture):
         return np.array([markers[m][c] for m, c in zip(marker_board.PICTURES[picture], marker_corner, strict=True)])

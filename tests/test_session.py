@@ -1,4 +1,4 @@
-"""Tests for course_lib.session: a background ROS session that survives re-run notebook cells."""
+"""Tests for course_lib.ros.session: a background ROS session that survives re-run notebook cells."""
 
 import subprocess
 import sys
@@ -10,7 +10,7 @@ from rclpy.exceptions import InvalidHandle
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 
-from course_lib import discovery, graph, rosenv, session
+from course_lib.ros import discovery, graph, rosenv, session
 
 
 class Counter(Node):
@@ -187,7 +187,7 @@ def test_spin_for_keeps_callbacks_running_in_the_background(domain_id):
     waited = session.spin_for(1.0)
     assert waited >= 1.0
     assert node.ticks > before
-    assert node.threads == {"course_lib.session"}
+    assert node.threads == {"course_lib.ros.session"}
 
 
 def test_wait_for_returns_false_when_time_runs_out(domain_id):

@@ -154,7 +154,7 @@ def test_the_scan_finds_a_planted_solution(wheel_files):
     blocks = reference_blocks()
     name, lines = next((n, ls) for n, ls in blocks.items() if n.startswith("catdog_warp: solution"))
     planted = dict(wheel_files)
-    planted["course_lib/scenes.py"] += "\n" + "\n".join(lines)
+    planted["course_lib/imaging/scenes.py"] += "\n" + "\n".join(lines)
     assert any(name in leak for leak in leaks(planted, blocks))
     key = next(n for n in blocks if n.startswith("answer key brightness"))
     planted = {"course_lib/helpers.py": "def f(image):\n    " + "\n    ".join(blocks[key])}

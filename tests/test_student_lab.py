@@ -1,4 +1,4 @@
-"""Tests for course_lib.student_lab: a student's lab shows nbgrader's student side, and Validate
+"""Tests for course_lib.notebook.student_lab: a student's lab shows nbgrader's student side, and Validate
 on a lesson does not say "Success". (tests/test_browser.py checks the running lab's extensions,
 tests/test_browser_validate.py its Validate.)"""
 
@@ -8,16 +8,16 @@ from pathlib import Path
 
 import nbformat
 
-from course_lib import student_lab
+from course_lib.notebook import student_lab
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
 def test_make_lab_puts_the_student_config_on_the_jupyter_config_path():
     commands = subprocess.run(["make", "-n", "lab"], cwd=ROOT, capture_output=True, text=True, timeout=60).stdout
-    assert f'JUPYTER_CONFIG_PATH="{ROOT}/course_lib/student_lab' in commands
+    assert f'JUPYTER_CONFIG_PATH="{ROOT}/course_lib/notebook/student_lab' in commands
     assert ".venv/bin/python -m autograder release-lab" in commands  # the assignments in its Assignments panel
-    assert student_lab.CONFIG_DIR == ROOT / "course_lib" / "student_lab"
+    assert student_lab.CONFIG_DIR == ROOT / "course_lib" / "notebook" / "student_lab"
 
 
 def test_the_lab_serves_validate_with_the_course_handler_instead_of_nbgraders():
@@ -25,19 +25,19 @@ def test_the_lab_serves_validate_with_the_course_handler_instead_of_nbgraders():
     (tests/test_browser_validate.py presses Validate in the running lab)."""
     from nbgrader.server_extensions.validate_assignment import handlers as nbgrader_handlers
 
-    from course_lib.student_lab import validate
+    from course_lib.notebook.student_lab import validate
 
     extensions = json.loads((student_lab.CONFIG_DIR / "jupyter_server_config.json").read_text())
     enabled = extensions["ServerApp"]["jpserver_extensions"]
     assert enabled["nbgrader.server_extensions.validate_assignment"] is False
-    assert enabled["course_lib.student_lab.validate"] is True
-    assert validate._jupyter_server_extension_points() == [{"module": "course_lib.student_lab.validate"}]
+    assert enabled["course_lib.notebook.student_lab.validate"] is True
+    assert validate._jupyter_server_extension_points() == [{"module": "course_lib.notebook.student_lab.validate"}]
     assert [p for p, _ in nbgrader_handlers.default_handlers] == ["/assignments/validate", "/nbgrader_version"]
     assert issubclass(validate.ValidateHandler, nbgrader_handlers.ValidateAssignmentHandler)
 
 
 def test_lessons_are_told_from_assignments(tmp_path):
-    from course_lib.student_lab.validate import is_assignment, is_lesson_file
+    from course_lib.notebook.student_lab.validate import is_assignment, is_lesson_file
 
     graded = nbformat.v4.new_code_cell("assert True")
     graded.metadata["nbgrader"] = {"grade": True, "grade_id": "t1", "points": 1, "solution": False,

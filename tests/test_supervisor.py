@@ -1,4 +1,4 @@
-"""Tests for course_lib.supervisor, through the NodeProcess that starts it: no orphans ever, even
+"""Tests for course_lib.supervision.supervisor, through the NodeProcess that starts it: no orphans ever, even
 when the caller dies; output relayed without blocking the child; the limits it sets bite."""
 
 import signal
@@ -9,7 +9,7 @@ import threading
 import pytest
 from process_support import processes_with, sleeper, sleeper_script, sleepers, wait_until
 
-from course_lib.processes import Limits, NodeProcess
+from course_lib.ros.processes import Limits, NodeProcess
 
 
 def test_child_that_ignores_sigint_is_killed_after_the_timeout(token):
@@ -95,7 +95,7 @@ def test_a_slow_on_output_never_blocks_the_child(tmp_path):
 CALLER = """
 import os, signal, sys, time
 import rclpy
-from course_lib.processes import NodeProcess
+from course_lib.ros.processes import NodeProcess
 # Like a notebook kernel, the caller runs DDS threads. Without rclpy's signal handlers, so that
 # SIGTERM ends it (rclpy's handler would only shut the context down and keep the caller alive).
 rclpy.init(signal_handler_options=rclpy.signals.SignalHandlerOptions.NO)

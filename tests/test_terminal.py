@@ -1,4 +1,4 @@
-"""Tests for course_lib.student_lab.terminal: the shell of JupyterLab's terminal in the course."""
+"""Tests for course_lib.notebook.student_lab.terminal: the shell of JupyterLab's terminal in the course."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from course_lib.student_lab import terminal
+from course_lib.notebook.student_lab import terminal
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -36,12 +36,12 @@ def test_a_bashrc_that_puts_another_python_first_does_not_hide_the_course_python
 def test_bash_gets_the_course_rc_file_and_other_shells_start_as_they_are():
     assert terminal.shell_command("/bin/bash") == ["/bin/bash", "--rcfile", str(terminal.BASHRC)]
     assert terminal.shell_command("/usr/bin/zsh") == ["/usr/bin/zsh"]
-    printed = subprocess.run([sys.executable, "-m", "course_lib.student_lab.terminal"], capture_output=True,
+    printed = subprocess.run([sys.executable, "-m", "course_lib.notebook.student_lab.terminal"], capture_output=True,
                              text=True, timeout=60, env={"SHELL": "/bin/bash", "PATH": "/usr/bin:/bin"})
     assert json.loads(printed.stdout) == {"shell_command": terminal.shell_command("/bin/bash")}
 
 
 def test_make_lab_and_the_hub_give_terminals_the_course_shell_and_environment():
     commands = subprocess.run(["make", "-n", "lab"], cwd=ROOT, capture_output=True, text=True, timeout=60).stdout
-    assert "-m course_lib.student_lab.terminal" in commands and f'. "{ROOT}/.venv/local_setup.sh"' in commands
+    assert "-m course_lib.notebook.student_lab.terminal" in commands and f'. "{ROOT}/.venv/local_setup.sh"' in commands
     assert "terminal.shell_command(" in (ROOT / "coursehub" / "jupyterhub_config.py").read_text()

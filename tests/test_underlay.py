@@ -1,4 +1,4 @@
-"""Tests for course_lib.underlay: the venv's local_setup.* files, as a ROS install's."""
+"""Tests for course_lib.ros.underlay: the venv's local_setup.* files, as a ROS install's."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from course_lib import pkg_create, rosenv, underlay, wheelfix
+from course_lib.ros import pkg_create, rosenv, underlay, wheelfix
 
 SHELLS = [shell for shell in ("sh", "bash", "zsh") if shutil.which(shell)]
 

@@ -1,4 +1,4 @@
-"""Tests for course_lib.wheelfix: the repair of the wheels' CMake files and the build environment.
+"""Tests for course_lib.ros.wheelfix: the repair of the wheels' CMake files and the build environment.
 
 The repair is exercised on a temporary prefix laid out like the venv (share/<pkg>/cmake/*.cmake)
 holding the foreign paths exactly as the ros-jazzy-* wheels ship them, so that the tests never
@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from course_lib import rosenv, wheelfix
+from course_lib.ros import rosenv, wheelfix
 
 FOREIGN_INCLUDES = ("/opt/python/cp311-cp311/include/python3.11;"
                     "/opt/python/cp311-cp311/lib/python3.11/site-packages/numpy/_core/include")

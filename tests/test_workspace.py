@@ -1,4 +1,4 @@
-"""Tests for course_lib.workspace: a built workspace sourced and its nodes run (and the real colcon build of it).
+"""Tests for course_lib.ros.workspace: a built workspace sourced and its nodes run (and the real colcon build of it).
 
 The slow tests share one workspace, built once per test run by the `built_ws` fixture: the
 interface package tutorial_interfaces (msg/MsgTutorial.msg) and the ament_python package
@@ -16,7 +16,7 @@ from pathlib import Path
 
 import pytest
 
-from course_lib import colcon, pkg_create, rosenv, workspace
+from course_lib.ros import colcon, pkg_create, rosenv, workspace
 
 MSG_TUTORIAL = "builtin_interfaces/Time stamp\nint32 data\n"
 

@@ -11,7 +11,8 @@ from pathlib import Path
 import pytest
 
 from autograder import packages
-from course_lib import contract, workspace
+from course_lib import contract
+from course_lib.ros import workspace
 
 pytestmark = pytest.mark.slow
 

@@ -132,7 +132,7 @@ A camera looks at the course's marker board: a cat picture framed by ArUco marke
 picture framed by markers 5-8 (dictionary `DICT_4X4_50`), in the order top-left, top-right,
 bottom-right, bottom-left. Each marker touches its picture with one corner: marker 1 with its
 corner 2, marker 2 with corner 3, marker 3 with corner 0, marker 4 with corner 1
-(`course_lib.marker_board.PICTURES` and `CORNER_OF_MARKER`; OpenCV numbers a marker's corners
+(`course_lib.imaging.marker_board.PICTURES` and `CORNER_OF_MARKER`; OpenCV numbers a marker's corners
 clockwise from its top-left).
 
 **Contract** (this is exactly what is graded). Your workspace `ros2_ws/src` holds three packages:
@@ -154,7 +154,7 @@ clockwise from its top-left).
      (`ros2 launch readmarker catdog_warp.launch.xml`); `package.xml` declares every ROS package the
      code imports.
 
-The grader renders scenes (`course_lib.scenes.render_scene`) with poses and lighting you have not
+The grader renders scenes (`course_lib.imaging.scenes.render_scene`) with poses and lighting you have not
 seen, and compares your crops with the true ones (`marker_board.crop_similarity`, passing at
 `marker_board.SAME_CROP_THRESHOLD`). Try your function on `scenes.render_scene(seed).frame`.
 """

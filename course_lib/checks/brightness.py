@@ -108,7 +108,7 @@ THROUGHPUT_RATE = 30.0
 #: The throughput verdict is on processor time, which the machine's load does not change: the
 #: student's node process may use at most this many times the processor time per frame answered
 #: right that the grader's yardstick node uses per frame it answered, measured the same way
-#: (course_lib.process_tree.cpu_seconds) over the same bursts. Both get the very same frames; the
+#: (course_lib.supervision.process_tree.cpu_seconds) over the same bursts. Both get the very same frames; the
 #: yardstick does what any brightness node does (receives the frame, one numpy sum over its 6
 #: million bytes: about 10 ms here). Measured against it, idle and beside 4-8 busy processes on 2
 #: cores: the reference 0.9-1.1 times; np.mean or a float copy 1.2-2.5; a node that answers every
@@ -171,7 +171,7 @@ def _exchange(ctx, probe, node, publisher, replies: list, frames, encoding: str,
     Returns True (all answered right), False (an item failed), or None when the node process
     ended during the exchange (nothing is recorded then: the caller reports the crash, the cause).
     """
-    from course_lib import images
+    from course_lib.imaging import images
 
     for image in frames:
         expected = ctx.expected("average_brightness", image)
@@ -372,7 +372,7 @@ def _frames_and_replies(probe, image_topic: str, brightness_topic: str):
 
 def _start_yardstick(ctx):
     """Start the throughput yardstick on the check's /image, answering on YARDSTICK_ANSWERS."""
-    from course_lib import processes
+    from course_lib.ros import processes
 
     return ctx.track(processes.python_node("course_lib.checks.brightness:yardstick_main", "--ros-args",
                                  "-r", "frames:=/image", "-r", f"answers:={YARDSTICK_ANSWERS}",
@@ -440,7 +440,7 @@ def throughput_verdict(student: CpuCost, yardstick: CpuCost) -> bool | None:
 def _throughput(ctx, probe, node, yardstick, publisher, replies, yardstick_replies, images: list) -> None:
     """Bursts to both the student's node and the yardstick, until their processor time per frame
     decides (throughput_verdict)."""
-    from course_lib import images as image_msgs
+    from course_lib.imaging import images as image_msgs
 
     label = "throughput at 1920x1080, 30 Hz"
     expected = {ctx.expected("average_brightness", image) for image in images}
@@ -482,7 +482,7 @@ def _throughput(ctx, probe, node, yardstick, publisher, replies, yardstick_repli
 
 def _remapped(ctx, probe, remapped, image) -> None:
     """The node started with remapped node and topic names answers on the remapped topics."""
-    from course_lib import images
+    from course_lib.imaging import images
 
     label = "remapped names"
     publisher, replies = _frames_and_replies(probe, REMAPPED_IMAGE, REMAPPED_BRIGHTNESS)

@@ -1,7 +1,7 @@
 """Checks of the catdog_warp assignment: ``crop_pictures`` and ``MarkerReader``, on generated scenes.
 
 The contract (also in the notebook and in assignments/README.md); the board convention is
-course_lib.marker_board's (markers of DICT_4X4_50; "cat" framed by markers 1-4, "dog" by 5-8, in the
+course_lib.imaging.marker_board's (markers of DICT_4X4_50; "cat" framed by markers 1-4, "dog" by 5-8, in the
 order top-left, top-right, bottom-right, bottom-left; the picture's corners are those marker
 corners that touch it, marker_board.CORNER_OF_MARKER):
 
@@ -60,7 +60,7 @@ def _seed(ctx) -> int:
 
 def compare_crop(ctx, label: str, crop, expected, show: bool = False) -> bool:
     """One item: the student's crop is the expected picture (shape, dtype, content, colours)."""
-    from course_lib import marker_board
+    from course_lib.imaging import marker_board
 
     if not isinstance(crop, np.ndarray):
         return ctx.item(False, f"{label}: the crop is a {type(crop).__name__}, not a numpy image")
@@ -90,7 +90,7 @@ def compare_crop(ctx, label: str, crop, expected, show: bool = False) -> bool:
 
 
 def _check_scene(ctx, label: str, scene, outcome, show: bool = False) -> None:
-    from course_lib import marker_board
+    from course_lib.imaging import marker_board
 
     if not outcome.ok:
         stub = outcome.error.startswith("NotImplementedError")
@@ -131,7 +131,7 @@ def _run_scenes(ctx, cases, show_first: bool = True) -> None:
 @check(points=3, timeout=60)
 def easy(ctx: Context) -> None:
     """crop_pictures finds and warps both pictures on easy (mildly tilted) views."""
-    from course_lib import scenes
+    from course_lib.imaging import scenes
 
     _run_scenes(ctx, [(f"easy scene {i + 1}", scenes.render_scene(_seed(ctx), difficulty="easy")) for i in range(3)])
 
@@ -139,7 +139,7 @@ def easy(ctx: Context) -> None:
 @check(points=2, timeout=60)
 def hard(ctx: Context) -> None:
     """crop_pictures on hard views: steep, rotated, partly off-frame; only fully framed pictures."""
-    from course_lib import scenes
+    from course_lib.imaging import scenes
 
     cases = []
     for _attempt in range(40):  # two scenes that show a whole picture, then one of any kind
@@ -157,7 +157,7 @@ def hard(ctx: Context) -> None:
 @check(points=2, timeout=60)
 def missing_and_none(ctx: Context) -> None:
     """A picture with any one of its markers missing is left out; frames without markers give an empty dict."""
-    from course_lib import marker_board, scenes
+    from course_lib.imaging import marker_board, scenes
 
     # Every marker is the missing one once, in every grading: scene k lacks the k-th marker of
     # each picture (so a solution that looks at only some of a picture's markers always loses).
@@ -183,7 +183,7 @@ def missing_and_none(ctx: Context) -> None:
 @check(points=1, timeout=60)
 def noisy(ctx: Context) -> None:
     """crop_pictures copes with sensor noise, blur and JPEG artefacts, and with another crop size."""
-    from course_lib import camera_views, scenes
+    from course_lib.imaging import camera_views, scenes
 
     pose = scenes.scene_pose(_seed(ctx), difficulty="easy")
     look = camera_views.Look(noise=7.0, blur=1.0, jpeg_quality=60, gain=0.9)
@@ -232,7 +232,7 @@ def _single_node_items(ctx: Context, proc, message_type) -> bool:
     from rclpy.qos import QoSProfile, ReliabilityPolicy
     from sensor_msgs.msg import Image
 
-    from course_lib import images, scenes
+    from course_lib.imaging import images, scenes
 
     try:
         with ctx.probe() as probe:

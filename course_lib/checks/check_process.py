@@ -11,12 +11,13 @@ import sys
 import traceback
 from pathlib import Path
 
-from course_lib import contract, processes
+from course_lib import contract
 from course_lib.checks.context import Context, StudentError
 from course_lib.checks.registry import get_check
 from course_lib.checks.result import Result, earned_points
 from course_lib.checks.runner import SELFCHECK_SEED
 from course_lib.checks.student_processes import StudentProcesses
+from course_lib.ros import processes
 
 
 def run_in_this_process(assignment: str, name: str, seed: int, workdir: Path, out: Path,

@@ -56,7 +56,7 @@ def scaled(seconds: float) -> float:
     machine, and a backstop must never be what decides against it."""
     factor = number_from_environment(contract.LOAD_FACTOR_ENV)
     if factor is None:
-        from course_lib import rosenv
+        from course_lib.ros import rosenv
 
         factor = rosenv.load_factor(MAX_LOAD_FACTOR)
     return seconds * min(MAX_LOAD_FACTOR, max(1.0, factor))
@@ -362,7 +362,7 @@ class Context:
     @property
     def domain_id(self) -> int:
         if self._reservation is None:
-            from course_lib import rosenv
+            from course_lib.ros import rosenv
 
             if rosenv.under_grading() and os.environ.get("ROS_DOMAIN_ID"):
                 # The grader reserved this domain for the whole submission, in a network
@@ -377,7 +377,7 @@ class Context:
         """A second ROS domain of this check's own, e.g. for a launch file's nodes while a single
         node of the same names runs in domain_id: given by the grader, else reserved on this machine."""
         if self._second_reservation is None:
-            from course_lib import rosenv
+            from course_lib.ros import rosenv
 
             self._second_reservation = rosenv.reserve_domain_id()
         return self._second_reservation.domain_id
@@ -397,7 +397,7 @@ class Context:
 
     def close(self) -> None:
         """Stop the processes this check started (and its own student servers)."""
-        from course_lib import processes
+        from course_lib.ros import processes
 
         processes.stop_together(self._started_processes, timeout=1.0)
         if self._own_servers:

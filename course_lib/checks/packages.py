@@ -24,10 +24,11 @@ import os
 import xml.etree.ElementTree as ElementTree
 from pathlib import Path
 
-from course_lib import contract, package_files
+from course_lib import contract
 from course_lib.checks.assignments import WORKSPACE
 from course_lib.checks.context import StudentError
 from course_lib.checks.student_processes import student_env as _student_env
+from course_lib.ros import package_files
 
 #: Python modules that belong to no ROS package (a <depend> on them is not needed here). Every
 #: other top-level module whose name is a ROS package (installed, or in the workspace) must be
@@ -53,7 +54,7 @@ def require_build(ctx) -> Path:
 def student_env(ctx, ws: Path) -> dict:
     """The environment of the student's processes: ``source ros2_ws/install/setup.bash`` on top of
     the course's, PYTHONPATH ending with course_lib's (student_processes.student_env)."""
-    from course_lib import workspace
+    from course_lib.ros import workspace
 
     if getattr(ctx, "_workspace_env", None) is None:
         try:
@@ -73,13 +74,13 @@ def run(ctx, package: str, executable: str, *ros_args: str, tag: str = ""):
     student's uid with the student's limits; stopped at the end of the check.
 
     Returns:
-        The started course_lib.processes.NodeProcess.
+        The started course_lib.ros.processes.NodeProcess.
 
     Raises:
         StudentError: the workspace is not built, or has no such package or executable
             (the message lists the executables there are: an entry point missing from setup.py).
     """
-    from course_lib import workspace
+    from course_lib.ros import workspace
 
     ws = require_build(ctx)
     try:
@@ -87,7 +88,7 @@ def run(ctx, package: str, executable: str, *ros_args: str, tag: str = ""):
     except FileNotFoundError as error:
         raise StudentError(f"`ros2 run {package} {executable}` cannot start: {error}") from None
     # Named after the check too: a process started under a name stops the earlier one of that
-    # name (course_lib.processes), and the checks of a grading run at the same time.
+    # name (course_lib.ros.processes), and the checks of a grading run at the same time.
     return ctx.students.start(command, name=f"student-{package}-{executable}{tag}-{ctx.spec.name}", cwd=ctx.workdir,
                               domain_id=ctx.domain_id, wall_seconds=ctx.remaining() + 5, env=student_env(ctx, ws))
 
@@ -102,7 +103,7 @@ def endpoints(ctx, module: str, class_name: str) -> dict:
 
 def ros_packages(ctx) -> set[str]:
     """The ROS packages the code could import: installed ones (the ament index) and the workspace's."""
-    from course_lib import ament
+    from course_lib.ros import ament
 
     names = set(ament.packages())
     src = ctx.workspace_dir() / "src"
@@ -140,7 +141,7 @@ def use_interfaces(ctx) -> None:
     """Make the assignment's message packages importable in this check process: at grading the
     reference interface packages the grader built (never code the student built: the check runs
     as the grader), in a self-check the student's own workspace."""
-    from course_lib import workspace
+    from course_lib.ros import workspace
 
     report = os.environ.get(contract.BUILD_REPORT_ENV)
     try:

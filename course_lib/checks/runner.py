@@ -62,7 +62,7 @@ def selfcheck(assignment: str, name: str) -> None:
     Under grading (COURSE_LIB_GRADING=1) it does nothing: the hidden test that follows it in the
     same cell runs the check with a fresh seed.
     """
-    from course_lib import rosenv
+    from course_lib.ros import rosenv
 
     if rosenv.under_grading():
         return
@@ -114,7 +114,8 @@ def execute(assignment: str, name: str, seed: int, workdir=None, mode: str = "se
     (recorded answers; only the self-check seed's inputs are recorded), "graded" (the grader's
     answer key) or "record" (graded, and the answers written to $AUTOGRADER_RECORD_TO).
     """
-    from course_lib import processes, progress
+    from course_lib.notebook import progress
+    from course_lib.ros import processes
 
     spec = get_check(assignment, name)
     workdir = Path(workdir or os.getcwd()).resolve()

@@ -21,7 +21,7 @@ STUDENT_FILE_MB = 128
 def student_env() -> dict:
     """The variables of a student process: course_lib importable, none of the grader's seeds or answers."""
     # Fast DDS's set-up for camera frames comes, as for every course process, from
-    # course_lib.rosenv.ros_environment (its shared-memory segments need RLIMIT_FSIZE above 32 MB).
+    # course_lib.ros.rosenv.ros_environment (its shared-memory segments need RLIMIT_FSIZE above 32 MB).
     return {"PYTHONPATH": child_pythonpath(), contract.SEED_ENV: None, contract.CHECK_SEED_ENV: None,
             contract.ANSWERS_ENV: None, contract.ANSWER_KEYS_ENV: None, contract.RECORD_ANSWERS_ENV: None,
             "PYTHONDONTWRITEBYTECODE": "1", **MALLOC_ENV}
@@ -41,9 +41,9 @@ class StudentProcesses:
 
     def start(self, command: list[str], *, name: str, cwd, domain_id: int, wall_seconds: float,
               env: dict | None = None):
-        """Start `command` (the student's code) and return its running course_lib.processes.NodeProcess;
+        """Start `command` (the student's code) and return its running course_lib.ros.processes.NodeProcess;
         `env`: variables on top of student_env() (a sourced workspace, course_lib.checks.packages)."""
-        from course_lib import processes
+        from course_lib.ros import processes
 
         command, env, private_dirs = self.confine(list(command), {**student_env(), **(env or {})})
         return processes.NodeProcess(command, name=name, cwd=cwd, domain_id=domain_id, env=env,
@@ -51,7 +51,7 @@ class StudentProcesses:
 
     def limits(self, wall_seconds: float):
         """Bounds of a student process: time, memory, file size."""
-        from course_lib import processes
+        from course_lib.ros import processes
 
         return processes.Limits(wall_seconds=wall_seconds, memory_mb=contract.STUDENT_MEMORY_MB,
                                 file_size_mb=STUDENT_FILE_MB, grace_seconds=1.0)

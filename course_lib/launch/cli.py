@@ -15,10 +15,10 @@ from pathlib import Path
 
 from ament_index_python import get_search_paths
 
-from course_lib import ament
 from course_lib.launch import actions, parser, substitutions
 from course_lib.launch.entities import LaunchFileError
 from course_lib.launch.runner import Launch, find_in_package
+from course_lib.ros import ament
 
 _NOT_SUPPORTED = {"print": "-p/--print", "launch_prefix": "--launch-prefix",
                   "launch_prefix_filter": "--launch-prefix-filter", "debug": "-d/--debug"}

@@ -129,7 +129,7 @@ class Node(Action):
     prefix: list | None = None
 
     def execute(self, context: LaunchContext) -> None:
-        from course_lib import ament
+        from course_lib.ros import ament
 
         def text(parts):
             return substitutions.perform(parts, context)

@@ -1,6 +1,6 @@
 """Run a launch file: start its processes, show their output like ``ros2 launch``, stop them all.
 
-Each node, and each other program (``<executable>``), runs as a course_lib.processes.NodeProcess
+Each node, and each other program (``<executable>``), runs as a course_lib.ros.processes.NodeProcess
 (own process group, bounded log, never an orphan). What the real tool prints, this prints the
 same way::
 
@@ -32,10 +32,10 @@ from collections import deque
 from collections.abc import Callable
 from pathlib import Path
 
-from course_lib import processes
 from course_lib.launch.actions import LaunchContext, run_launch_file
 from course_lib.launch.entities import LaunchFileError
 from course_lib.launch.executables import ProcessToStart
+from course_lib.ros import processes
 
 #: How a launch stops a process that still runs, as ros2/launch's ExecuteLocal does: SIGINT, then
 #: SIGTERM after ``sigterm_timeout`` seconds, then SIGKILL after ``sigkill_timeout`` seconds more.
@@ -403,7 +403,7 @@ def find_in_package(package: str, file_name: str) -> Path:
         LookupError: no such package (the message says how to make it visible).
         FileNotFoundError: no such file, or more than one.
     """
-    from course_lib import ament
+    from course_lib.ros import ament
 
     share = ament.share(package)
     found = sorted(Path(root) / name for root, _, names in os.walk(share) for name in names if name == file_name)

@@ -102,7 +102,7 @@ class Substitution:
                 return perform(self.args[1], context)
             raise self.error(_MISSING[self.name].format(name=first))
         if self.name in ("find-pkg-share", "find-pkg-prefix"):
-            from course_lib import ament
+            from course_lib.ros import ament
 
             try:
                 found = ament.share(first) if self.name == "find-pkg-share" else ament.prefix(first)

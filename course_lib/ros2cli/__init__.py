@@ -5,17 +5,17 @@ ros2cli is not on PyPI, so ``make setup`` puts this stand-in into the virtual en
 real tool's verbs, options and output for what it supports, each a thin layer over course_lib:
 
 =============================================  =============================================
-``ros2 run PKG EXE [args]``                    :mod:`.run` (course_lib.ament)
+``ros2 run PKG EXE [args]``                    :mod:`.run` (course_lib.ros.ament)
 ``ros2 launch PKG FILE`` / ``ros2 launch PATH``  :mod:`.launch` (course_lib.launch)
-``ros2 node list|info``                        :mod:`.node` (course_lib.graph)
-``ros2 topic list|echo|hz|info|pub``           :mod:`.topic` (course_lib.graph)
-``ros2 topic type|find|bw|delay``              :mod:`.topic` (course_lib.graph)
+``ros2 node list|info``                        :mod:`.node` (course_lib.ros.graph)
+``ros2 topic list|echo|hz|info|pub``           :mod:`.topic` (course_lib.ros.graph)
+``ros2 topic type|find|bw|delay``              :mod:`.topic` (course_lib.ros.graph)
 ``ros2 service list|type|find|call``           :mod:`.service` (the tool node's clients)
 ``ros2 action list|info|type|send_goal``       :mod:`.action` (rclpy.action)
-``ros2 bag record|info|play``                  :mod:`.bag` (course_lib.bag_files)
-``ros2 param list|get|set|dump|load``          :mod:`.param` (course_lib.parameters)
-``ros2 interface show|list|package|packages``  :mod:`.interface` (course_lib.interfaces)
-``ros2 pkg create|list|executables|prefix``    :mod:`.pkg` (course_lib.workspace, ament)
+``ros2 bag record|info|play``                  :mod:`.bag` (course_lib.ros.bag_files)
+``ros2 param list|get|set|dump|load``          :mod:`.param` (course_lib.ros.parameters)
+``ros2 interface show|list|package|packages``  :mod:`.interface` (course_lib.ros.interfaces)
+``ros2 pkg create|list|executables|prefix``    :mod:`.pkg` (course_lib.ros.workspace, ament)
 =============================================  =============================================
 
 Anything else (a command, a verb or an option) prints one line that says so and names what is

@@ -20,7 +20,7 @@ def action_pairs() -> list[tuple[str, list[str]]]:
     """(name, [type, ...]) of every action in the graph, sorted."""
     from rclpy.action import get_action_names_and_types
 
-    from course_lib import session
+    from course_lib.ros import session
 
     return sorted((name, list(kinds)) for name, kinds in get_action_names_and_types(session.tool_node()))
 
@@ -59,7 +59,7 @@ def _info(args) -> str | None:
     from rclpy.action import get_action_client_names_and_types_by_node, get_action_server_names_and_types_by_node
     from rclpy.exceptions import InvalidTopicNameException
 
-    from course_lib import session
+    from course_lib.ros import session
 
     node = session.tool_node()
     try:
@@ -93,7 +93,7 @@ def _send_goal_arguments(parser) -> None:
 
 
 def _yaml(msg) -> str:
-    from course_lib import message_yaml
+    from course_lib.ros import message_yaml
 
     return message_yaml.format_message(msg)
 
@@ -104,7 +104,7 @@ def _send_goal(args) -> str | None:
 
     from rclpy.action import ActionClient
 
-    from course_lib import message_yaml, session
+    from course_lib.ros import message_yaml, session
     from course_lib.ros2cli.service import read_values
 
     try:

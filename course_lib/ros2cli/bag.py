@@ -1,4 +1,4 @@
-"""``ros2 bag record|info|play``: rosbag2's verbs (Jazzy) over course_lib.bag_files' MCAP bags.
+"""``ros2 bag record|info|play``: rosbag2's verbs (Jazzy) over course_lib.ros.bag_files' MCAP bags.
 
 record subscribes like rosbag2's Recorder: to the topics asked for (or all, ``-a``) as discovery
 finds their publishers, polling the graph every ``--polling-interval`` ms, with a QoS every
@@ -16,7 +16,7 @@ import datetime
 import os
 import time
 
-from course_lib import bag_files, bag_metadata
+from course_lib.ros import bag_files, bag_metadata
 from course_lib.ros2cli.common import Verb, loop_limit, run_group, signals_received, unsupported
 
 #: Verbs of ros2bag (Jazzy) that the course leaves out.
@@ -66,7 +66,7 @@ def _node(name: str):
     from rclpy.node import Node
     from rclpy.parameter import Parameter
 
-    from course_lib import session
+    from course_lib.ros import session
 
     session.start()
     node = Node(name, start_parameter_services=False,
@@ -141,7 +141,7 @@ class Recorder:
         from rclpy.logging import get_logger
         from rclpy.topic_or_service_is_hidden import topic_or_service_is_hidden
 
-        from course_lib import message_yaml
+        from course_lib.ros import message_yaml
 
         if name in self.subscriptions or name in self.refused or (self.requested and name not in self.requested):
             return False
@@ -173,7 +173,7 @@ class Recorder:
         return bool(self.requested) and len(self.subscriptions) == len(self.requested)
 
     def _subscribe(self, name: str, type_name: str) -> None:
-        from course_lib import graph, message_yaml
+        from course_lib.ros import graph, message_yaml
 
         publishers = self.node.get_publishers_info_by_topic(name)
         # rosbag2 keeps the type hash the publishers agree on ("" when they differ or have none).
@@ -348,7 +348,7 @@ def _await_subscribers(node, publishers: dict, received: list) -> None:
     subscriptions the graph shows on its topic, so that a running echo hears the bag from its
     start (the real player starts at once; a new process may take a second to be discovered).
     A signal ends the wait."""
-    from course_lib import discovery, session
+    from course_lib.ros import discovery, session
     from course_lib.ros2cli.common import COMPLETE_SECONDS, DISCOVERY_BACKSTOP, QUIET_SECONDS
 
     discovery.wait_for_discovery(minimum=0.0, quiet=QUIET_SECONDS, complete_within=COMPLETE_SECONDS,
@@ -361,7 +361,7 @@ def _await_subscribers(node, publishers: dict, received: list) -> None:
 def _publishers(node, metadata: bag_metadata.BagMetadata, topics: list[str]) -> dict:
     """A publisher for each topic of the bag to play (of ``topics``, if given) whose type is
     installed, with the QoS its recorded publishers offered; player.cpp's warning for the others."""
-    from course_lib import message_yaml
+    from course_lib.ros import message_yaml
 
     publishers = {}
     for topic in metadata.topics:

@@ -20,12 +20,12 @@ DEFAULT_SPIN_TIME = 0.5
 QUIET_SECONDS = 0.2
 
 #: Seconds after its start up to which a listing verb waits for the nodes of the other ROS
-#: processes on this machine (course_lib.discovery.wait_for_discovery counts them; longer on a
+#: processes on this machine (course_lib.ros.discovery.wait_for_discovery counts them; longer on a
 #: busy machine).
 COMPLETE_SECONDS = 4.0
 
 #: Seconds discovery may take in a new process at most: the backstop of the discovery wait
-#: (course_lib.discovery), which ends as soon as the graph has stopped changing.
+#: (course_lib.ros.discovery), which ends as soon as the graph has stopped changing.
 DISCOVERY_BACKSTOP = 5
 
 
@@ -155,7 +155,7 @@ def wait_for_whole_graph(spin_time: float) -> None:
     the nodes of every other ROS process on this machine show (on a busy machine a new process
     can take seconds to discover them all).
     """
-    from course_lib import discovery
+    from course_lib.ros import discovery
 
     discovery.wait_for_discovery(minimum=spin_time, quiet=min(QUIET_SECONDS, spin_time),
                                  complete_within=COMPLETE_SECONDS)
@@ -170,7 +170,7 @@ def wait_for_name(shown: typing.Callable[[], bool], spin_time: float, timeout: f
     Returns:
         shown(), at the end of the wait.
     """
-    from course_lib import discovery
+    from course_lib.ros import discovery
 
     discovery.wait_for_discovery(minimum=spin_time + timeout, quiet=min(QUIET_SECONDS, spin_time),
                                  complete_within=COMPLETE_SECONDS, until=shown)
@@ -179,7 +179,7 @@ def wait_for_name(shown: typing.Callable[[], bool], spin_time: float, timeout: f
 
 def wait_for_nothing() -> None:
     """Before a verb that needs nothing from the graph to begin (a type was given): no wait."""
-    from course_lib import discovery
+    from course_lib.ros import discovery
 
     discovery.wait_for_discovery(minimum=0.0, quiet=0.0, complete_within=0.0)
 
@@ -230,10 +230,10 @@ def loop_limit(seconds: float | None) -> float | None:
     """How long a wait that the user bounds to ``seconds`` (None: until Ctrl-C) may last.
 
     Live, just ``seconds``. Under the test suite or the grader, also at most
-    course_lib.session.time_limit after the DISCOVERY_BACKSTOP that discovery may take in a new
+    course_lib.ros.session.time_limit after the DISCOVERY_BACKSTOP that discovery may take in a new
     process, so that a ``!ros2 topic hz`` cell cannot hang a notebook run.
     """
-    from course_lib import session
+    from course_lib.ros import session
 
     limit = session.time_limit(seconds)
     return limit + DISCOVERY_BACKSTOP if limit is not None and limit != seconds else limit
@@ -241,7 +241,7 @@ def loop_limit(seconds: float | None) -> float | None:
 
 def wait_until(done: typing.Callable[[], bool], seconds: float | None = None) -> bool:
     """Wait until ``done()`` or ``seconds`` pass (None: until Ctrl-C), within loop_limit."""
-    from course_lib import session
+    from course_lib.ros import session
 
     return session.wait_for(done, timeout=loop_limit(seconds), poll=0.02)
 

@@ -17,7 +17,7 @@ import shutil
 import sys
 from pathlib import Path
 
-from course_lib import rosenv
+from course_lib.ros import rosenv
 
 #: The second line of the script; it tells our ``ros2`` from a real one.
 MARKER = "# ros2 of course_lib (course_lib.ros2cli): the pip install has no ros2cli"

@@ -1,4 +1,4 @@
-"""``ros2 interface show|list|package|packages``, from course_lib.interfaces."""
+"""``ros2 interface show|list|package|packages``, from course_lib.ros.interfaces."""
 
 from __future__ import annotations
 
@@ -33,7 +33,7 @@ def _show_arguments(parser) -> None:
 
 
 def _show(args) -> str | None:
-    from course_lib import interfaces
+    from course_lib.ros import interfaces
 
     name = sys.stdin.readline().strip() if args.type == "-" else args.type
     if not name:
@@ -46,7 +46,7 @@ def _show(args) -> str | None:
 
 
 def _list(args) -> None:
-    from course_lib import interfaces
+    from course_lib.ros import interfaces
 
     for kind, title in _chosen_kinds(args):
         print(f"{title}:")
@@ -61,7 +61,7 @@ def _package_arguments(parser) -> None:
 
 
 def _package(args) -> str | None:
-    from course_lib import ament, interfaces
+    from course_lib.ros import ament, interfaces
 
     if args.package_name not in ament.packages():
         return f"Unknown package '{args.package_name}'"
@@ -72,7 +72,7 @@ def _package(args) -> str | None:
 
 
 def _packages(args) -> None:
-    from course_lib import interfaces
+    from course_lib.ros import interfaces
 
     kinds = [kind for kind, _ in _chosen_kinds(args)]
     for package in interfaces.packages():

@@ -1,4 +1,4 @@
-"""``ros2 node list`` and ``ros2 node info NODE``, printed from course_lib.graph."""
+"""``ros2 node list`` and ``ros2 node info NODE``, printed from course_lib.ros.graph."""
 
 from __future__ import annotations
 
@@ -15,7 +15,7 @@ def _list_arguments(parser) -> None:
 
 
 def _list(args) -> None:
-    from course_lib import graph
+    from course_lib.ros import graph
 
     wait_for_whole_graph(args.spin_time)
     names = graph.node_list(all=args.all)
@@ -36,7 +36,7 @@ def _info_arguments(parser) -> None:
 
 
 def _info(args) -> str | None:
-    from course_lib import graph
+    from course_lib.ros import graph
 
     wait_for_whole_graph(args.spin_time)  # all the node's endpoints, not the first found
     # Like ros2cli: the name as given (a full name), among the nodes --include-hidden shows.

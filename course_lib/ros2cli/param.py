@@ -1,4 +1,4 @@
-"""``ros2 param list|get|set|dump|load``, through course_lib.parameters (the node's services)."""
+"""``ros2 param list|get|set|dump|load``, through course_lib.ros.parameters (the node's services)."""
 
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ NODE_TIMEOUT = 1
 #: Verbs of ros2cli's ``ros2 param`` that the course leaves out.
 LEFT_OUT = ("delete", "describe")
 
-#: How ``ros2 param get`` labels a value, by its type's name in course_lib.parameters.TYPE_NAMES.
+#: How ``ros2 param get`` labels a value, by its type's name in course_lib.ros.parameters.TYPE_NAMES.
 LABELS = {"boolean": "Boolean value is:", "integer": "Integer value is:", "double": "Double value is:",
           "string": "String value is:", "byte array": "Byte values are:",
           "boolean array": "Boolean values are:", "integer array": "Integer values are:",
@@ -39,7 +39,7 @@ def _add_timeout(parser) -> None:
 
 def _find_node(args) -> str | None:
     """The node's full name once it is in the graph (waiting like ros2cli does), else None."""
-    from course_lib import graph
+    from course_lib.ros import graph
 
     name = _absolute(args.node_name)
     shown = wait_for_name(lambda: name in graph.node_list(all=args.include_hidden_nodes), args.spin_time,
@@ -60,7 +60,7 @@ def _list_arguments(parser) -> None:
 
 
 def _list(args) -> str | None:
-    from course_lib import graph, parameters
+    from course_lib.ros import graph, parameters
 
     if args.node_name:
         args.timeout = 0  # ros2cli's param list looks once, after --spin-time
@@ -99,7 +99,7 @@ def _get_arguments(parser) -> None:
 def _get(args) -> str | None:
     from rclpy.parameter import parameter_value_to_python
 
-    from course_lib import parameters
+    from course_lib.ros import parameters
 
     node = _find_node(args)
     if node is None:
@@ -129,7 +129,7 @@ def _set(args) -> str | None:
     from rcl_interfaces.msg import Parameter
     from rclpy.parameter import get_parameter_value
 
-    from course_lib import parameters
+    from course_lib.ros import parameters
 
     node = _find_node(args)
     if node is None:
@@ -152,7 +152,7 @@ def _dump_arguments(parser) -> None:
 
 
 def _dump(args) -> str | None:
-    from course_lib import parameters
+    from course_lib.ros import parameters
 
     node = _find_node(args)
     if node is None:
@@ -171,7 +171,7 @@ def _load_arguments(parser) -> None:
 
 
 def _load(args) -> str | None:
-    from course_lib import parameters
+    from course_lib.ros import parameters
 
     node = _find_node(args)
     if node is None:

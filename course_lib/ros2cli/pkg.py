@@ -1,4 +1,4 @@
-"""``ros2 pkg create|list|executables|prefix``, from course_lib.workspace and course_lib.ament."""
+"""``ros2 pkg create|list|executables|prefix``, from course_lib.ros.workspace and course_lib.ros.ament."""
 
 from __future__ import annotations
 
@@ -42,7 +42,7 @@ def _git_email() -> str:
 
 
 def _create(args) -> str | None:
-    from course_lib import pkg_create
+    from course_lib.ros import pkg_create
 
     if args.build_type != "ament_python":
         default = " (the default)" if args.build_type == "ament_cmake" else ""
@@ -86,7 +86,7 @@ def _create(args) -> str | None:
 # --- ros2 pkg list / executables / prefix ------------------------------------------------
 
 def _list(args) -> None:
-    from course_lib import ament
+    from course_lib.ros import ament
 
     for name in ament.packages():
         print(name)
@@ -98,7 +98,7 @@ def _executables_arguments(parser) -> None:
 
 
 def _executables(args) -> str | None:
-    from course_lib import ament
+    from course_lib.ros import ament
 
     names = [args.package_name] if args.package_name else list(ament.packages())
     if args.package_name and args.package_name not in ament.packages():
@@ -115,7 +115,7 @@ def _prefix_arguments(parser) -> None:
 
 
 def _prefix(args) -> str | None:
-    from course_lib import ament
+    from course_lib.ros import ament
 
     try:
         print(ament.share(args.package_name) if args.share else ament.prefix(args.package_name))

@@ -21,7 +21,7 @@ def main(argv: list[str]) -> int | str:
     parser.add_argument("argv", nargs=argparse.REMAINDER,
                         help="Pass arbitrary arguments to the executable")
     args = parser.parse_args(argv)
-    from course_lib import ament
+    from course_lib.ros import ament
 
     if args.package_name not in ament.packages():
         return f"Package '{args.package_name}' not found"  # ros2run's words

@@ -25,7 +25,7 @@ def service_pairs(include_hidden: bool) -> list[tuple[str, list[str]]]:
     """(name, [type, ...]) of every service in the graph, sorted, as ros2service lists them."""
     from rclpy.topic_or_service_is_hidden import topic_or_service_is_hidden
 
-    from course_lib import session
+    from course_lib.ros import session
 
     pairs = session.tool_node().get_service_names_and_types()
     return sorted((name, list(kinds)) for name, kinds in pairs
@@ -97,7 +97,7 @@ def service_class(type_name: str):
     Raises:
         RuntimeError: in ros2service's words, when the type is not there or not a service.
     """
-    from course_lib import message_yaml
+    from course_lib.ros import message_yaml
 
     try:
         service = message_yaml.message_class(type_name, kind="srv")
@@ -122,7 +122,7 @@ def read_values(text: str, what: str):
 def _call(args) -> str | None:
     import sys
 
-    from course_lib import message_yaml, session
+    from course_lib.ros import message_yaml, session
 
     if args.rate is not None and args.rate <= 0:
         return "rate must be greater than zero"

@@ -1,4 +1,4 @@
-"""``ros2 topic list|echo|hz|bw|delay|info|type|find|pub``, from course_lib.graph and its tool node."""
+"""``ros2 topic list|echo|hz|bw|delay|info|type|find|pub``, from course_lib.ros.graph and its tool node."""
 
 from __future__ import annotations
 
@@ -66,7 +66,7 @@ def _nonnegative_int(text: str) -> int:
 
 def _topic_shown(topic: str):
     """A function telling whether the graph shows ``topic`` (hidden or not) with its type."""
-    from course_lib import graph, session
+    from course_lib.ros import graph, session
 
     name = session.tool_node().resolve_topic_name(topic)
     return lambda: any(other == name for other in graph.topic_list(include_hidden=True))
@@ -88,7 +88,7 @@ def _list_arguments(parser) -> None:
 
 
 def _list(args) -> None:
-    from course_lib import graph
+    from course_lib.ros import graph
 
     wait_for_whole_graph(args.spin_time)
     pairs = graph.topic_list(types=True, include_hidden=args.include_hidden_topics)
@@ -128,7 +128,7 @@ def _echo_arguments(parser) -> None:
 
 
 def _echo(args) -> int | str | None:
-    from course_lib import graph, message_yaml
+    from course_lib.ros import graph, message_yaml
 
     field = None if args.field is None else [part for part in args.field.split(".") if part]
     if field == []:
@@ -181,7 +181,7 @@ def _hz_arguments(parser) -> None:
 def _hz(args) -> None:
     from rclpy.qos import qos_profile_sensor_data
 
-    from course_lib import graph, rates
+    from course_lib.ros import graph, rates
 
     shown = wait_for_name(_topic_shown(args.topic_name), args.spin_time)
     arrivals: list[float] = []
@@ -225,7 +225,7 @@ def _subscribe_for_seconds(args, callback, report, raw: bool, announce: bool) ->
     say "Subscribed to [TOPIC]" first (bw does)."""
     from rclpy.qos import qos_profile_sensor_data
 
-    from course_lib import graph
+    from course_lib.ros import graph
 
     shown = wait_for_name(_topic_shown(args.topic), args.spin_time)
     if not shown:
@@ -280,7 +280,7 @@ def _delay(args) -> str | None:
 
     from rclpy.time import Time
 
-    from course_lib import session
+    from course_lib.ros import session
 
     clock = session.tool_node().get_clock()
     lock = threading.Lock()
@@ -326,7 +326,7 @@ def _type_arguments(parser) -> None:
 
 
 def _type(args) -> int:
-    from course_lib import graph
+    from course_lib.ros import graph
 
     return print_types_of(args.topic_name,
                           lambda: graph.topic_list(types=True, include_hidden=args.include_hidden_topics),
@@ -342,7 +342,7 @@ def _find_arguments(parser) -> None:
 
 
 def _find(args) -> None:
-    from course_lib import graph
+    from course_lib.ros import graph
 
     wait_for_whole_graph(args.spin_time)
     print_names_of_type(graph.topic_list(types=True, include_hidden=args.include_hidden_topics), args.topic_type,
@@ -360,7 +360,7 @@ def _info_arguments(parser) -> None:
 
 
 def _info(args) -> str | None:
-    from course_lib import graph
+    from course_lib.ros import graph
 
     wait_for_whole_graph(args.spin_time)  # counts and endpoints: all of them, not the first found
     if not _topic_shown(args.topic_name)():
@@ -403,7 +403,7 @@ def _pub(args) -> str | None:
     import yaml
     from rclpy.duration import Duration
 
-    from course_lib import message_yaml, session
+    from course_lib.ros import message_yaml, session
 
     times = 1 if args.once else args.times
     wanted = args.wait_matching_subscriptions

@@ -5,7 +5,7 @@ are named before anything is started.
 
 from __future__ import annotations
 
-from course_lib import progress
+from course_lib.notebook import progress
 from course_lib.selfcheck.verdicts import Verdict, _verdict
 
 #: The package and executable of lesson 02's exercise (the brightness assignment asks for the
@@ -35,7 +35,7 @@ def _package_files(ws) -> Verdict | None:
     """The static part of the brightness package check: files, imports against package.xml, the entry point."""
     import ast
 
-    from course_lib import ament, package_files
+    from course_lib.ros import ament, package_files
 
     package_dir = ws / "src" / BRIGHTNESS_PACKAGE
     node_file = package_dir / BRIGHTNESS_PACKAGE / f"{BRIGHTNESS_EXECUTABLE}.py"
@@ -104,7 +104,7 @@ def _entries(scripts: dict[str, str]) -> str:
 
 def _build_state(ws) -> Verdict | None:
     """Is what ros2 run would start built from the current files?"""
-    from course_lib import package_files
+    from course_lib.ros import package_files
 
     install = ws / "install" / BRIGHTNESS_PACKAGE
     build = _BUILD_COMMAND.format(ws=ws)
@@ -212,8 +212,9 @@ def _run_brightness_node(ws) -> Verdict:
     from sensor_msgs.msg import Image
     from std_msgs.msg import UInt8
 
-    from course_lib import images, rosenv, workspace
     from course_lib.checks.probe import RosProbe
+    from course_lib.imaging import images
+    from course_lib.ros import rosenv, workspace
 
     command = (f"ros2 run {BRIGHTNESS_PACKAGE} {BRIGHTNESS_EXECUTABLE} --ros-args -r /image:={CHECK_CAMERA_TOPIC}")
     with rosenv.reserve_domain_id() as reservation, RosProbe(reservation.domain_id) as probe:

@@ -20,7 +20,7 @@ def _parameter_file(path, temp_dir) -> str:
 
     import yaml
 
-    from course_lib import ament
+    from course_lib.ros import ament
 
     path = Path(path)
     if path.is_relative_to(temp_dir):

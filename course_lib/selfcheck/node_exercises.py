@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from itertools import pairwise
 
-from course_lib import progress
+from course_lib.notebook import progress
 from course_lib.selfcheck.verdicts import Verdict, _not_done, _verdict
 
 
@@ -14,7 +14,7 @@ def _exercise_node(node_or_class, class_name: str, hint: str):
     """(node added to the session, None) or (None, a Verdict) for a student's Node class or instance."""
     from rclpy.node import Node
 
-    from course_lib import session
+    from course_lib.ros import session
 
     if (result := _not_done(node_or_class, hint)) is not None:
         return None, result
@@ -79,8 +79,8 @@ def publisher_exercise(node_or_class, topic: str = "/announcements", prefix: str
     the check runs the node until it published three times and listens to it."""
     from std_msgs.msg import String
 
-    from course_lib import session
     from course_lib.checks.context import scaled
+    from course_lib.ros import session
 
     hint = (f"Pass your node class; in __init__ create a publisher of String on {topic.lstrip('/')!r} and a "
             f"timer that calls a method every {_seconds(period)}; the method publishes '{prefix}0', '{prefix}1', ...")
@@ -164,7 +164,7 @@ def subscriber_exercise(node_or_class, msg_type, topic: str = "/ros_tutorial_msg
     messages of its own, marked by negative data, and looks at what the node kept."""
     from rclpy.qos import QoSProfile
 
-    from course_lib import session
+    from course_lib.ros import session
 
     hint = (f"Pass your node class; in __init__ set self.received = [] and subscribe to {topic.lstrip('/')!r}; "
             "the callback appends (stamp in seconds, data) for each message.")

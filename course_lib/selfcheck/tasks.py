@@ -9,7 +9,7 @@ from course_lib.selfcheck.verdicts import Verdict, _call, _not_a_function, _not_
 
 def task1_node_name(answer, expected_node: str = "my_node") -> Verdict:
     """Task 1 (lesson 00): the name of the student's node as `ros2 node list` prints it."""
-    from course_lib import graph
+    from course_lib.ros import graph
 
     hint = "Run graph.node_list() and copy your node's name, exactly as printed, into my_node_name."
     if (result := _not_done(answer, hint)) is not None:
@@ -202,7 +202,7 @@ def _board_views():
     """(name, {marker id: corners}, {picture: corners}) of the board seen upright, turned and in perspective."""
     import numpy as np
 
-    from course_lib import boards, marker_board
+    from course_lib.imaging import boards, marker_board
 
     board = boards.default_board()
     bw, bh = board.size
@@ -227,7 +227,7 @@ def task_picture_corners(function) -> Verdict:
     """Lesson 03: picture_corners_of(markers, picture) takes each framing marker's corner that touches the picture."""
     import numpy as np
 
-    from course_lib import marker_board
+    from course_lib.imaging import marker_board
 
     hint = ("Write picture_corners_of(markers, picture): for each marker of marker_board.PICTURES[picture] (top-left, "
             "top-right, bottom-right, bottom-left), take the one of its four corners that touches the picture, and "

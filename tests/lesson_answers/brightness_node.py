@@ -7,7 +7,7 @@ from rclpy.qos import qos_profile_sensor_data
 from sensor_msgs.msg import Image
 from std_msgs.msg import UInt8
 
-from course_lib import images
+from course_lib.imaging import images
 
 
 def centre_value(frame):

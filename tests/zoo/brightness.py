@@ -177,7 +177,7 @@ def entries(course_dir: str) -> dict[str, dict]:
                                        "        os.fork()\n    " + SUM)], values=0, node=None,
                           reason="average_brightness failed"),
         # 256 MB of output from each of the grader's student processes, 800 times what the grader
-        # keeps of a log (course_lib.bounded_log): neither memory nor disk fills, the answers count.
+        # keeps of a log (course_lib.supervision.bounded_log): neither memory nor disk fills, the answers count.
         "prints_flood": dict(edits=[(SUM, "import sys\n"
                                           "    if 'ipykernel' not in sys.argv[0] "
                                           "and not getattr(average_brightness, 'printed', False):\n"

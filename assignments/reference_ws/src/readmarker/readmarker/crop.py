@@ -1,7 +1,7 @@
 """Crop the cat and dog pictures out of a camera frame: a plain function of numpy arrays.
 
 The marker convention (dictionary, marker ids per picture, which marker corner touches the
-picture, crop corners) is course_lib.marker_board's; this module only applies it:
+picture, crop corners) is course_lib.imaging.marker_board's; this module only applies it:
 
 1. detect the ArUco markers in the frame, and look again, where the board's layout puts them,
    for board markers that merged with a dark picture corner (find_board_markers);

@@ -1,7 +1,7 @@
 """The course webcam as a ROS 2 executable: ``ros2 run webcam image_publisher``.
 
 The node (``image_publisher``, topic ``image``, parameters rate, width, height, source, seed)
-is course_lib.camera.WebcamNode; this module only gives it a package and an entry point.
+is course_lib.imaging.camera.WebcamNode; this module only gives it a package and an entry point.
 """
 
 from course_lib import camera
