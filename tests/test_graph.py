@@ -13,7 +13,7 @@ from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
 from std_msgs.msg import String
 
-from course_lib.ros import discovery, graph, message_yaml, rosenv, session
+from course_lib.ros import discovery, graph, graph_info, message_yaml, rosenv, session
 
 # A talker in another process: a 10 Hz timer publishing "hello N" on /far_chatter.
 FAR_TALKER = """
@@ -292,12 +292,12 @@ def test_topic_info_reports_best_effort_publisher_and_reliable_subscriber(local_
     assert publisher.qos.durability == subscription.qos.durability == "VOLATILE"
     assert publisher.qos.liveliness == "AUTOMATIC"
     assert math.isinf(publisher.qos.deadline)
-    text = graph.format_topic_info(info)
+    text = graph_info.format_topic_info(info)
     assert text.startswith("Type: std_msgs/msg/String\n\nPublisher count: 1\n\nNode name: camera\n")
     assert "Endpoint type: PUBLISHER\n" in text and "Endpoint type: SUBSCRIPTION\n" in text
     assert "  Reliability: BEST_EFFORT\n" in text and "  Reliability: RELIABLE\n" in text
     assert "  Deadline: Infinite\n" in text
-    brief = graph.format_topic_info(graph.topic_info("camera_data", verbose=False), verbose=False)
+    brief = graph_info.format_topic_info(graph.topic_info("camera_data", verbose=False), verbose=False)
     assert brief == "Type: std_msgs/msg/String\nPublisher count: 1\nSubscription count: 1\n"
 
 
@@ -329,7 +329,7 @@ def test_node_info_lists_topics_and_services_like_ros2_node_info(local_session):
     info = graph.node_info("info_talker")
     assert ("/info_chatter", ["std_msgs/msg/String"]) in info.publishers
     assert ("/info_talker/get_parameters", ["rcl_interfaces/srv/GetParameters"]) in info.service_servers
-    text = graph.format_node_info(info)
+    text = graph_info.format_node_info(info)
     assert text.startswith("/info_talker\n  Subscribers:\n\n  Publishers:\n")
     assert "    /info_chatter: std_msgs/msg/String\n" in text
     assert text.endswith("  Action Servers:\n\n  Action Clients:\n\n")

@@ -138,17 +138,6 @@ def test_a_node_in_a_context_of_its_own_is_left_alone(domain_id):
         context.try_shutdown()
 
 
-@pytest.mark.parametrize("args, expected", [
-    (("talker",), "/talker"),
-    (("talker", "robot1"), "/robot1/talker"),
-    (("talker", "/robot1/"), "/robot1/talker"),
-    (("talker", None, ["--ros-args", "-r", "__node:=news", "-r", "__ns:=/r2"]), "/r2/news"),
-    (("talker", None, ["--ros-args", "-r", "talker:__node:=news"]), "/news"),
-])
-def test_expected_name(args, expected):
-    assert session.expected_name(*args) == expected
-
-
 def test_adding_the_same_node_twice_keeps_it(domain_id):
     """add_node() of a node the session already spins returns it and changes nothing."""
     session.start(domain_id=domain_id)

@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import math
 
+from course_lib.ros import node_names
 from course_lib.ros.discovery import _graph_node
-from course_lib.ros.graph import _full_name, _is_hidden, node_list
+from course_lib.ros.graph import node_list
 
 #: Topics every rclpy node has; draw_graph() leaves them out unless asked.
 DEFAULT_HIDDEN_TOPICS = ("/rosout", "/parameter_events")
@@ -26,13 +27,13 @@ def graph_edges(all: bool = False,  # noqa: A002
     node = _graph_node()
     edges = set()
     for topic, _ in node.get_topic_names_and_types():
-        if topic in hide_topics or (not all and _is_hidden(topic)):
+        if topic in hide_topics or (not all and node_names.is_hidden(topic)):
             continue
         for kind, infos in (("publishes", node.get_publishers_info_by_topic(topic)),
                             ("subscribes", node.get_subscriptions_info_by_topic(topic))):
             for info in infos:
                 if all or not info.node_name.startswith("_"):
-                    edges.add((_full_name(info.node_namespace, info.node_name), topic, kind))
+                    edges.add((node_names.full_name(info.node_namespace, info.node_name), topic, kind))
     return sorted(edges)
 
 

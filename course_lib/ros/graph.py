@@ -18,17 +18,16 @@ command, :mod:`course_lib.ros2cli`, prints them):
 Another process's nodes become visible only after discovery (up to a few seconds), so the first
 query after the tool node starts waits, briefly and boundedly, for the graph to settle
 (:mod:`course_lib.ros.discovery`); pass ``wait_for=[...]`` to wait for particular names. Messages are
-printed and filled by :mod:`course_lib.ros.message_yaml`, rates computed by :mod:`course_lib.ros.rates`.
+printed and filled by :mod:`course_lib.ros.message_yaml`, rates computed by :mod:`course_lib.ros.rates`,
+the answers of ``topic_info`` and ``node_info`` are records of :mod:`course_lib.ros.graph_info`.
 """
 
 from __future__ import annotations
 
 import contextlib
-import dataclasses
-import math
 import time
 
-from course_lib.ros import session
+from course_lib.ros import graph_info, node_names, session
 from course_lib.ros.discovery import _graph_node
 from course_lib.ros.message_yaml import message_class
 from course_lib.ros.rates import RateStatistics, rate_statistics
@@ -50,15 +49,6 @@ def _unsubscribe(node, subscription, topic: str, timeout: float = 10.0) -> None:
     _wait_until(lambda: not any(info.node_name == node.get_name()
                                 for info in node.get_subscriptions_info_by_topic(topic)),
                 timeout)
-
-
-def _full_name(namespace: str, name: str) -> str:
-    return namespace.rstrip("/") + "/" + name
-
-
-def _is_hidden(name: str) -> bool:
-    # Like rclpy's topic_or_service_is_hidden: any token of the name that starts with "_".
-    return any(token.startswith("_") for token in name.split("/") if token)
 
 
 # --- ros2 node list / ros2 topic list ----------------------------------------------------
@@ -111,7 +101,7 @@ def topic_list(types: bool = False, include_hidden: bool = False, wait_for=(),
     if wanted:
         _wait_until(lambda: set(wanted) <= {name for name, _ in current()}, timeout)
     pairs = sorted((name, list(kinds)) for name, kinds in current()
-                   if include_hidden or not _is_hidden(name))
+                   if include_hidden or not node_names.is_hidden(name))
     return pairs if types else [name for name, _ in pairs]
 
 
@@ -273,80 +263,18 @@ def topic_hz(topic: str, window: int = 10000, duration: float = 2.0, timeout: fl
     return rate_statistics(list(times), window)
 
 
+#: What a notebook prints the answers of topic_info() and node_info() with, like the CLI:
+#: ``print(graph.format_topic_info(graph.topic_info("/t")))``.
+format_topic_info = graph_info.format_topic_info
+format_node_info = graph_info.format_node_info
+
+
 # --- ros2 topic info -v -----------------------------------------------------------------
-
-@dataclasses.dataclass(frozen=True)
-class QosSummary:
-    """The QoS profile of one endpoint, with policy names as the CLI prints them.
-
-    Durations are in seconds; math.inf means "Infinite". Discovery does not carry the history
-    of another endpoint, so history is often "UNKNOWN" and depth 0 there.
-    """
-
-    reliability: str
-    durability: str
-    history: str
-    depth: int
-    deadline: float
-    lifespan: float
-    liveliness: str
-    liveliness_lease_duration: float
-
-
-@dataclasses.dataclass(frozen=True)
-class Endpoint:
-    """One publisher or subscription of a topic."""
-
-    node_name: str
-    node_namespace: str
-    topic_type: str
-    topic_type_hash: str
-    endpoint_type: str  # "PUBLISHER" or "SUBSCRIPTION"
-    gid: str
-    qos: QosSummary
-
-    @property
-    def node(self) -> str:
-        """The fully-qualified name of the endpoint's node."""
-        return _full_name(self.node_namespace, self.node_name)
-
-
-@dataclasses.dataclass(frozen=True)
-class TopicInfo:
-    """What ``ros2 topic info -v`` shows about a topic."""
-
-    name: str
-    types: list[str]
-    publisher_count: int
-    subscription_count: int
-    publishers: list[Endpoint]
-    subscriptions: list[Endpoint]
-
-
-def _seconds(duration) -> float:
-    from rclpy.duration import Infinite
-
-    return math.inf if duration == Infinite else duration.nanoseconds / 1e9
-
-
-def _endpoint(info) -> Endpoint:
-    qos = info.qos_profile
-    return Endpoint(
-        node_name=info.node_name, node_namespace=info.node_namespace,
-        topic_type=info.topic_type, topic_type_hash=str(info.topic_type_hash),
-        endpoint_type=info.endpoint_type.name,
-        gid=".".join(f"{byte:02x}" for byte in info.endpoint_gid),
-        qos=QosSummary(reliability=qos.reliability.name, durability=qos.durability.name,
-                       history=qos.history.name, depth=int(qos.depth),
-                       deadline=_seconds(qos.deadline), lifespan=_seconds(qos.lifespan),
-                       liveliness=qos.liveliness.name,
-                       liveliness_lease_duration=_seconds(qos.liveliness_lease_duration)))
-
 
 _UNKNOWN_NODE = "_NODE_NAME_UNKNOWN_"
 
 
-def topic_info(topic: str, verbose: bool = True, timeout: float = 2.0) -> TopicInfo:
+def topic_info(topic: str, verbose: bool = True, timeout: float = 2.0) -> graph_info.TopicInfo:
     """The type and endpoints of a topic, like ``ros2 topic info [-v]``.
 
     Args:
@@ -382,11 +310,11 @@ def topic_info(topic: str, verbose: bool = True, timeout: float = 2.0) -> TopicI
 
     _wait_until(named, timeout)
     publishers, subscriptions = endpoints
-    return TopicInfo(
+    return graph_info.TopicInfo(
         name=name, types=list(found[0]), publisher_count=len(publishers),
         subscription_count=len(subscriptions),
-        publishers=[_endpoint(p) for p in publishers] if verbose else [],
-        subscriptions=[_endpoint(s) for s in subscriptions] if verbose else [])
+        publishers=[graph_info.endpoint_of(p) for p in publishers] if verbose else [],
+        subscriptions=[graph_info.endpoint_of(s) for s in subscriptions] if verbose else [])
 
 
 class NoPublisher(LookupError):
@@ -418,64 +346,9 @@ def wait_for_publisher(topic: str, timeout: float = 3.0, hint: str = "") -> int:
                       f"can arrive there.{' ' + hint if hint else ''}")
 
 
-def _format_duration(seconds: float) -> str:
-    return "Infinite" if math.isinf(seconds) else f"{round(seconds * 1e9)} nanoseconds"
-
-
-def format_endpoint(endpoint: Endpoint) -> str:
-    """One endpoint as ``ros2 topic info -v`` prints it."""
-    qos = endpoint.qos
-    history = f"{qos.history} ({qos.depth})" if qos.history == "KEEP_LAST" else qos.history
-    return "\n".join([
-        f"Node name: {endpoint.node_name}",
-        f"Node namespace: {endpoint.node_namespace}",
-        f"Topic type: {endpoint.topic_type}",
-        f"Topic type hash: {endpoint.topic_type_hash}",
-        f"Endpoint type: {endpoint.endpoint_type}",
-        f"GID: {endpoint.gid}",
-        "QoS profile:",
-        f"  Reliability: {qos.reliability}",
-        f"  History (Depth): {history}",
-        f"  Durability: {qos.durability}",
-        f"  Lifespan: {_format_duration(qos.lifespan)}",
-        f"  Deadline: {_format_duration(qos.deadline)}",
-        f"  Liveliness: {qos.liveliness}",
-        f"  Liveliness lease duration: {_format_duration(qos.liveliness_lease_duration)}",
-    ])
-
-
-def format_topic_info(info: TopicInfo, verbose: bool = True) -> str:
-    """A TopicInfo as ``ros2 topic info`` prints it; ``verbose=True`` is ``-v``.
-
-    Like the CLI, the verbose form separates its parts with blank lines and the short form
-    does not.
-    """
-    kinds = info.types[0] if len(info.types) == 1 else str(info.types)
-    parts = [f"Type: {kinds}", f"Publisher count: {info.publisher_count}"]
-    if verbose:
-        parts += [format_endpoint(endpoint) for endpoint in info.publishers]
-    parts.append(f"Subscription count: {info.subscription_count}")
-    if verbose:
-        parts += [format_endpoint(endpoint) for endpoint in info.subscriptions]
-    return ("\n\n" if verbose else "\n").join(parts) + "\n"
-
-
 # --- ros2 node info ---------------------------------------------------------------------
 
-@dataclasses.dataclass(frozen=True)
-class NodeInfo:
-    """What ``ros2 node info`` shows about a node: each list holds (name, [types]) pairs."""
-
-    name: str
-    subscribers: list[tuple[str, list[str]]]
-    publishers: list[tuple[str, list[str]]]
-    service_servers: list[tuple[str, list[str]]]
-    service_clients: list[tuple[str, list[str]]]
-    action_servers: list[tuple[str, list[str]]]
-    action_clients: list[tuple[str, list[str]]]
-
-
-def node_info(name: str, include_hidden: bool = False, timeout: float = 2.0) -> NodeInfo:
+def node_info(name: str, include_hidden: bool = False, timeout: float = 2.0) -> graph_info.NodeInfo:
     """The topics, services and actions of a node, like ``ros2 node info``.
 
     Args:
@@ -498,9 +371,9 @@ def node_info(name: str, include_hidden: bool = False, timeout: float = 2.0) -> 
     node = _graph_node()
 
     def shown(pairs):
-        return [(topic, list(kinds)) for topic, kinds in pairs if include_hidden or not _is_hidden(topic)]
+        return [(topic, list(kinds)) for topic, kinds in pairs if include_hidden or not node_names.is_hidden(topic)]
 
-    return NodeInfo(
+    return graph_info.NodeInfo(
         name=full,
         subscribers=shown(node.get_subscriber_names_and_types_by_node(base, namespace)),
         publishers=shown(node.get_publisher_names_and_types_by_node(base, namespace)),
@@ -508,16 +381,3 @@ def node_info(name: str, include_hidden: bool = False, timeout: float = 2.0) -> 
         service_clients=shown(node.get_client_names_and_types_by_node(base, namespace)),
         action_servers=shown(get_action_server_names_and_types_by_node(node, base, namespace)),
         action_clients=shown(get_action_client_names_and_types_by_node(node, base, namespace)))
-
-
-def format_node_info(info: NodeInfo) -> str:
-    """A NodeInfo as ``ros2 node info`` prints it (an empty section leaves an empty line)."""
-    lines = [info.name]
-    for title, pairs in (("Subscribers", info.subscribers), ("Publishers", info.publishers),
-                         ("Service Servers", info.service_servers),
-                         ("Service Clients", info.service_clients),
-                         ("Action Servers", info.action_servers),
-                         ("Action Clients", info.action_clients)):
-        lines.append(f"  {title}:")
-        lines += [f"    {topic}: {', '.join(kinds)}" for topic, kinds in pairs] or [""]
-    return "\n".join(lines) + "\n"

@@ -47,7 +47,7 @@ import traceback
 from collections.abc import Callable
 
 from course_lib import waiting
-from course_lib.ros import node_logs, rosenv
+from course_lib.ros import node_logs, node_names, rosenv
 
 #: Name of the session's hidden helper node (a leading "_" hides it from node listings).
 TOOL_NODE_NAME = "_course_tools"
@@ -307,7 +307,7 @@ def add_node(node):
                         "create the node first, e.g. session.add_node(MyNode())")
     with _lock:
         state = _running_state()
-        name = _alive_name(node)
+        name = node_names.alive_name(node)
         if node.context is not state.context:
             raise ValueError(f"Node {name} belongs to another ROS context (it was made before "
                              "the session restarted, or with context=...): create it again "
@@ -361,38 +361,11 @@ def _before_node_created(node_name, namespace, context, cli_args) -> None:
             return
         if (context is not None and context is not state.context) or not isinstance(node_name, str):
             return
-        name = expected_name(node_name, namespace, cli_args)
+        name = node_names.expected_name(node_name, namespace, cli_args)
         state.created_at[name] = time.time()
         node_logs.expect(name, state.created_at[name])  # lines stamped from now on are the new node's
         if name in state.nodes:
             _remove(state, name)
-
-
-def expected_name(node_name: str, namespace: str | None = None, cli_args=None) -> str:
-    """The fully-qualified name a node will get: "/ns/name", after ``__node``/``__ns`` remaps.
-
-    Args:
-        node_name: the name passed to Node().
-        namespace: the namespace passed to Node(); None or "" is the root namespace.
-        cli_args: the node's own arguments, e.g. ["--ros-args", "-r", "__ns:=/robot1"].
-    """
-    for arg in map(str, cli_args or ()):  # "-r __node:=x" or "-r talker:__node:=x"
-        if "__node:=" in arg:
-            node_name = arg.split("__node:=", 1)[1]
-        elif "__ns:=" in arg:
-            namespace = arg.split("__ns:=", 1)[1]
-    namespace = "/" + (namespace or "").strip("/")
-    return namespace.rstrip("/") + "/" + node_name
-
-
-def _alive_name(node) -> str:
-    from rclpy.exceptions import InvalidHandle
-
-    try:
-        return node.get_fully_qualified_name()
-    except InvalidHandle:
-        raise ValueError("This node was destroyed (by session.stop(), session.remove_node() or "
-                         "destroy_node()): create it again") from None
 
 
 def _remove(state: _State, name: str) -> None:

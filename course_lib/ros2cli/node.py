@@ -36,7 +36,7 @@ def _info_arguments(parser) -> None:
 
 
 def _info(args) -> str | None:
-    from course_lib.ros import graph
+    from course_lib.ros import graph, graph_info
 
     wait_for_whole_graph(args.spin_time)  # all the node's endpoints, not the first found
     # Like ros2cli: the name as given (a full name), among the nodes --include-hidden shows.
@@ -47,7 +47,7 @@ def _info(args) -> str | None:
     if count > 1:
         print(f'There are {count} nodes in the graph with the exact name "{info.name}". '
               "You are seeing information about only one of them.", file=sys.stderr)
-    print(graph.format_node_info(info), end="")
+    print(graph_info.format_node_info(info), end="")
     return None
 
 

@@ -360,7 +360,7 @@ def _info_arguments(parser) -> None:
 
 
 def _info(args) -> str | None:
-    from course_lib.ros import graph
+    from course_lib.ros import graph, graph_info
 
     wait_for_whole_graph(args.spin_time)  # counts and endpoints: all of them, not the first found
     if not _topic_shown(args.topic_name)():
@@ -368,7 +368,7 @@ def _info(args) -> str | None:
     # The wait is for the endpoints' node names, which DDS may announce a moment after them.
     info = graph.topic_info(args.topic_name, verbose=args.verbose, timeout=args.spin_time + DISCOVERY_BACKSTOP)
     # ros2cli ends every part (the last one too) with a blank line in verbose mode.
-    print(graph.format_topic_info(info, verbose=args.verbose), end="\n" if args.verbose else "")
+    print(graph_info.format_topic_info(info, verbose=args.verbose), end="\n" if args.verbose else "")
     return None
 
 
