@@ -7,19 +7,20 @@ by the notebook's ``%%writefile`` cells). After the notebook ran, the grader bui
 - inside the submission's sandbox and as the student's uid (a ``setup.py`` or ``CMakeLists.txt``
   is the student's code), with a wall time and memory bound (the caller's ``run``);
 - interface packages (``rosidl_generate_interfaces``: ``.msg`` files) are built once per content
-  and kept in a cache folder of the course (:class:`InterfaceCache`, keyed by the hash of the
-  package's files and of this environment), so a class that hands in identical ``.msg`` files
-  costs one CMake build; the workspace's other packages are built on top of the cached install
-  (an underlay, as ``source other_ws/install/setup.bash`` before ``colcon build
+  and kept in a cache folder of the course (:class:`autograder.build_caches.InterfaceCache`, keyed
+  by the hash of the package's files and of this environment), so a class that hands in identical
+  ``.msg`` files costs one CMake build; the workspace's other packages are built on top of the
+  cached install (an underlay, as ``source other_ws/install/setup.bash`` before ``colcon build
   --packages-ignore <interface packages>``);
 - the other packages are built as the assignment's build cell builds them (``colcon build
-  --symlink-install``), and a successful build is kept too (:class:`WorkspaceBuilds`, keyed by
-  :func:`workspace_key`): with ``--symlink-install`` an ament_python build holds links to the
-  package's modules, not copies, so it depends on every file of ``src/`` except the modules'
-  contents (their names count). A class whose package.xml, setup.py and setup.cfg are the
-  release's gets one build; every later identical workspace gets a copy of it, its paths moved to
-  its own folder. (A setup.py that reads its package's modules while building, which ROS packages
-  do not do, would get the build of the first such submission.)
+  --symlink-install``), and a successful build is kept too
+  (:class:`autograder.build_caches.WorkspaceBuilds`, keyed by its ``workspace_key``): with
+  ``--symlink-install`` an ament_python build holds links to the package's modules, not copies,
+  so it depends on every file of ``src/`` except the modules' contents (their names count). A
+  class whose package.xml, setup.py and setup.cfg are the release's gets one build; every later
+  identical workspace gets a copy of it, its paths moved to its own folder. (A setup.py that reads
+  its package's modules while building, which ROS packages do not do, would get the build of the
+  first such submission.)
 
 The outcome is a :class:`BuildReport` (written as JSON for the checks, see
 course_lib.checks.packages): when the build failed, its ``reason`` quotes the first error lines of
@@ -30,26 +31,29 @@ checks of plain functions still grade.
 from __future__ import annotations
 
 import dataclasses
-import functools
-import hashlib
 import json
 import os
 import re
 import shutil
-import sys
 import time
 import xml.etree.ElementTree as ElementTree
 from pathlib import Path
 
+from autograder.build_caches import (
+    InterfaceCache,
+    WorkspaceBuilds,
+    builds_of,
+    cache_of,
+    content_key,
+    local_cache,
+    workspace_key,
+)
 from course_lib import contract
 from course_lib.checks.assignments import ASSIGNMENTS, WORKSPACE
 from course_lib.ros import colcon, package_files, workspace
 
 #: Seconds one colcon build may take (an interface package takes 10-40 s on a busy machine).
 BUILD_SECONDS = 240.0
-
-#: Bumped when the way interface packages are built changes: older cache entries are then unused.
-CACHE_VERSION = "1"
 
 #: Lines that start an error in colcon's, CMake's, the compiler's or setup.py's output.
 _ERROR_LINE = re.compile(r"(CMake Error|error:|Error:|Traceback \(most recent call last\)|SyntaxError|"
@@ -125,163 +129,6 @@ def _depends(folder: Path) -> set[str]:
         return package_files.dependencies(folder / "package.xml")
     except (ElementTree.ParseError, OSError):
         return set()
-
-
-def content_key(folder: Path, underlay_keys=()) -> str:
-    """The cache key of an interface package: its files (names and bytes), the keys of the
-    workspace's interface packages it builds on, this interpreter and CACHE_VERSION."""
-    digest = hashlib.sha256(f"{CACHE_VERSION}\0{sys.version}\0{sys.prefix}\0".encode())
-    for key in underlay_keys:
-        digest.update(key.encode() + b"\0")
-    for path in sorted(p for p in folder.rglob("*") if p.is_file()):
-        digest.update(str(path.relative_to(folder)).encode() + b"\0" + path.read_bytes() + b"\0")
-    return digest.hexdigest()[:32]
-
-
-# ---- the cache ---------------------------------------------------------------------------------
-
-class InterfaceCache:
-    """Built interface packages, one folder per content key: ``<root>/<key>/install/`` (a colcon
-    install prefix). Written by the grader (root) only; entries appear atomically. Failed builds
-    are not kept (see _build_interface); store(key, None, reason) records one all the same."""
-
-    def __init__(self, root: Path):
-        self.root = Path(root)
-
-    def entry(self, key: str) -> Path:
-        return self.root / key
-
-    def lookup(self, key: str) -> tuple[Path | None, str | None]:
-        """(install prefix, None) when built, (None, reason) when it failed, (None, None) when new."""
-        entry = self.entry(key)
-        if (entry / "install" / "setup.bash").is_file():
-            return entry / "install", None
-        if (entry / "failed.txt").is_file():
-            return None, (entry / "failed.txt").read_text()
-        return None, None
-
-    def store(self, key: str, install: Path | None, reason: str = "") -> None:
-        def fill(staging: Path) -> None:
-            if install is not None:
-                shutil.copytree(install, staging / "install", symlinks=True)
-            else:
-                (staging / "failed.txt").write_text(reason)
-        _store_atomically(self.entry(key), fill)
-
-
-def _store_atomically(entry: Path, fill) -> None:
-    """Make the folder `entry` appear whole: `fill(folder)` fills a staging folder beside it,
-    which is then renamed; when another worker stored the same entry meanwhile, theirs stays."""
-    entry.parent.mkdir(parents=True, exist_ok=True)
-    staging = entry.parent / f".{entry.name}.{os.getpid()}.{time.monotonic_ns()}"
-    staging.mkdir()
-    try:
-        fill(staging)
-        os.rename(staging, entry)
-    except OSError:
-        shutil.rmtree(staging, ignore_errors=True)
-
-
-#: Set to 0 to build every workspace with colcon even when an identical one was built before.
-#: What colcon and setuptools make of a workspace depends on their versions too.
-_BUILD_TOOLS = ("colcon-core", "colcon-ros", "colcon-python-setup-py", "setuptools")
-
-
-def workspace_key(src: Path, interface_keys=()) -> str:
-    """The key of a workspace's ``colcon build --symlink-install``: the names of every file of
-    `src` and the bytes of all but the Python modules (setup.py's count), the keys of the
-    interface packages it builds on, this interpreter, the build tools' versions and
-    CACHE_VERSION."""
-    digest = hashlib.sha256(f"{CACHE_VERSION}\0{sys.version}\0{sys.prefix}\0{_build_tool_versions()}\0".encode())
-    for key in interface_keys:
-        digest.update(key.encode() + b"\0")
-    for path in sorted(p for p in Path(src).rglob("*") if p.is_file() or p.is_symlink()):
-        relative = path.relative_to(src)
-        if any(part in ("__pycache__", ".ipynb_checkpoints") for part in relative.parts):
-            continue
-        digest.update(str(relative).encode() + b"\0")
-        if path.is_symlink():
-            digest.update(b"link " + os.readlink(path).encode() + b"\0")
-        elif path.suffix != ".py" or path.name == "setup.py":
-            digest.update(path.read_bytes() + b"\0")
-    return digest.hexdigest()[:32]
-
-
-@functools.cache
-def _build_tool_versions() -> str:
-    """"colcon-core=0.x ..." of _BUILD_TOOLS (looked up once: it reads the venv's metadata)."""
-    from importlib import metadata
-
-    versions = []
-    for tool in _BUILD_TOOLS:
-        try:
-            versions.append(f"{tool}={metadata.version(tool)}")
-        except metadata.PackageNotFoundError:
-            versions.append(f"{tool}=none")
-    return " ".join(versions)
-
-
-class WorkspaceBuilds:
-    """Successful workspace builds (``build/`` and ``install/``), one folder per workspace_key,
-    with the folders they were built in (``paths.json``): a copy of one, those paths replaced by
-    another workspace's in every file and link, is what colcon would have built there. Written
-    by the grader only, from builds no other code of the student's uid ran beside (see
-    build_for_checks)."""
-
-    def __init__(self, root: Path):
-        self.root = Path(root)
-
-    def entry(self, key: str) -> Path:
-        return self.root / key
-
-    def restore(self, key: str, ws: Path, scratch: Path) -> bool:
-        """Copy the build of `key` into `ws` (which has neither build/ nor install/) for a build
-        whose scratch folder is `scratch`; False when there is none."""
-        entry = self.entry(key)
-        try:
-            paths = json.loads((entry / "paths.json").read_text())
-        except (OSError, ValueError):
-            return False
-        moves = sorted({paths["workspace"]: str(ws), paths["scratch"]: str(scratch)}.items(),
-                       key=lambda move: -len(move[0]))
-        for folder in ("build", "install"):
-            shutil.copytree(entry / folder, Path(ws) / folder, symlinks=True)
-            _relocate(Path(ws) / folder, moves)
-        return True
-
-    def store(self, key: str, ws: Path, scratch: Path) -> None:
-        def fill(staging: Path) -> None:
-            for folder in ("build", "install"):
-                shutil.copytree(Path(ws) / folder, staging / folder, symlinks=True)
-            (staging / "paths.json").write_text(json.dumps({"workspace": str(ws), "scratch": str(scratch)}))
-        _store_atomically(self.entry(key), fill)
-
-
-def _relocate(tree: Path, moves: list[tuple[str, str]]) -> None:
-    """Replace the old paths of `moves` by the new ones in every link target and file of `tree`."""
-    encoded = [(old.encode(), new.encode()) for old, new in moves]
-
-    def moved(data: bytes) -> bytes:
-        for old, new in encoded:
-            data = data.replace(old, new)
-        return data
-
-    for directory, dirs, files in os.walk(os.fsencode(tree)):
-        for name in [*files, *dirs]:
-            path = os.path.join(directory, name)
-            if os.path.islink(path):
-                target = os.readlink(path)
-                new_target = moved(target)
-                if new_target != target:
-                    os.unlink(path)
-                    os.symlink(new_target, path)
-            elif name in files:
-                with open(path, "rb") as handle:
-                    data = handle.read()
-                new_data = moved(data)
-                if new_data != data:
-                    with open(path, "wb") as handle:
-                        handle.write(new_data)
 
 
 # ---- building ----------------------------------------------------------------------------------
@@ -469,16 +316,6 @@ def _in_dependency_order(interfaces: dict[str, Path]) -> list[str]:
 _SANDBOX_VARIABLES = (contract.EXPOSE_ENV, contract.BLOCKED_ENV, contract.STAGE_ENV)
 
 
-def cache_of(course: Path) -> InterfaceCache:
-    """The course's cache of built interface packages: COURSE_DIR/autograder/.interface-cache."""
-    return InterfaceCache(Path(course) / "autograder" / ".interface-cache")
-
-
-def builds_of(course: Path) -> WorkspaceBuilds:
-    """The course's kept workspace builds: COURSE_DIR/autograder/.workspace-builds."""
-    return WorkspaceBuilds(Path(course) / "autograder" / ".workspace-builds")
-
-
 def build_for_checks(assignment: str, course: Path, work: Path, workdir: Path, uid: int | None, domain_id: int,
                      grader_env: dict, hide: list[Path], run_sandboxed,
                      seconds: float = BUILD_SECONDS, prefix: str = "", store: bool = True) -> tuple[dict, float]:
@@ -597,13 +434,6 @@ def reference_interfaces(assignment: str, cache: InterfaceCache, scratch: Path) 
             shutil.copytree(install, copy, symlinks=True)
         found.append(copy)
     return found
-
-
-def local_cache() -> InterfaceCache:
-    """A cache of interface builds for runs outside a course (tests, benchmarks, record-answers)."""
-    import tempfile
-
-    return InterfaceCache(Path(tempfile.gettempdir()) / f"ros2cv-interface-cache-{os.getuid()}")
 
 
 def build_here(assignment: str, workdir: Path, cache: InterfaceCache | None = None) -> BuildReport:

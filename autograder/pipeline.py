@@ -24,7 +24,7 @@ are listed in :data:`STEPS`):
    built and checked while nbgrader runs the notebook, from the files the notebook is predicted
    to write, as a uid of its own (the worker's + EARLY_UID_OFFSET: the kernel cannot reach those
    files; autograder.early_checks); when it wrote other files, again after it, from those. A
-   build of an identical workspace is copied instead (autograder.packages.WorkspaceBuilds).
+   build of an identical workspace is copied instead (autograder.build_caches.WorkspaceBuilds).
 5. The trusted grader reads the other cells' scores from the private gradebook, copies the
    autograded notebook to COURSE_DIR/autograded/ (without the grader's temporary paths), and
    records the scores in the course gradebook as nbgrader's autograde would (autograder.gradebook:

@@ -24,7 +24,7 @@ class GradeResult:
     # The build and checks run while the notebook ran (autograder.early_checks): True when they
     # counted, False when the notebook wrote other files and they ran again, None when not tried.
     checked_early: bool | None = None
-    # The workspace build of an identical workspace was copied (autograder.packages.WorkspaceBuilds).
+    # The workspace build of an identical workspace was copied (autograder.build_caches.WorkspaceBuilds).
     build_reused: bool = False
 
     @classmethod

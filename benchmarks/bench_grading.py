@@ -40,7 +40,7 @@ sys.path[:0] = [str(ROOT), str(ROOT / "tests")]  # the grader runs from the repo
 
 import zoo  # noqa: E402 (tests/zoo builds submissions from the reference solutions)
 
-from autograder import grading, packages, pipeline, release, sandbox  # noqa: E402
+from autograder import build_caches, grading, pipeline, release, sandbox  # noqa: E402
 from course_lib import contract  # noqa: E402
 from course_lib.checks import assignments  # noqa: E402
 
@@ -68,8 +68,8 @@ def main(argv=None) -> int:
         for index in range(args.students):
             for assignment in ASSIGNMENTS:
                 zoo.submit(course, f"student{index}", assignment)
-        shutil.rmtree(packages.cache_of(course).root, ignore_errors=True)
-        shutil.rmtree(packages.builds_of(course).root, ignore_errors=True)
+        shutil.rmtree(build_caches.cache_of(course).root, ignore_errors=True)
+        shutil.rmtree(build_caches.builds_of(course).root, ignore_errors=True)
         runs = {"cold": timed_grade(course, 1), "sequential": timed_grade(course, 1, early=False, reuse=False),
                 "built": timed_grade(course, 1, reuse=False), "early": timed_grade(course, 1),
                 "workers": timed_grade(course, args.workers)}

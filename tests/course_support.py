@@ -6,7 +6,7 @@ once per test module.
   the others taken out again (their release/ folder and their gradebook entry), which leaves what
   a release of just those assignments leaves.
 - The reference interface packages (a CMake build each, 20-30 s of CPU) are built once into the
-  interface cache of tests and benchmarks (autograder.packages.local_cache) and copied into each
+  interface cache of tests and benchmarks (autograder.build_caches.local_cache) and copied into each
   course's own cache (COURSE_DIR/autograder/.interface-cache), where the grader finds them as if
   an earlier submission had built them: a submission with the reference .msg files then builds
   only its own packages. Courses of the same test run share nothing else.
@@ -90,11 +90,11 @@ def seed_lab_exchange(tmp_path_factory, lab_root: Path) -> None:
 
 def seed_interface_cache(tmp_path_factory, course: Path, assignments: list[str]) -> None:
     """Put the assignments' reference interface packages, built once, into COURSE's interface cache."""
-    from autograder import packages
+    from autograder import build_caches, packages
     from autograder.reference import REFERENCE_SRC
 
     shared = shared_folder(tmp_path_factory)
-    cache, target = packages.local_cache(), packages.cache_of(course)
+    cache, target = build_caches.local_cache(), build_caches.cache_of(course)
     with _locked(shared / "interface-cache.lock"):
         for assignment in assignments:
             packages.reference_interfaces(assignment, cache, shared / "interface-scratch")
@@ -102,6 +102,6 @@ def seed_interface_cache(tmp_path_factory, course: Path, assignments: list[str])
         for name in specs.spec(assignment).packages:
             folder = REFERENCE_SRC / name
             if packages.is_interface_package(folder):
-                key = packages.content_key(folder)
+                key = build_caches.content_key(folder)
                 if not target.entry(key).exists():
                     shutil.copytree(cache.entry(key), target.entry(key), symlinks=True)

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from autograder import packages
+from autograder import build_caches, packages
 
 MSG = "builtin_interfaces/Time stamp\nint32 data\n"
 
@@ -53,7 +53,7 @@ class FakeColcon:
 def test_identical_interface_packages_are_built_once(tmp_path):
     """Two workspaces with byte-identical .msg packages: one interface build; each workspace's other
     packages are built with the interface package skipped (an underlay)."""
-    cache = packages.InterfaceCache(tmp_path / "cache")
+    cache = build_caches.InterfaceCache(tmp_path / "cache")
     colcon = FakeColcon()
     reports = []
     for student in ("alice", "bob"):
@@ -74,7 +74,7 @@ def test_identical_interface_packages_are_built_once(tmp_path):
 def test_a_build_that_is_not_kept_leaves_the_cache_alone(tmp_path):
     """store=False (a kernel of the same uid ran beside the build): the new interface package
     serves this workspace, from its scratch folder, and the cache stays empty."""
-    cache = packages.InterfaceCache(tmp_path / "cache")
+    cache = build_caches.InterfaceCache(tmp_path / "cache")
     ws = tmp_path / "ros2_ws"
     write_interface(ws)
     write_python_package(ws)
@@ -87,13 +87,13 @@ def test_a_changed_message_is_built_again(tmp_path):
     """One byte more in a .msg file is another cache key."""
     a, b = write_interface(tmp_path / "a"), write_interface(tmp_path / "b", msg=MSG + "int32 extra\n")
     same = write_interface(tmp_path / "c")
-    assert packages.content_key(a) == packages.content_key(same) != packages.content_key(b)
+    assert build_caches.content_key(a) == build_caches.content_key(same) != build_caches.content_key(b)
 
 
 def test_a_failed_interface_build_gives_its_first_error_lines_and_is_not_cached(tmp_path):
     """A CMake error: the reason quotes it from its first line, the workspace's other packages are
     not built, and an identical package later is built again (a failure may be the machine's)."""
-    cache = packages.InterfaceCache(tmp_path / "cache")
+    cache = build_caches.InterfaceCache(tmp_path / "cache")
     output = ("Starting >>> tutorial_interfaces\n-- Found ament_cmake\n"
               "CMake Error at CMakeLists.txt:2 (rosidl_generate_interfaces):\n  Unknown type 'float96'\n"
               "Failed   <<< tutorial_interfaces [2s, exited with code 1]\n")
@@ -117,13 +117,13 @@ def test_a_failed_python_package_names_the_package_and_the_error(tmp_path):
     output = ("Starting >>> pubsub\n--- stderr: pubsub\n  File \"setup.py\", line 3\n"
               "SyntaxError: '(' was never closed\n---\nFailed   <<< pubsub [0.5s, exited with code 1]\n")
     colcon = FakeColcon(fail={"ros2_ws": output})
-    report = packages.build_workspace(ws, packages.InterfaceCache(tmp_path / "cache"), tmp_path, colcon)
+    report = packages.build_workspace(ws, build_caches.InterfaceCache(tmp_path / "cache"), tmp_path, colcon)
     assert not report.ok
     assert "in package 'pubsub'" in report.reason and "SyntaxError: '(' was never closed" in report.reason
 
 
 def test_no_workspace_says_which_cells_write_it(tmp_path):
-    report = packages.build_workspace(tmp_path / "ros2_ws", packages.InterfaceCache(tmp_path / "c"), tmp_path,
+    report = packages.build_workspace(tmp_path / "ros2_ws", build_caches.InterfaceCache(tmp_path / "c"), tmp_path,
                                       FakeColcon())
     assert not report.ok and "%%writefile ros2_ws/src/" in report.reason
 
