@@ -1,8 +1,8 @@
 """nbgrader's student side in JupyterLab, driven as a student drives it: the notebook's Validate
 button (``validate``: press it, read the dialog) and the Nbgrader > Assignment List panel
 (``open_assignment_list``, ``assignment_lists``, ``chosen_course``, ``wait_for_assignment``), and the kernels a
-server runs (``kernel_processes``, ``kernels_left``: what a Validate leaves behind). The server, the
-browser and the notebook UI are browser_support's.
+server runs (``kernel_processes``, ``kernels_left``: what a Validate leaves behind). The server and the
+browser are browser_support's, the notebook UI is browser_notebook's.
 """
 
 from __future__ import annotations
@@ -13,7 +13,8 @@ import time
 from pathlib import Path
 
 import psutil
-from browser_support import NOTEBOOK, JupyterLab, click_menu, click_toolbar_button
+from browser_notebook import NOTEBOOK, click_menu, click_toolbar_button
+from browser_support import JupyterLab
 
 # nbgrader's lab extension answers every press of Validate with a dialog of one of these classes,
 # titled "Validation Results" when validation ran (success, failed or changed cells, or the error

@@ -4,14 +4,14 @@ One JupyterLab server and one headless Chromium serve the whole module. The serv
 scratch directory holding a copy of notebooks/ (outputs never reach the repository) and the
 checker's own small notebooks, which prove that the checker passes a good notebook and fails
 one that raises. Screenshots go to artifacts/browser/<notebook>.png. The lessons that build
-packages run in tests/test_browser_lessons.py, beside this file (browser_support.SECOND_LAB_LESSONS).
+packages run in tests/test_browser_lessons.py, beside this file (browser_notebook.SECOND_LAB_LESSONS).
 """
 
 import json
 from pathlib import Path
 
 import pytest
-from browser_support import (
+from browser_notebook import (
     LESSON_RUN_TIMEOUT,
     NOTEBOOK,
     SCREENSHOTS,
@@ -24,10 +24,10 @@ from browser_support import (
     open_notebook,
     run_in_lab,
     run_notebook,
-    running_jupyterlab,
     toolbar_labels,
     write_notebook,
 )
+from browser_support import running_jupyterlab
 
 ROOT = Path(__file__).resolve().parents[1]
 NOTEBOOKS = ROOT / "notebooks"

@@ -2,17 +2,12 @@
 
 The same test as tests/test_browser.py runs for the other lessons, in a JupyterLab and a
 Chromium of this module's own, so that under `--dist loadfile` the two halves of the lessons
-run on two workers at once (browser_support.SECOND_LAB_LESSONS says which lessons are here).
+run on two workers at once (browser_notebook.SECOND_LAB_LESSONS says which lessons are here).
 """
 
 import pytest
-from browser_support import (
-    LESSON_RUN_TIMEOUT,
-    assert_lesson_runs_clean,
-    copy_lessons,
-    course_lessons,
-    running_jupyterlab,
-)
+from browser_notebook import LESSON_RUN_TIMEOUT, assert_lesson_runs_clean, copy_lessons, course_lessons
+from browser_support import running_jupyterlab
 
 pytestmark = pytest.mark.browser
 
@@ -29,7 +24,7 @@ def lab(tmp_path_factory):
 
 @pytest.mark.timeout(LESSON_RUN_TIMEOUT + 180)
 @pytest.mark.parametrize("notebook", course_lessons(second_lab=True) or [
-    pytest.param(None, marks=pytest.mark.skip(reason="none of browser_support.SECOND_LAB_LESSONS is in notebooks/"))])
+    pytest.param(None, marks=pytest.mark.skip(reason="none of browser_notebook.SECOND_LAB_LESSONS is in notebooks/"))])
 def test_course_notebook_runs_clean_in_jupyterlab(notebook, browser, lab):
     """After Run All Cells every code cell has run, none shows an error, every image renders."""
     assert_lesson_runs_clean(browser, lab, notebook)

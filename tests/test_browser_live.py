@@ -8,15 +8,8 @@ the widget's picture. Screenshots go to artifacts/browser/live_image_view-<n>.pn
 from pathlib import Path
 
 import pytest
-from browser_support import (
-    NOTEBOOK,
-    close_notebook,
-    code_cell_count,
-    open_notebook,
-    run_notebook,
-    running_jupyterlab,
-    write_notebook,
-)
+from browser_notebook import NOTEBOOK, close_notebook, code_cell_count, open_notebook, run_notebook, write_notebook
+from browser_support import running_jupyterlab
 
 SCREENSHOTS = Path(__file__).resolve().parents[1] / "artifacts" / "browser"
 CAMERA_SIZE = (320, 240)

@@ -28,7 +28,8 @@ from browser_nbgrader import (
     validate,
     wait_for_assignment,
 )
-from browser_support import close_notebook, open_notebook, running_jupyterlab
+from browser_notebook import close_notebook, open_notebook
+from browser_support import running_jupyterlab
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 

@@ -32,7 +32,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import zoo  # noqa: E402
 from browser_nbgrader import wait_for_assignment  # noqa: E402
-from browser_support import CHROMIUM_ARGS, VIEWPORT, ChromiumUnavailable, click_menu, find_chromium  # noqa: E402
+from browser_notebook import click_menu  # noqa: E402
+from browser_support import CHROMIUM_ARGS, VIEWPORT, ChromiumUnavailable, find_chromium  # noqa: E402
 from hub_support import (  # noqa: E402  # noqa: E402
     course_processes,
     grading_service,
