@@ -2,6 +2,7 @@
 
 - ``course_lib.checks.<assignment>``: the checks of one assignment (``brightness``, ``pubsub``,
   ``catdog_warp``). A notebook imports one as ``checks`` and calls ``checks.selfcheck("values")``.
+  ``brightness_throughput``: the brightness node's throughput, judged against a yardstick node.
 - ``registry`` (what a check is), ``runner`` (how it runs: its own process, ``check_process``),
   ``context`` (what a check gets), ``student_server``/``student_calls``/``student_processes`` (the
   student's code in another process, one per module serving many calls), ``probe`` (the checker's

@@ -1,7 +1,7 @@
-"""The brightness node check's throughput verdict (course_lib.checks.brightness.throughput_verdict):
+"""The brightness node check's throughput verdict (course_lib.checks.brightness_throughput.throughput_verdict):
 processor time per frame against the yardstick's, never answers per second."""
 
-from course_lib.checks.brightness import (
+from course_lib.checks.brightness_throughput import (
     THROUGHPUT_CPU_RATIO,
     THROUGHPUT_MIN_ANSWERS,
     THROUGHPUT_MIN_EVIDENCE_CPU,
