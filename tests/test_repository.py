@@ -2,13 +2,21 @@
 course's packages import each other without cycles."""
 
 import ast
+import functools
 import json
+import re
 import subprocess
 from pathlib import Path
 
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
+
+
+@functools.cache
+def syntax(path: Path) -> ast.Module:
+    """The parsed file (parsed once for all the tests here)."""
+    return ast.parse(path.read_text())
 
 
 def tracked(*patterns):
@@ -56,7 +64,7 @@ def module_imports() -> dict[str, set[str]]:
     for name, path in files.items():
         here = name.split(".") if path.name == "__init__.py" else name.split(".")[:-1]
         found = set()
-        for node in ast.walk(ast.parse(path.read_text())):
+        for node in ast.walk(syntax(path)):
             if isinstance(node, ast.Import):
                 found |= {alias.name for alias in node.names}
             elif isinstance(node, ast.ImportFrom):
@@ -97,4 +105,72 @@ def test_no_import_cycles():
     part can be read, tested and moved on its own (a parser registers with the actions instead)."""
     graph = module_imports()
     assert "course_lib.contract" in graph["course_lib.checks.answers"]
+    assert {"course_lib.ros.graph_info", "course_lib.ros.node_names"} <= graph["course_lib.ros.graph"]
+    assert "course_lib.supervision.bounded_log" in graph["course_lib.supervision.supervisor"]
     assert import_cycle(graph) is None, " -> ".join(import_cycle(graph))
+
+
+# --- each file does one job ----------------------------------------------------------------------
+
+def course_sources():
+    roots = (*PACKAGES, "tests", "benchmarks")
+    return [path for path in tracked("*.py") if path.relative_to(ROOT).parts[0] in roots]
+
+
+def opens_with_a_docstring(text: str) -> bool:
+    """Whether the first statement is a string (after blank and comment lines), without parsing."""
+    lines = (line.strip() for line in text.splitlines())
+    first = next((line for line in lines if line and not line.startswith("#")), "")
+    return first.lstrip("rRuU").startswith(('"""', "'''", '"', "'"))
+
+
+def test_each_source_file_opens_with_a_docstring():
+    """A file's first lines say its job (STYLE.md), so that a reader finds the file of a job."""
+    assert not opens_with_a_docstring("import os\n") and opens_with_a_docstring('#!/bin/python\n"""Job."""\n')
+    silent = [str(path.relative_to(ROOT)) for path in course_sources()
+              if not opens_with_a_docstring(path.read_text())]
+    assert not silent, f"say in a docstring at the top what each of these files does: {silent}"
+
+
+def test_no_source_file_is_over_500_lines():
+    """Past 500 lines a file does several jobs: split it by job (not in halves)."""
+    long = {str(path.relative_to(ROOT)): lines for path in course_sources()
+            if (lines := len(path.read_text().splitlines())) > 500}
+    assert not long, f"split these files by job: {long}"
+
+
+# --- short names are for notebooks ----------------------------------------------------------------
+
+def test_the_course_imports_modules_by_their_place_not_their_short_name():
+    """``from course_lib import session`` is the notebooks' and students' way (course_lib.SHORT_NAMES);
+    the course's own code names the module's place (``from course_lib.ros import session``), so
+    that the import graph above is the real one."""
+    import course_lib
+
+    moved = {name for name, place in course_lib.SHORT_NAMES.items() if place != name}
+    candidate = re.compile(rf"from course_lib import ([^\n]*\b({'|'.join(moved)})\b|\()")
+    found = []
+    # The reference solutions (assignments/reference_ws) are what a student writes: short names.
+    for path in course_sources() + [p for p in tracked("assignments/*.py") if "reference_ws" not in p.parts]:
+        if not candidate.search(path.read_text()):
+            continue  # parsing every file would cost a second
+        for node in ast.walk(syntax(path)):
+            if isinstance(node, ast.ImportFrom) and node.module == "course_lib" and not node.level:
+                found += [f"{path.relative_to(ROOT)}:{node.lineno} {alias.name}" for alias in node.names
+                          if alias.name in moved]
+    assert not found, f"import these from their subpackage (course_lib.SHORT_NAMES says which): {found}"
+
+
+def test_every_short_name_is_a_module_of_course_lib():
+    """Each short name leads to a module (found, not imported: importing them all costs seconds);
+    ``vision`` is the drawing module, not a package of that name."""
+    import importlib.util
+
+    import course_lib
+
+    missing = [name for name, place in course_lib.SHORT_NAMES.items()
+               if importlib.util.find_spec(f"course_lib.{place}") is None]
+    assert not missing, missing
+    from course_lib.imaging import drawing  # course_lib.imaging is imported first, as in a lesson
+
+    assert course_lib.vision is drawing
