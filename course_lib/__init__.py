@@ -31,8 +31,8 @@ SHORT_NAMES = {
     **{name: f"imaging.{name}" for name in (
         "boards", "camera", "camera_views", "images", "marker_board", "photos", "pictures", "scenes", "table")},
     "vision": "imaging.drawing",
-    **{name: f"notebook.{name}" for name in ("doctor", "live", "progress", "rqt_graph", "student_lab")},
-    **{name: name for name in ("launch", "selfcheck", "waiting")},
+    **{name: f"notebook.{name}" for name in ("doctor", "live", "rqt_graph", "student_lab")},
+    **{name: name for name in ("launch", "progress", "selfcheck", "waiting")},
 }
 
 

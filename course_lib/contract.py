@@ -9,15 +9,27 @@ student's package holds this module, and the answer keys stay on the instructor'
 
 from __future__ import annotations
 
+import os
+
 #: nbgrader's course id: the course's assignments in an exchange, on a hub and in a student's lab alike.
 COURSE_ID = "ros2-jazzy-opencv"
 
 # --- who runs: grading, the test suite ---------------------------------------------------------
 
-#: "1" in every process of a grading run (course_lib.ros.rosenv.under_grading).
+#: "1" in every process of a grading run (under_grading).
 GRADING_ENV = "COURSE_LIB_GRADING"
 #: "1" under the test suite and CI's notebook runs: loops that would run for ever live are bounded.
 UNDER_TEST_ENV = "COURSE_LIB_UNDER_TEST"
+
+
+def under_grading() -> bool:
+    """True while the autograder runs a submission (a separate flag from under_test on purpose)."""
+    return os.environ.get(GRADING_ENV, "") not in ("", "0")
+
+
+def under_test() -> bool:
+    """True under the test suite or CI notebook runs: bound loops that would run forever live."""
+    return os.environ.get(UNDER_TEST_ENV, "") not in ("", "0")
 
 # --- seeds --------------------------------------------------------------------------------------
 

@@ -46,14 +46,14 @@ CHECKER_NOTEBOOKS = {
     "broken_image.ipynb": ["from IPython.display import Image\nImage(data=b'these bytes are no PNG', format='png')"],
 }
 
-# A long call in a cell: it waits until the test makes the file `go` (course_lib.notebook.progress's line).
+# A long call in a cell: it waits until the test makes the file `go` (course_lib.progress's line).
 PROGRESS_NOTEBOOK = ["""from pathlib import Path
 from course_lib import progress, waiting
 with progress.Progress("waiting for the test") as shown:
     shown.step("until the file go exists")
     waiting.spin_until(lambda: Path("go").exists(), timeout=600)"""]
 
-# What the lessons' long calls leave under their cells (course_lib.notebook.progress): the build of lesson
+# What the lessons' long calls leave under their cells (course_lib.progress): the build of lesson
 # 00 and the publisher self-check of lesson 01 said what ran while it ran.
 PROGRESS_LINES = {"00_setup_and_workspace.ipynb": "colcon build in ros2_ws: finished after ",
                   "01_publisher_subscriber.ipynb": "self-check: running your publisher: finished after "}
@@ -132,7 +132,7 @@ _RUNNING_OUTPUT_JS = """([notebook, text]) => {
 
 @pytest.mark.timeout(RUN_TIMEOUT)
 def test_a_long_call_shows_what_it_does_and_for_how_long_while_the_cell_runs(browser, lab):
-    """course_lib.notebook.progress: the line is under the cell while the cell still runs, its seconds count
+    """course_lib.progress: the line is under the cell while the cell still runs, its seconds count
     up, and when the call ends it says how long it took."""
     path = "checker/progress.ipynb"
     running = "⏳ waiting for the test … until the file go exists ("

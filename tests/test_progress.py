@@ -1,11 +1,11 @@
-"""Tests for course_lib.notebook.progress outside a kernel (tests/test_browser.py watches the line in
+"""Tests for course_lib.progress outside a kernel (tests/test_browser.py watches the line in
 JupyterLab while a cell runs, and the lessons' build and self-check leave theirs)."""
 
 import threading
 
 import pytest
 
-from course_lib.notebook import progress
+from course_lib import progress
 
 
 def test_outside_a_kernel_progress_shows_nothing_and_starts_no_thread(capsys):

@@ -110,6 +110,31 @@ def test_no_import_cycles():
     assert import_cycle(graph) is None, " -> ".join(import_cycle(graph))
 
 
+def package_imports(graph: dict[str, set[str]], package: str = "course_lib") -> dict[str, set[str]]:
+    """The module graph folded to `package`'s parts: each subpackage one node (course_lib.ros), each
+    module at its top one node (course_lib.contract)."""
+    def part(module):
+        return ".".join(module.split(".")[:2])
+    folded = {}
+    for module, imported in graph.items():
+        if module.startswith(f"{package}."):
+            folded.setdefault(part(module), set()).update(
+                part(other) for other in imported if other.startswith(f"{package}.") and part(other) != part(module))
+    return folded
+
+
+def test_course_lib_packages_depend_on_each_other_in_one_direction():
+    """Its parts by job (ros, supervision, imaging, notebook, checks, ...) import each other without
+    a cycle: supervision needs no ROS, ros shows no notebook UI; what every part uses (contract,
+    waiting, progress) sits at the top and imports none of them."""
+    folded = package_imports(module_imports())
+    assert {"course_lib.ros", "course_lib.supervision", "course_lib.notebook"} <= set(folded)
+    assert "course_lib.supervision" in folded["course_lib.ros"]
+    assert import_cycle(folded) is None, " -> ".join(import_cycle(folded))
+    for shared in ("course_lib.contract", "course_lib.waiting", "course_lib.progress"):
+        assert folded[shared] <= {"course_lib.contract"}, (shared, folded[shared])
+
+
 # --- each file does one job ----------------------------------------------------------------------
 
 def course_sources():

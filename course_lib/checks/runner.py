@@ -114,7 +114,7 @@ def execute(assignment: str, name: str, seed: int, workdir=None, mode: str = "se
     (recorded answers; only the self-check seed's inputs are recorded), "graded" (the grader's
     answer key) or "record" (graded, and the answers written to $AUTOGRADER_RECORD_TO).
     """
-    from course_lib.notebook import progress
+    from course_lib import progress
     from course_lib.ros import processes
 
     spec = get_check(assignment, name)

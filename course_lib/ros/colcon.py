@@ -17,7 +17,7 @@ import threading
 import time
 from pathlib import Path
 
-from course_lib.notebook import progress
+from course_lib import progress
 from course_lib.ros import rosenv, wheelfix
 from course_lib.supervision import process_tree
 
@@ -105,7 +105,7 @@ def build(ws_dir, packages=None, *, extra_args=(), timeout: float = 600,
         extra_args: more colcon build arguments, e.g. ["--symlink-install"].
         timeout: seconds before the build is stopped.
         echo: called with each output line as it arrives (e.g. print) to show progress live. In a
-            notebook a progress line follows the packages in any case (course_lib.notebook.progress).
+            notebook a progress line follows the packages in any case (course_lib.progress).
 
     Returns:
         A BuildResult (``finished`` lists the built packages).

@@ -5,7 +5,7 @@ are named before anything is started.
 
 from __future__ import annotations
 
-from course_lib.notebook import progress
+from course_lib import progress
 from course_lib.selfcheck.verdicts import Verdict, _verdict
 
 #: The package and executable of lesson 02's exercise (the brightness assignment asks for the

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from itertools import pairwise
 
-from course_lib.notebook import progress
+from course_lib import progress
 from course_lib.selfcheck.verdicts import Verdict, _not_done, _verdict
 
 
