@@ -17,6 +17,7 @@ A lesson calls them as ``selfcheck.<name>``; they live by kind of answer:
 - :mod:`.verdicts`: the :class:`Verdict` they return and the helpers they share.
 """
 
+from course_lib.selfcheck.bag_exercise import read_topic_exercise
 from course_lib.selfcheck.brightness_package import (
                                                      BRIGHTNESS_ENTRY_POINT,
                                                      BRIGHTNESS_EXECUTABLE,
@@ -40,4 +41,4 @@ from course_lib.selfcheck.verdicts import PLACEHOLDERS, Verdict
 __all__ = ["BRIGHTNESS_ENTRY_POINT", "BRIGHTNESS_EXECUTABLE", "BRIGHTNESS_PACKAGE", "CHECK_CAMERA_TOPIC",
            "PLACEHOLDERS", "PYTHON_DEPENDENCIES", "Verdict", "brightness_package_exercise", "check_quiz", "publisher_exercise",
            "subscriber_exercise", "task1_node_name", "task2_echo", "task3_brightness_on_change", "task4_order_corners",
-           "show_quiz", "task_launch_yaml", "task_picture_corners"]
+           "show_quiz", "read_topic_exercise", "task_launch_yaml", "task_picture_corners"]
