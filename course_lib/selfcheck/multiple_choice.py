@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import dataclasses
 
+from course_lib.selfcheck.verdicts import PLACEHOLDERS
+
 
 @dataclasses.dataclass(frozen=True)
 class Question:
@@ -39,7 +41,7 @@ class Question:
 def answer_problem(question: Question, answer) -> str | None:
     """What is wrong with the form of an answer (None when it is one of the question's letters):
     not answered yet, not a string, or a letter the question does not offer."""
-    if answer is None or answer == "" or answer is ...:
+    if answer is None or answer is ... or (isinstance(answer, str) and answer.strip() in PLACEHOLDERS):
         return f"not answered yet: write one of {question.letters()}"
     if not isinstance(answer, str):
         return f"{answer!r} is a {type(answer).__name__}; write the letter as a string, one of {question.letters()}"
