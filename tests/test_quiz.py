@@ -101,7 +101,8 @@ def test_no_explanation_of_the_key_is_in_what_students_install():
 
     import course_lib
 
-    texts = [path.read_text() for path in Path(course_lib.__file__).parent.rglob("*") if path.suffix in (".py", ".json")]
+    folder = Path(course_lib.__file__).parent
+    texts = [path.read_text() for path in folder.rglob("*") if path.suffix in (".py", ".json")]
     for name, (_letter, why) in key.KEY.items():
         assert not any(why[:40] in text for text in texts), name
 

@@ -91,7 +91,8 @@ def selfcheck(name: str) -> None:
     lines = [f"[self-check] {len(done)} of {len(problems)} answers are well-formed (whether they are right "
              "is graded after you hand the quiz in)", *missing]
     if done:
-        lines.append("  ✔ answered: " + ", ".join(f"{question} = {normalized(answers[question])!r}" for question in done))
+        answered = (f"{question} = {normalized(answers[question])!r}" for question in done)
+        lines.append("  ✔ answered: " + ", ".join(answered))
     stream = sys.stderr if missing else sys.stdout
     stream.write("\n".join(lines) + "\n")
     stream.flush()

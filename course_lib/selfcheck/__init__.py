@@ -39,6 +39,7 @@ from course_lib.selfcheck.tasks import (
 from course_lib.selfcheck.verdicts import PLACEHOLDERS, Verdict
 
 __all__ = ["BRIGHTNESS_ENTRY_POINT", "BRIGHTNESS_EXECUTABLE", "BRIGHTNESS_PACKAGE", "CHECK_CAMERA_TOPIC",
-           "PLACEHOLDERS", "PYTHON_DEPENDENCIES", "Verdict", "brightness_package_exercise", "check_quiz", "publisher_exercise",
-           "subscriber_exercise", "task1_node_name", "task2_echo", "task3_brightness_on_change", "task4_order_corners",
-           "show_quiz", "read_topic_exercise", "task_launch_yaml", "task_picture_corners"]
+           "PLACEHOLDERS", "PYTHON_DEPENDENCIES", "Verdict", "brightness_package_exercise", "check_quiz",
+           "publisher_exercise", "read_topic_exercise", "show_quiz", "subscriber_exercise", "task1_node_name",
+           "task2_echo", "task3_brightness_on_change", "task4_order_corners", "task_launch_yaml",
+           "task_picture_corners"]

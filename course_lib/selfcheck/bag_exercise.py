@@ -86,6 +86,6 @@ def _series_problem(got, topic: str, message_class, expected: dict) -> str | Non
         return "the times are the bag's clock; subtract the time of the topic's first message."
     if abs(seconds[-1] - (times[-1] - times[0]) * 1e9) < 1.0:
         return "the times are in nanoseconds: divide by 1e9 for seconds."
-    if any(abs(s - (t - times[0])) > 1e-6 for s, t in zip(seconds, times)):
+    if any(abs(s - (t - times[0])) > 1e-6 for s, t in zip(seconds, times, strict=True)):
         return f"the times are {[round(s, 3) for s in seconds]}, expected {[t - times[0] for t in times]}."
     return None

@@ -25,7 +25,8 @@ LESSON_QUIZZES: dict[str, tuple[Answered, ...]] = {
             "c": "the first node started, which then acts as the master",
             "d": "the parameter server"}),
             "b", "ROS 2 has no master: DDS discovery connects the nodes of one domain directly."),
-        Answered(Question("After `colcon build`, a new terminal says `Package 'my_package' not found`. What is missing?", {
+        Answered(Question("After `colcon build`, a new terminal says `Package 'my_package' not found`. "
+                          "What is missing?", {
             "a": "`colcon build` once more",
             "b": "`source install/setup.bash` in that terminal",
             "c": "`pip install my_package`",
@@ -96,7 +97,8 @@ LESSON_QUIZZES: dict[str, tuple[Answered, ...]] = {
             "b", "Both give the same number; only numpy's sum is fast enough for the camera's rate."),
     ),
     "02b": (
-        Answered(Question("You added a launch file to `data_files` in `setup.py`. What do you run before `ros2 launch` finds it?", {
+        Answered(Question("You added a launch file to `data_files` in `setup.py`. What do you run before "
+                          "`ros2 launch` finds it?", {
             "a": "nothing: `--symlink-install` links every file",
             "b": "`colcon build` again",
             "c": "`ros2 pkg create` again",
@@ -106,7 +108,8 @@ LESSON_QUIZZES: dict[str, tuple[Answered, ...]] = {
         Answered(Question("In a node named `dark_fraction`, which topic is `~/frames`?", {
             "a": "`/frames`", "b": "`/dark_fraction/frames`", "c": "`~/frames`, literally", "d": "a parameter"}),
             "b", "`~` stands for the node's own name: a private name."),
-        Answered(Question('What does `<remap from="image" to="/camera/image_raw"/>` inside a launch file\'s `<node>` do?', {
+        Answered(Question('What does `<remap from="image" to="/camera/image_raw"/>` inside a launch file\'s '
+                          "`<node>` do?", {
             "a": "it renames the node",
             "b": "the node's topic `image` becomes `/camera/image_raw`",
             "c": "the node publishes on both topics",
@@ -143,7 +146,8 @@ LESSON_QUIZZES: dict[str, tuple[Answered, ...]] = {
             "c": "bags make DDS reliable",
             "d": "the node does not need to spin"}),
             "a", "The same input gives the same output: the bag fixes the input, the test compares the output."),
-        Answered(Question("`ros2 bag play --loop run1 --topics /camera/image_raw` runs while the brightness node runs. What happens?", {
+        Answered(Question("`ros2 bag play --loop run1 --topics /camera/image_raw` runs while the brightness node "
+                          "runs. What happens?", {
             "a": "the node gets the recorded frames again and again and publishes their brightness",
             "b": "the bag's `/brightness` values are played as well",
             "c": "nothing: the node needs the camera",
