@@ -2,7 +2,7 @@
 
 The notebooks under assignments/source/ are what instructors edit in JupyterLab; this script is
 how they are made, from each assignment's spec (course_lib/checks/assignments.py: its packages, the
-module of its plain functions, the words of its notebook), its checks and its reference packages,
+module of its plain functions, its questions, the words of its notebook), its checks and its reference packages,
 and how a test checks that their graded cells match the checks (points of each test cell = points
 of its check in course_lib/checks/).
 
@@ -136,6 +136,23 @@ if not rosenv.under_grading():
     return cells
 
 
+def question_cells(assignment: str, questions: dict) -> list:
+    """A markdown cell per multiple-choice question and a solution cell the student answers it in:
+    its right letter from the grader's answer key (autograder/answers/<assignment>.py, KEY) between
+    the solution markers, which the release replaces by nbgrader's stub."""
+    import importlib
+
+    if not questions:
+        return []
+    key = importlib.import_module(f"autograder.answers.{assignment}").KEY  # build() puts the repository on the path
+    cells = []
+    for name, question in questions.items():
+        cells += [md(question.markdown(name)),
+                  code(f"# {name}: one of {question.letters()}\n### BEGIN SOLUTION\n{name} = \"{key[name][0]}\"\n"
+                       "### END SOLUTION", "solution", name)]
+    return cells
+
+
 def notebook(cells) -> nbformat.NotebookNode:
     nb = nbformat.v4.new_notebook()
     for index, cell in enumerate(cells):  # stable ids: rebuilding gives the same file
@@ -148,12 +165,15 @@ def notebook(cells) -> nbformat.NotebookNode:
 
 def assignment_notebook(spec: Assignment) -> nbformat.NotebookNode:
     """An assignment's source notebook: its own words (spec.notebook) around what its spec and its
-    checks say: the setup, its packages' files, the import of its plain functions, a test cell per check."""
+    checks say: the setup, its packages' files, the import of its plain functions, its questions,
+    a test cell per check."""
     from course_lib.checks import registry
 
     text = spec.notebook
-    cells = [md(text.intro, "intro"), setup_cell(spec.name, text.imports),
-             *package_cells(list(spec.packages), text.plain_ros)]
+    cells = [md(text.intro, "intro"), setup_cell(spec.name, text.imports)]
+    if spec.packages:
+        cells += package_cells(list(spec.packages), text.plain_ros)
+    cells += question_cells(spec.name, spec.questions)
     if spec.functions is not None:
         cells += [import_cell(*spec.functions, text.names), md(text.try_text), code(text.try_code)]
     for number, name in enumerate(registry.checks_of(spec.name), 1):

@@ -387,9 +387,10 @@ def build_for_checks(assignment: str, course: Path, work: Path, workdir: Path, u
 
 
 def needed(assignment: str, workdir: Path) -> bool:
-    """Whether a submission's workspace is built: the assignment's checks run packages, or the
-    notebook wrote a workspace."""
-    return assignment in ASSIGNMENTS or (Path(workdir) / WORKSPACE).exists()
+    """Whether a submission's workspace is built: the assignment's checks run packages (its spec
+    names some), or the notebook wrote a workspace."""
+    has_packages = assignment in ASSIGNMENTS and bool(ASSIGNMENTS[assignment].packages)
+    return has_packages or (Path(workdir) / WORKSPACE).exists()
 
 
 def run_here(command, cwd, env, wall_seconds):

@@ -1,7 +1,8 @@
 """The autograder end to end, with the real nbgrader CLI and gradebook: release -> reference
 solution -> grade -> full marks (catdog_warp here; see FULL_RUN_REFERENCES), typical mistakes
-graded down with their reason on the feedback page. (The checks on single mistakes, without
-nbgrader: tests/test_autograder.py; they run on another test worker.)"""
+graded down with their reason on the feedback page, a quiz with one wrong answer. (The checks on
+single mistakes, without nbgrader: tests/test_autograder.py and tests/test_quiz.py; they run on
+another test worker.)"""
 
 from __future__ import annotations
 
@@ -15,8 +16,10 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import course_support  # noqa: E402
 import zoo  # noqa: E402
 from test_autograder import ASSIGNMENTS, CATDOG_CHECK, CATDOG_MISTAKES, FULL_RUN, PUBSUB_MISTAKES  # noqa: E402
+from zoo.quiz import answered  # noqa: E402
 
 from autograder import grading  # noqa: E402
+from autograder.answers import quiz as quiz_key  # noqa: E402
 
 #: Typical mistakes that go through the whole pipeline (nbgrader, grader, feedback page), as
 #: (edits, the check it costs, a phrase of the verdict); the other typical mistakes are run through
@@ -26,6 +29,9 @@ FULL_RUN_MISTAKES = {
                     CATDOG_MISTAKES[FULL_RUN["catdog_warp"]][1]),
     "pubsub": PUBSUB_MISTAKES[FULL_RUN["pubsub"]],
 }
+
+#: The quiz handed in with every answer right but QUIZ_WRONG's (no ROS, no build: a cheap grading).
+QUIZ_WRONG = ("q8", "a")
 
 
 #: References graded through the whole pipeline here. Each assignment's reference goes through it
@@ -60,6 +66,7 @@ def course(tmp_path_factory):
     for assignment, (edits, _check, _reason) in FULL_RUN_MISTAKES.items():
         zoo.submit(course, "mistaken", assignment, edits)
     submit_rewriting(course, "rewriting")
+    zoo.submit(course, "mistaken", "quiz", [answered(dict([QUIZ_WRONG]))])
     results = grading.grade(course, workers=2, progress=False)
     return course, {(r.student, r.assignment): r for r in results}
 
@@ -133,3 +140,18 @@ def test_feedback_shows_crops_beside_expected(feedback_pages):
     assert "yours" in page and "expected" in page and "data:image/png;base64" in page
     assert "reproduce with AUTOGRADER_SEED=" in page
     assert not (root / "feedback" / "reference" / "catdog_warp" / "autograder.log").exists()
+
+
+@pytest.mark.slow
+def test_a_quiz_with_one_wrong_answer_loses_exactly_its_point_and_the_feedback_says_why(feedback_pages, course):
+    """The quiz's answers go from the notebook's variables through the grader's check to the feedback
+    page: every point but the wrong answer's, and why it is wrong."""
+    _, results = course
+    root, _pages = feedback_pages
+    result = results["mistaken", "quiz"]
+    assert result.status == "graded", result.reason
+    question, letter = QUIZ_WRONG
+    assert result.score == result.max_score - 1 == 14, zoo.graded_outputs(root, "mistaken", "quiz")
+    page = (root / "feedback" / "mistaken" / "quiz" / "quiz.html").read_text()
+    page = page.replace("&quot;", '"').replace("&#39;", "'")
+    assert f"{question}: not {letter}; {quiz_key.explain(question, letter)}" in page

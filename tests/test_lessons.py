@@ -127,3 +127,16 @@ def test_lesson_02_says_truly_where_the_brightness_assignment_starts():
         assert claim not in text
     assert "in a workspace of its own (`ros2_ws`, next to the assignment's notebook)" in text
     assert "Copy your `BrightnessNode` into the node file's cell there" in text
+
+
+def test_every_lesson_ends_with_its_quiz_and_an_answer_cell_for_each_question():
+    """Each lesson has a short quiz (course_lib.selfcheck.lesson_quiz) before its clean-up: the
+    questions shown, then a blank answer per question and the check."""
+    from course_lib.selfcheck.lesson_quiz import quiz_of
+
+    for lesson in sorted(NOTEBOOKS.glob("*.ipynb")):
+        key = lesson.name.split("_", 1)[0]
+        code = _cells(lesson, "code")
+        assert f'selfcheck.show_quiz("{key}")' in code, lesson.name
+        blank = "{" + ", ".join(f'{number}: ""' for number in range(1, len(quiz_of(key)) + 1)) + "}"
+        assert f'quiz = {blank}\nselfcheck.check_quiz("{key}", quiz)' in code, lesson.name

@@ -1,18 +1,22 @@
 """The graded assignments, one spec each: what the notebook builder (assignments/build.py), the checks,
 the grader and the tests read about an assignment.
 
-An assignment is a colcon workspace beside its notebook (``ros2_ws/src/<package>/``). Its spec says
-which packages the student writes and the executables each installs (what ``ros2 run`` offers),
-which module holds the plain functions the checks call without a build, and where the expected
-answers of its checks come from, and the words of its notebook that are its own (assignments/build.py
-writes the rest: the packages' cells, the imports, a test cell per check). Its checks and their
-points are in ``course_lib/checks/<name>.py``; its reference packages in
+An assignment is a colcon workspace beside its notebook (``ros2_ws/src/<package>/``), multiple-choice
+questions answered in the notebook (``q3 = "b"``), or both. Its spec says which packages the student
+writes and the executables each installs (what ``ros2 run`` offers), which module holds the plain
+functions the checks call without a build, its questions, where the expected answers of its checks
+come from, and the words of its notebook that are its own (assignments/build.py writes the rest: the
+packages' cells, the imports, a markdown and an answer cell per question, a test cell per check).
+Its checks and their points are in ``course_lib/checks/<name>.py``; its reference packages in
 ``assignments/reference_ws/src/``.
 """
 
 from __future__ import annotations
 
 import dataclasses
+
+from course_lib.checks.multiple_choice import Question
+from course_lib.checks.quiz_questions import QUIZ_QUESTIONS
 
 #: The workspace folder beside an assignment's notebook.
 WORKSPACE = "ros2_ws"
@@ -24,7 +28,7 @@ class NotebookText:
 
     Attributes:
         intro: the first cell (markdown): the assignment and its contract, what is graded.
-        plain_ros: how its packages come about in plain ROS 2 (ends the packages' introduction).
+        plain_ros: how its packages come about in plain ROS 2 (ends the packages' introduction; "" without packages).
         checks: each check -> its heading (after "Check N: ") and, optionally, markdown under it.
         imports: more lines of the setup cell.
         names: what the notebook imports from the module of the plain functions (Assignment.functions).
@@ -32,8 +36,8 @@ class NotebookText:
     """
 
     intro: str
-    plain_ros: str
     checks: dict[str, tuple[str, ...]]
+    plain_ros: str = ""
     imports: str = ""
     names: str = ""
     try_text: str = ""
@@ -47,11 +51,14 @@ class Assignment:
     Attributes:
         name: the assignment's name: its notebook, its checks module, its nbgrader assignment.
         packages: each package the student writes -> the executables it installs (none for a
-            message package), in build order.
+            message package), in build order; {} for an assignment without a workspace (nothing
+            is built).
         functions: (package, dotted module) of the plain functions the checks call, or None.
+        questions: its multiple-choice questions, the notebook's variable -> the question ({} for none).
         answers: where the checks' expected answers come from: "key" (the grader's answer key,
-            autograder/answers/<name>.py, recorded for self-checks in checks/recorded/<name>.json)
-            or "scene" (the ground truth of the scenes the checks draw).
+            autograder/answers/<name>.py, recorded for self-checks in checks/recorded/<name>.json),
+            "secret" (the grader's answer key, asked only when graded and never recorded: a quiz's
+            key would be its answers) or "scene" (the ground truth of the scenes the checks draw).
         notebook: the words of its notebook that are its own.
     """
 
@@ -59,6 +66,7 @@ class Assignment:
     packages: dict[str, tuple[str, ...]]
     notebook: NotebookText
     functions: tuple[str, str] | None = None
+    questions: dict[str, Question] = dataclasses.field(default_factory=dict)
     answers: str = "scene"
 
     def executables(self, package: str) -> tuple[str, ...]:
@@ -159,6 +167,19 @@ seen, and compares your crops with the true ones (`marker_board.crop_similarity`
 `marker_board.SAME_CROP_THRESHOLD`). Try your function on `scenes.render_scene(seed).frame`.
 """
 
+QUIZ_INTRO = """
+# Quiz: lessons 00-05
+
+Fifteen multiple-choice questions on what the lessons taught: ROS 2's concepts, reading what the
+`ros2` command prints, choosing a QoS, reading a launch file, images, markers and bags. Each has one
+right answer and earns one point.
+
+**How to answer:** write the letter of your choice as a string into the cell under the question,
+e.g. `q3 = "b"`, and run it. The check cell at the end saves your answers and says whether each is
+one of the question's letters; whether it is right is graded after you hand the quiz in, and the
+feedback explains each wrong answer. Run every cell (Run All) before you hand it in.
+"""
+
 
 #: Every graded assignment, in the order the course teaches them.
 ASSIGNMENTS: dict[str, Assignment] = {spec.name: spec for spec in (
@@ -193,6 +214,8 @@ scene = scenes.render_scene(1)
 print(sorted(crop_pictures(scene.frame)))   # ['cat', 'dog']
 """),
                functions=("readmarker", "readmarker.crop")),
+    Assignment("quiz", {}, NotebookText(intro=QUIZ_INTRO, checks={"answers": ("your answers",)}),
+               questions=QUIZ_QUESTIONS, answers="secret"),
 )}
 
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import dataclasses
 
-PLACEHOLDERS = (None, ..., "...", "")
+from course_lib.checks.multiple_choice import PLACEHOLDERS
 
 
 @dataclasses.dataclass(frozen=True)

@@ -1,0 +1,154 @@
+"""The questions of the graded quiz (lessons 00-05), without their answers: the grader's answer
+key (autograder/answers/quiz.py) holds the right letters and why.
+
+Each question is a variable of the quiz's notebook (``q3 = "b"``), one point each;
+assignments/build.py writes a markdown cell and an answer cell per question.
+"""
+
+from __future__ import annotations
+
+from course_lib.checks.multiple_choice import Question
+
+_TOPIC_INFO = """
+A plotter node shows nothing. You run:
+
+```
+$ ros2 topic info /brightness -v
+Type: std_msgs/msg/UInt8
+
+Publisher count: 1
+
+Node name: brightness_node
+Topic type: std_msgs/msg/UInt8
+Endpoint type: PUBLISHER
+QoS profile:
+  Reliability: BEST_EFFORT
+  Durability: VOLATILE
+
+Subscription count: 1
+
+Node name: plotter
+Topic type: std_msgs/msg/UInt8
+Endpoint type: SUBSCRIPTION
+QoS profile:
+  Reliability: RELIABLE
+  Durability: VOLATILE
+```
+
+Why does the plotter get no messages?
+"""
+
+_NODE_LIST = """
+```
+$ ros2 node list
+/camera/image_publisher
+/brightness_node
+/brightness_node
+```
+
+What does this output say?
+"""
+
+_LAUNCH = """
+`dark.launch.xml` of the package `image_stats`:
+
+```xml
+<launch>
+  <arg name="threshold" default="60"/>
+  <node pkg="image_stats" exec="dark_fraction" name="dark" namespace="robot1">
+    <param name="dark.threshold" value="$(var threshold)"/>
+    <remap from="image" to="/camera/image_raw"/>
+  </node>
+</launch>
+```
+"""
+
+_TOPIC_HZ = """
+```
+$ ros2 topic hz /camera/image_raw
+average rate: 14.982
+	min: 0.061s max: 0.074s std dev: 0.00310s window: 47
+```
+
+About how much time passes between two frames?
+"""
+
+_BAG_INFO = """
+```
+$ ros2 bag info run1
+Files:             run1_0.mcap
+Bag size:          27.9 MiB
+Storage id:        mcap
+ROS Distro:        jazzy
+Duration:          2.000000000s
+Messages:          92
+Topic information: Topic: /camera/image_raw | Type: sensor_msgs/msg/Image | Count: 61 | Serialization Format: cdr
+                   Topic: /brightness | Type: std_msgs/msg/UInt8 | Count: 31 | Serialization Format: cdr
+```
+"""
+
+#: The graded quiz: variable name -> question, in the order of the notebook.
+QUIZ_QUESTIONS: dict[str, Question] = {
+    "q1": Question("How do two ROS 2 nodes on one machine find each other?", {
+        "a": "through `roscore`, which must run first",
+        "b": "by discovery: each node announces itself, and nodes of one `ROS_DOMAIN_ID` connect directly",
+        "c": "only through the `ros2 daemon`",
+        "d": "through the parameter server"}),
+    "q2": Question(_TOPIC_INFO, {
+        "a": "the types of the publisher and the subscription differ",
+        "b": "a reliable subscription does not match a best-effort publisher",
+        "c": "the subscription's queue is too short",
+        "d": "the plotter runs in another ROS domain"}),
+    "q3": Question("A node publishes a map once, at its start; nodes started later must still get it. "
+                   "Which QoS does its publisher need (and the subscriptions alike)?", {
+        "a": "best effort, volatile",
+        "b": "reliable, transient local",
+        "c": "the sensor-data profile",
+        "d": "reliable, volatile, depth 1"}),
+    "q4": Question("A camera publishes 1920×1080 frames at 30 Hz; one subscriber cannot keep up. "
+                   "Which QoS suits the frames?", {
+        "a": "reliable with a queue of 1000, so that no frame is lost",
+        "b": "the sensor-data profile: best effort, keep the last few",
+        "c": "transient local, so that late subscribers get old frames",
+        "d": "any: QoS does not matter on one machine"}),
+    "q5": Question(_NODE_LIST, {
+        "a": "two processes run a node of the same name: its parameters and services are ambiguous, "
+             "rename one (`-r __node:=other`)",
+        "b": "nothing unusual: each node is listed once per topic it publishes",
+        "c": "the brightness node restarted, and the old entry stays until the daemon stops",
+        "d": "the camera runs twice"}),
+    "q6": Question(_LAUNCH + "\nWhat is the full name of the node it starts?", {
+        "a": "`/dark_fraction`", "b": "`/robot1/dark`", "c": "`/dark`", "d": "`/image_stats/dark`"}),
+    "q7": Question("With the same launch file, `ros2 launch image_stats dark.launch.xml threshold:=80` "
+                   "gives the parameter `dark.threshold` which value?", {
+        "a": "60", "b": "80", "c": "the string `$(var threshold)`", "d": "none: it is an error"}),
+    "q8": Question("The same node publishes on the relative name `dark_fraction`. On which topic do its "
+                   "messages appear?", {
+        "a": "`/dark_fraction`", "b": "`/robot1/dark_fraction`", "c": "`/camera/dark_fraction`",
+        "d": "`/robot1/dark/dark_fraction`"}),
+    "q9": Question("`ros2 run brightness brightness_node` answers `No executable found`, though the package "
+                   "built. What is the likely cause?", {
+        "a": "`setup.py` has no `brightness_node` entry in `console_scripts`",
+        "b": "`package.xml` does not list `rclpy`",
+        "c": "the node's class is not called `BrightnessNode`",
+        "d": "the camera is not running"}),
+    "q10": Question("A `sensor_msgs/Image` is 640×480, `mono8`, with `step` 640. How many bytes has `data`?", {
+        "a": "640", "b": "307 200", "c": "921 600", "d": "480"}),
+    "q11": Question(_TOPIC_HZ, {
+        "a": "15 s", "b": "about 0.067 s", "c": "0.0031 s", "d": "47 ms"}),
+    "q12": Question("How many point correspondences does `cv2.getPerspectiveTransform` need for a homography?", {
+        "a": "2", "b": "3", "c": "4", "d": "8"}),
+    "q13": Question("Which calls find a marker's picture upright in a camera frame?", {
+        "a": "detect the markers, take the four picture corners they touch, `getPerspectiveTransform` to "
+             "an upright rectangle, `warpPerspective`",
+        "b": "`cv2.resize` of the frame to the picture's size",
+        "c": "`cv2.rotate` by the marker's angle",
+        "d": "`cv2.flip`, then crop the markers' bounding box"}),
+    "q14": Question(_BAG_INFO + "\nAt what rate did the camera's frames come in?", {
+        "a": "92 Hz", "b": "about 30 Hz", "c": "61 Hz", "d": "about 15 Hz"}),
+    "q15": Question(_BAG_INFO + "\nThe brightness node should answer every frame. What does the bag say?", {
+        "a": "it answered about half of the frames (31 of 61)",
+        "b": "it answered every frame",
+        "c": "it answered more often than the camera sent",
+        "d": "nothing: a bag cannot tell"}),
+}
