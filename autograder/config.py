@@ -13,7 +13,7 @@ from __future__ import annotations
 import dataclasses
 from pathlib import Path
 
-from traitlets import Dict
+from traitlets import Dict, Int
 from traitlets.config import Configurable
 
 from course_lib.checks.validate import apply_student
@@ -76,10 +76,14 @@ class GradeOnSubmit(Configurable):
     submissions before the due date are graded (default: no limit; later ones are refused and set
     aside, so the instructor's collect takes the last one graded). ``reasons_before_due``: False
     shows only the scores of the hidden checks until the due date, not why they failed (default
-    True). After the due date the instructor's grade and feedback runs give the final grades."""
+    True). After the due date the instructor's grade and feedback runs give the final grades.
+    ``c.GradeOnSubmit.workers = 2``: submissions graded at the same time (read when the service
+    starts; the hub restarts it when it is stopped)."""
 
     assignments = Dict(default_value={}, help="assignment -> {'attempts': int, 'reasons_before_due': bool}; "
                        "named assignments are graded when submitted").tag(config=True)
+    workers = Int(default_value=None, allow_none=True,
+                  help="submissions graded at the same time (default SUBMIT_WORKERS)").tag(config=True)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -126,6 +130,27 @@ def submit_rules(course_config, assignments: list[str]) -> dict[str, SubmitRules
     return rules
 
 
+def submit_workers(course_config) -> int:
+    """How many submissions the grading service grades at the same time (c.GradeOnSubmit.workers).
+
+    Raises:
+        ValueError: the setting is not a whole number of at least 1 (the message names the fix).
+    """
+    from traitlets import TraitError
+
+    try:
+        workers = GradeOnSubmit(config=course_config).workers
+    except TraitError:
+        workers = course_config.GradeOnSubmit.workers
+    if workers is None:
+        return SUBMIT_WORKERS
+    if not isinstance(workers, int) or isinstance(workers, bool) or workers < 1:
+        raise ValueError(f"c.GradeOnSubmit.workers in the course's nbgrader_config.py is {workers!r}: give a whole "
+                         f"number of at least 1 (each grading keeps about two cores busy), or leave it out for "
+                         f"{SUBMIT_WORKERS}.")
+    return workers
+
+
 #: The line of the course's nbgrader_config.py below which the instructor's settings are kept.
 MARKER = "# ---- Your settings below this line are kept when the autograder rewrites this file ----"
 
@@ -161,6 +186,8 @@ SETTINGS_EXAMPLE = '''\
 # Grading on submission on the course's JupyterHub (its grading service), per assignment: how many
 # submissions before the due date are graded, and whether the hidden checks' reasons show before it:
 # c.GradeOnSubmit.assignments = {"brightness": {"attempts": 3, "reasons_before_due": True}}
+# and how many submissions it grades at the same time (each keeps about two cores busy):
+# c.GradeOnSubmit.workers = 1
 # The time zone of the submission times in your LMS's file names (python -m autograder collect):
 # c.LmsFileNames.timezone = "Europe/Berlin"
 # The file names of your LMS's download, when they differ from autograder.collect.LMS_FILE_NAME

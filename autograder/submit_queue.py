@@ -8,7 +8,8 @@ found, which is the order of arrival. A row goes
 and every change is one SQLite transaction (synchronous=FULL), so a service killed at any point
 loses nothing: on start, :meth:`SubmitQueue.recover` puts the rows it was grading back in the
 queue, and graded rows whose feedback was not released yet are released again. Workers take rows
-one at a time (:meth:`claim`), oldest first. A newer submission of the same student and
+one at a time (:meth:`claim`), oldest first; a row keeps which worker took it last and when, as a
+count of the queue's claims (``worker``, ``claimed``). A newer submission of the same student and
 assignment supersedes an older one still queued; one past the assignment's attempts before the
 due date is refused (:meth:`add`). ``gradings`` counts the results recorded for a row (1 when
 all went well, whatever crashed in between).
@@ -42,9 +43,13 @@ CREATE TABLE IF NOT EXISTS submissions (
     max_score REAL,
     message TEXT NOT NULL DEFAULT '',
     gradings INTEGER NOT NULL DEFAULT 0,
-    changed TEXT NOT NULL
+    changed TEXT NOT NULL,
+    worker INTEGER,                  -- the worker that took it last (0, 1, ...: the service's --workers)
+    claimed INTEGER                  -- when: 1 for the queue's first claim, 2 for the next, ...
 )
 """
+#: Columns a queue file written by an earlier version lacks: added when it is opened.
+ADDED_COLUMNS = {"worker": "INTEGER", "claimed": "INTEGER"}
 
 
 @dataclasses.dataclass
@@ -63,6 +68,8 @@ class Row:
     message: str = ""
     gradings: int = 0
     changed: str = ""
+    worker: int | None = None
+    claimed: int | None = None
 
 
 def _now() -> str:
@@ -81,6 +88,10 @@ class SubmitQueue:
         self._db.execute("PRAGMA journal_mode=WAL")
         self._db.execute("PRAGMA synchronous=FULL")
         self._db.execute(SCHEMA)
+        columns = {row[1] for row in self._db.execute("PRAGMA table_info(submissions)")}
+        for name, declaration in ADDED_COLUMNS.items():
+            if name not in columns:
+                self._db.execute(f"ALTER TABLE submissions ADD COLUMN {name} {declaration}")
 
     def close(self) -> None:
         with self._lock:
@@ -143,14 +154,15 @@ class SubmitQueue:
     def get(self, row_id: int) -> Row:
         return self._rows("SELECT * FROM submissions WHERE id=?", row_id)[0]
 
-    def claim(self) -> Row | None:
-        """The oldest queued row, now 'grading'; None when nothing is queued."""
+    def claim(self, worker: int = 0) -> Row | None:
+        """The oldest queued row, now 'grading' by `worker`; None when nothing is queued."""
 
         def work(db):
             found = db.execute("SELECT id FROM submissions WHERE state='queued' ORDER BY id LIMIT 1").fetchone()
             if found is None:
                 return None
-            db.execute("UPDATE submissions SET state='grading', changed=? WHERE id=?", (_now(), found[0]))
+            db.execute("UPDATE submissions SET state='grading', worker=?, claimed=(SELECT COALESCE(MAX(claimed), 0) "
+                       "+ 1 FROM submissions), changed=? WHERE id=?", (worker, _now(), found[0]))
             return found[0]
 
         row_id = self._transaction(work)

@@ -15,6 +15,9 @@ from pathlib import Path
 
 DEFAULT_HUB_DIR = Path("/srv/ros2cv-hub")
 DEFAULT_EXCHANGE = Path("/srv/nbgrader/exchange")  # nbgrader's documented default place
+#: The hub's grading service (coursehub.grading_service): its name, and its page's path on the hub.
+GRADING_SERVICE = "grading"
+GRADING_PAGE = f"services/{GRADING_SERVICE}/"
 
 
 @dataclasses.dataclass

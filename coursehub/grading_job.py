@@ -15,6 +15,7 @@ graded (root; coursehub.grading_service runs these in its threads).
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import os
 import shutil
@@ -28,15 +29,23 @@ from coursehub import inbound
 from coursehub.accounts import chown_tree
 
 
-def grade(course, queue: SubmitQueue, row: Row) -> None:
-    """Collect, grade (or reuse a grading of the same content) and record one claimed row."""
-    from autograder.pipeline import grade_submission
-    from course_lib.ros import rosenv
-
+def grade(course, queue: SubmitQueue, row: Row, one_at_a_time=None) -> None:
+    """Collect, grade (or reuse a grading of the same content) and record one claimed row.
+    `one_at_a_time(content)`: a lock held from looking for a grading of the same content to
+    recording this one (workers given the same files grade them once); None: no other worker."""
     course_dir = course.course_dir
     entry = inbound.parse(inbound.inbound(course.exchange, course.course_id) / row.entry)
     sub = Submission(row.student, row.assignment, inbound.collect(entry, course_dir))
     content = submission_digest(sub, course_dir, content_only=True)
+    with one_at_a_time(content) if one_at_a_time else contextlib.nullcontext():
+        _grade_collected(course, queue, row, sub, content)
+
+
+def _grade_collected(course, queue: SubmitQueue, row: Row, sub: Submission, content: str) -> None:
+    from autograder.pipeline import grade_submission
+    from course_lib.ros import rosenv
+
+    course_dir = course.course_dir
     course_config = config.load(course_dir)
     result, reused_from = store.cached_result(course_dir, sub), None
     if result is not None:  # recorded before the service stopped: record it again, grade nothing

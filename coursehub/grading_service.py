@@ -8,7 +8,9 @@ autograder.config), it
 - looks at the exchange's inbound/ every second and queues each new, complete submission
   (coursehub.inbound; the queue autograder.submit_queue is durable, so a submission that arrives
   while the service is down, or one it was grading when killed, is graded when it is back);
-- grades the queue in arrival order, one submission per worker (coursehub.grading_job.grade);
+- grades the queue in arrival order, one submission per worker (coursehub.grading_job.grade;
+  ``--workers``, else ``c.GradeOnSubmit.workers``, autograder.config), and the same files once:
+  a worker given files another is grading waits for that grading and reuses it;
 - writes and releases the feedback of what was graded (coursehub.grading_job.release), so that
   Fetch Feedback in the student's Assignments panel shows it;
 - serves each student the state of their submissions (coursehub.grading_status), and publishes
@@ -60,7 +62,8 @@ class Service:
         self.stopping = threading.Event()
         self.queued = threading.Semaphore(0)  # one release per row queued (and per recovered row)
         self.graded = threading.Event()
-        self._rules, self._rules_read = {}, None
+        self._rules, self._rules_read, self._rules_lock = {}, None, threading.Lock()
+        self._contents, self._contents_lock = {}, threading.Lock()
 
     def start(self) -> None:
         recovered = self.queue.recover()
@@ -71,7 +74,7 @@ class Service:
         self.graded.set()  # feedback left unreleased by a stop is released now
         threads = [threading.Thread(target=self._look, name="grading-inbound", daemon=True),
                    threading.Thread(target=self._release, name="grading-feedback", daemon=True)]
-        threads += [threading.Thread(target=self._grade, name=f"grading-worker-{n}", daemon=True)
+        threads += [threading.Thread(target=self._grade, args=(n,), name=f"grading-worker-{n}", daemon=True)
                     for n in range(self.workers)]
         for thread in threads:
             thread.start()
@@ -79,17 +82,18 @@ class Service:
     def rules(self) -> dict[str, config.SubmitRules]:
         """The assignments graded on submission, read again when nbgrader_config.py changes."""
         path = self.course.course_dir / "nbgrader_config.py"
-        stamp = path.stat().st_mtime_ns
-        if stamp != self._rules_read:
-            try:
-                self._rules = config.submit_rules(config.load(self.course.course_dir),
-                                                  assignments_in(self.course.course_dir))
-            except ValueError as error:
-                _log(f"{error} Grading on submission waits until it is corrected.")
-                self._rules = {}
-            self._rules_read = stamp
-            self.publish()
-        return self._rules
+        with self._rules_lock:  # the threads ask at once at the start: read and publish once
+            stamp = path.stat().st_mtime_ns
+            if stamp != self._rules_read:
+                try:
+                    self._rules = config.submit_rules(config.load(self.course.course_dir),
+                                                      assignments_in(self.course.course_dir))
+                except ValueError as error:
+                    _log(f"{error} Grading on submission waits until it is corrected.")
+                    self._rules = {}
+                self._rules_read = stamp
+                self.publish()
+            return self._rules
 
     def publish(self) -> None:
         """The attempts and due dates for the students' servers' Submit (coursehub.limited_submit)."""
@@ -127,15 +131,21 @@ class Service:
                 _log(f"could not read the inbound submissions:\n{traceback.format_exc()}")
             self.stopping.wait(self.poll_seconds)
 
-    def _grade(self) -> None:
+    def one_at_a_time(self, content: str) -> threading.Lock:
+        """The lock of one content: held while a worker grades it, so that another worker given the
+        same files waits and reuses that grading instead of grading them again."""
+        with self._contents_lock:
+            return self._contents.setdefault(content, threading.Lock())
+
+    def _grade(self, worker: int) -> None:
         while not self.stopping.is_set():
             if not self.queued.acquire(timeout=self.poll_seconds):
                 continue
-            row = self.queue.claim()
+            row = self.queue.claim(worker)
             if row is None:  # superseded meanwhile
                 continue
             try:
-                grading_job.grade(self.course, self.queue, row)
+                grading_job.grade(self.course, self.queue, row, self.one_at_a_time)
             except Exception:  # noqa: BLE001 - not the student's fault: the instructor's grade run takes it
                 _log(f"could not grade {row.entry}:\n{traceback.format_exc()}")
                 self.queue.failed(row.id, "the grading service ran into an error.")
@@ -171,20 +181,28 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="python -m coursehub.grading_service", description=__doc__.split("\n")[0])
     parser.add_argument("--hub-dir", type=Path, default=Path(os.environ.get("COURSEHUB_HUB_DIR",
                                                                            course_settings.DEFAULT_HUB_DIR)))
-    parser.add_argument("--workers", type=int, default=config.SUBMIT_WORKERS)
+    parser.add_argument("--workers", type=int, help="submissions graded at the same time (default: "
+                        f"c.GradeOnSubmit.workers in the course's nbgrader_config.py, else {config.SUBMIT_WORKERS})")
     args = parser.parse_args(argv)
     from tornado import ioloop
 
     from coursehub import grading_status
 
     course = course_settings.load(args.hub_dir)
-    service = Service(course, workers=max(1, args.workers),
-                      rules_file=course.submit_rules)
+    workers = args.workers
+    if workers is None:
+        try:
+            workers = config.submit_workers(config.load(course.course_dir))
+        except ValueError as error:  # the hub would restart a service that stops, again and again
+            _log(f"{error} Grading with {config.SUBMIT_WORKERS} worker(s) until it is corrected and the service "
+                 "restarted.")
+            workers = config.SUBMIT_WORKERS
+    service = Service(course, workers=max(1, workers), rules_file=course.submit_rules)
     service.start()
-    prefix = os.environ.get("JUPYTERHUB_SERVICE_PREFIX", "/services/grading/")
+    prefix = os.environ.get("JUPYTERHUB_SERVICE_PREFIX", f"/{course_settings.GRADING_PAGE}")
     grading_status.application(service.queue, prefix).listen(course.grading_port, "127.0.0.1")
-    _log(f"grading {', '.join(service.rules()) or 'nothing yet (c.GradeOnSubmit.assignments)'} on submission; "
-         f"status at {prefix} (127.0.0.1:{course.grading_port})")
+    _log(f"grading {', '.join(service.rules()) or 'nothing yet (c.GradeOnSubmit.assignments)'} on submission "
+         f"with {service.workers} worker(s); status at {prefix} (127.0.0.1:{course.grading_port})")
     try:
         ioloop.IOLoop.current().start()
     except KeyboardInterrupt:  # the hub stops its services with SIGINT

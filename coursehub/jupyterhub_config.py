@@ -41,8 +41,10 @@ c.Spawner.http_timeout = 180
 # Graded feedback minutes after Submit (coursehub.grading_service), as root (the grader's sandbox
 # needs it); the hub restarts it when it dies. Students reach its page behind the hub's login.
 c.JupyterHub.services = [{
-    "name": "grading", "url": f"http://127.0.0.1:{course.grading_port}", "display": True, "oauth_no_confirm": True,
+    "name": course_settings.GRADING_SERVICE, "url": f"http://127.0.0.1:{course.grading_port}", "display": True,
+    "oauth_no_confirm": True,
     "command": [sys.executable, "-m", "coursehub.grading_service"],
     "environment": {"COURSEHUB_HUB_DIR": str(course.hub_dir)},
 }]
-c.JupyterHub.load_roles = [{"name": "user", "scopes": ["self", "access:services!service=grading"]}]
+c.JupyterHub.load_roles = [{"name": "user",
+                            "scopes": ["self", f"access:services!service={course_settings.GRADING_SERVICE}"]}]

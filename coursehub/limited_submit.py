@@ -7,7 +7,8 @@ hub's jupyter settings folder, readable by all: attempts and due date per assign
 submission; the course's nbgrader_config.py itself is the instructor's) and counts the student's
 own earlier submissions in nbgrader's cache of them (``~/.local/share/jupyter/nbgrader_cache``).
 This only spares the student a submission that would not be graded: the service counts again from
-the exchange and refuses what gets past (coursehub.grading_service).
+the exchange and refuses what gets past (coursehub.grading_service). The message names the
+service's page, where the student sees their submissions and scores.
 """
 
 from __future__ import annotations
@@ -20,6 +21,8 @@ from pathlib import Path
 from nbgrader.exchange.default.submit import ExchangeSubmit
 from nbgrader.utils import parse_utc
 from traitlets import Unicode
+
+from coursehub.course import GRADING_PAGE, GRADING_SERVICE
 
 
 def write_rules(path: Path, rules: dict) -> None:
@@ -54,6 +57,8 @@ class LimitedSubmit(ExchangeSubmit):
                    if due is None or parse_utc(os.path.basename(path).split("+")[2]) <= due]
         if len(earlier) >= rule["attempts"]:
             before = f"before the due date ({due:%Y-%m-%d %H:%M} UTC)" if due else "before the due date"
+            page = f"{os.environ.get('JUPYTERHUB_BASE_URL', '/')}{GRADING_PAGE}"
             self.fail(f"{assignment} allows {rule['attempts']} graded submissions {before}, and you have made "
                       f"{len(earlier)}: this one would not be graded. Your last graded submission stands; your "
-                      "instructor grades it again after the due date.")
+                      f"instructor grades it again after the due date.\nYour submissions and their scores: {page} on "
+                      f"the hub (its home page: Services > {GRADING_SERVICE}).")

@@ -7,8 +7,9 @@ and find every process of the course's users.
 - ``log_in``: a requests session logged in through the hub's login form, with the user's server up;
 - ``run_in_kernel``: start a kernel in a user's server, run code, return what it printed;
 - ``course_processes``: the processes of the course's uids and of their network namespaces;
-- ``grading_service``, ``submission_states``: the hub's grading service process, and the rows of
-  its queue as its page shows them to a student.
+- ``grading_service``, ``sandboxed``, ``submission_states``: the hub's grading service process,
+  its processes in the grader's sandbox (a grading runs), and the rows of its queue as its page
+  shows them to a student.
 """
 
 from __future__ import annotations
@@ -264,6 +265,17 @@ def grading_service(hub: Hub, timeout: float = 120) -> psutil.Process:
             raise TimeoutError(f"the grading service did not answer on 127.0.0.1:{port} within {timeout:.0f} s:\n"
                                f"{hub.log_tail()}")
         time.sleep(0.2)
+
+
+def sandboxed(process: psutil.Process) -> list[psutil.Process]:
+    """The processes below `process` that run in the grader's sandbox (autograder/sandbox_entry.py)."""
+    from autograder.sandbox import ENTRY
+
+    try:
+        below = process.children(recursive=True)
+    except psutil.Error:
+        return []
+    return [child for child in below if str(ENTRY) in _cmdline(child)]
 
 
 def _cmdline(process: psutil.Process) -> list[str]:

@@ -66,3 +66,18 @@ def test_without_rules_no_assignment_is_graded_on_submission(tmp_path):
 def test_a_mistake_in_the_rules_names_the_fix(tmp_path, line, fix):
     with pytest.raises(ValueError, match=fix):
         _rules(tmp_path, line)
+
+
+def test_the_grading_service_grades_one_submission_at_a_time_unless_told(tmp_path):
+    path = config.write_config(tmp_path)
+    assert config.submit_workers(config.load(tmp_path)) == config.SUBMIT_WORKERS == 1
+    path.write_text(path.read_text() + "c.GradeOnSubmit.workers = 2\n")
+    assert config.submit_workers(config.load(tmp_path)) == 2
+
+
+@pytest.mark.parametrize("value", ["0", "'2'", "True"])
+def test_a_wrong_number_of_workers_names_the_fix(tmp_path, value):
+    path = config.write_config(tmp_path)
+    path.write_text(path.read_text() + f"c.GradeOnSubmit.workers = {value}\n")
+    with pytest.raises(ValueError, match="GradeOnSubmit.workers .* give a whole number of at least 1"):
+        config.submit_workers(config.load(tmp_path))

@@ -9,8 +9,10 @@ submission and releases its feedback, with no instructor step: bob's wrong avera
 reasons, his fix full marks, a Submit past the attempts is refused with the reason; each student
 sees only their own submissions and feedback and cannot reach the other's server. The
 instructor's collect, grade and feedback afterwards agree with the service and grade nothing
-again. Many submissions at once survive a SIGKILL of the service, each graded once. Stopping the
-hub leaves no process of the course behind. Root only (accounts, namespaces); skipped otherwise."""
+again. 30 submissions at once survive a SIGKILL of the service in the middle of a sandboxed
+grading, each graded once, each content once, in arrival order per worker of the restarted
+service's two. Stopping the hub leaves no process of the course behind. Root only (accounts,
+namespaces); skipped otherwise."""
 
 from __future__ import annotations
 
@@ -40,6 +42,7 @@ from hub_support import (  # noqa: E402  # noqa: E402
     log_in,
     run_in_kernel,
     running_hub,
+    sandboxed,
     submission_states,
     why_no_hub,
 )
@@ -267,8 +270,20 @@ def test_students_get_graded_feedback_minutes_after_submit_and_only_their_own(hu
     _press(pages[bob], "fetched", "Submit")
     dialog = pages[bob].locator("#submission-message")
     dialog.wait_for()
-    assert f"{ASSIGNMENT} allows {ATTEMPTS} graded submissions before the due date" in dialog.inner_text()
+    SCREENSHOTS.mkdir(parents=True, exist_ok=True)
+    pages[bob].screenshot(path=str(SCREENSHOTS / "hub_submit_refused.png"))
+    # The reason first and alone (course_lib.notebook.student_lab.assignment_list), not nbgrader's traceback.
+    said = " ".join(dialog.inner_text().split())
+    assert said.startswith(f"Assignment not submitted: {ASSIGNMENT} allows {ATTEMPTS} graded submissions before "
+                           "the due date") and "Traceback" not in said, said
+    assert said.endswith("Your submissions and their scores: /services/grading/ on the hub (its home page: "
+                         "Services > grading)."), said
     pages[bob].locator(".jp-Dialog .jp-mod-accept").click()
+    # The page it names is in the hub's Services menu (File > Hub Control Panel in the lab).
+    home = pages[bob].context.new_page()
+    home.goto(f"{hub.url}/hub/home", wait_until="domcontentloaded")
+    assert home.locator("a.dropdown-item", has_text="grading").get_attribute("href") == "/services/grading/"
+    home.close()
     # Copied into inbound/ past the panel (from a terminal, say): the service refuses it and says so.
     _drop_in_inbound(hub, bob, hub.course_dir / "submitted" / bob / ASSIGNMENT)
     refused, said = _status(pages[bob], hub, 3)
@@ -277,7 +292,6 @@ def test_students_get_graded_feedback_minutes_after_submit_and_only_their_own(hu
     status = {user: page.context.new_page() for user, page in pages.items()}
     for page in status.values():
         page.goto(f"{hub.url}/services/grading/", wait_until="domcontentloaded")
-    SCREENSHOTS.mkdir(parents=True, exist_ok=True)
     status[bob].screenshot(path=str(SCREENSHOTS / "hub_grading_status.png"))
     assert "this is your 3rd" in status[bob].inner_text("body")
 
@@ -307,8 +321,14 @@ def test_students_get_graded_feedback_minutes_after_submit_and_only_their_own(hu
         page.context.close()
 
 
-#: Submissions handed in at once in the queue test, and while its service is down.
-AT_ONCE, WHILE_DOWN = 10, 2
+#: The queue test: submissions handed in at once, those among them with files nobody handed in before
+#: (their place in the queue), and those handed in while the service is down. The rest are alice's
+#: files, graded in the browser test: the service reuses that grading, which is cheap.
+AT_ONCE, NEW_AT, WHILE_DOWN = 30, (0, 1, 15, 29), 2
+#: The new files: the reference with a comment in the student's module (full marks, graded once).
+NEW_FILES = [(SUM, f"{SUM}  # handed in by four students")]
+#: Submissions the restarted service grades at the same time (c.GradeOnSubmit.workers).
+WORKERS = 2
 
 
 def _drop_in_inbound(hub, student: str, like: Path) -> str:
@@ -359,10 +379,18 @@ def _wait_for_rows(hub, students, done, timeout: float = 300) -> dict:
     return rows
 
 
-def test_submissions_at_once_are_each_graded_once_across_a_kill_of_the_service(hub):
-    """Many submissions of one content at once (alice's, graded in the browser test: cheap), the
-    service killed with SIGKILL mid-queue, more submitted while it is down: when the hub has
-    restarted it, each is graded exactly once, with the score a plain grade run gives."""
+def _new_files(hub, like: Path, folder: Path) -> Path:
+    """A submitted folder like `like` whose notebook has NEW_FILES."""
+    shutil.copytree(like, folder)
+    nbformat.write(zoo.edited_notebook(hub.course_dir, ASSIGNMENT, NEW_FILES), folder / f"{ASSIGNMENT}.ipynb")
+    return folder
+
+
+def test_submissions_at_once_are_each_graded_once_across_a_kill_of_the_service(hub, tmp_path):
+    """30 submissions at once, the service killed with SIGKILL while it grades one in the sandbox,
+    two more handed in while it is down: the service the hub restarts (with two workers) grades each
+    exactly once, in arrival order per worker, each content once, with the scores of a plain grade
+    run."""
     from nbgrader.utils import notebook_hash
 
     from autograder import store
@@ -370,35 +398,57 @@ def test_submissions_at_once_are_each_graded_once_across_a_kill_of_the_service(h
 
     alice = hub.students[0]
     like = hub.course_dir / "submitted" / alice / ASSIGNMENT
+    new = _new_files(hub, like, tmp_path / "new")
     graded = store.recorded_results(hub.course_dir, ASSIGNMENT, alice)[0]
     students = [f"{hub.instructor[:-1]}q{n:02d}" for n in range(AT_ONCE + WHILE_DOWN)]
     service = grading_service(hub)
-    for student in students[:AT_ONCE]:
-        _drop_in_inbound(hub, student, like)
-    at_kill = _wait_for_rows(hub, students,
-                             lambda rows: any(r["state"] in ("graded", "released") for r in rows.values()))
+    for n, student in enumerate(students[:AT_ONCE]):
+        _drop_in_inbound(hub, student, new if n in NEW_AT else like)
+    first = students[NEW_AT[0]]
+
+    def grading_in_sandbox(rows) -> bool:
+        assert rows.get(first, {}).get("state") in (None, "queued", "grading"), f"graded before the kill: {rows[first]}"
+        return rows.get(first, {}).get("state") == "grading" and bool(sandboxed(service))
+
+    _wait_for_rows(hub, students, grading_in_sandbox)
+    running = sandboxed(service)
+    with open(hub.course_dir / "nbgrader_config.py", "a") as handle:  # read when the service starts again
+        handle.write(f"c.GradeOnSubmit.workers = {WORKERS}\n")
     service.kill()
     _wait_until_gone(service)
-    left = [s for s, r in _queue_rows(hub, students).items() if r["state"] in ("queued", "grading", "graded")]
-    assert left, f"every submission was done before the kill: {at_kill}"
+    for process in running:  # the sandbox goes with the service (course_lib.processes: never an orphan)
+        _wait_until_gone(process)
     for student in students[AT_ONCE:]:  # handed in while the service is down
         _drop_in_inbound(hub, student, like)
     assert grading_service(hub, timeout=180).pid != service.pid  # the hub restarts it
 
     rows = _wait_for_rows(hub, students, lambda rows: len(rows) == len(students) and all(
         r["state"] == "released" for r in rows.values()))
+    new_rows = [rows[students[n]] for n in NEW_AT]
     for student, row in rows.items():
-        # Graded once each; the content was graded before (alice's), so no grading ran again.
-        assert row["gradings"] == 1 and row["reused_from"] is not None, row
-        assert (row["score"], row["max_score"]) == (graded.score, graded.max_score), row
+        assert row["gradings"] == 1, row  # graded once each, the one cut short by the kill too
         with open(hub.course_dir / "feedback" / student / ASSIGNMENT / "submission_secret.txt") as handle:
             checksum = notebook_hash(secret=handle.read(), notebook_id=ASSIGNMENT)
         assert (hub.hub_dir / "exchange" / COURSE_ID / "feedback" / f"{checksum}.html").is_file(), student
-    # The instructor's plain grade run of one of them, from scratch, gives the same scores.
-    service_cells = store.recorded_results(hub.course_dir, ASSIGNMENT, students[0])[0].cells
-    hub.coursehub("grade", ASSIGNMENT, "--student", students[0], "--force")
-    plain = store.recorded_results(hub.course_dir, ASSIGNMENT, students[0])[0]
-    assert not plain.from_cache and plain.score == graded.score, plain
+        if row not in new_rows:  # alice's files: her grading reused
+            assert row["reused_from"] is not None and (row["score"], row["max_score"]) == (graded.score,
+                                                                                          graded.max_score), row
+    # Each content graded once: the new files in the sandbox for one of the first two only (the
+    # workers took both at once after the restart; the one to reach them first graded them, the other
+    # waited and reused that grading), then reused by the later two.
+    graded_new = [r["reused_from"] is None for r in new_rows]
+    assert sum(graded_new) == 1 and any(graded_new[:2]), new_rows
+    assert len({(r["content"], r["score"]) for r in new_rows}) == 1, new_rows
+    # Arrival order per worker: each worker took its rows oldest first, and so did both together.
+    by_claim = sorted(rows.values(), key=lambda r: r["claimed"])
+    assert [r["id"] for r in by_claim] == sorted(r["id"] for r in rows.values()), by_claim
+    assert {r["worker"] for r in rows.values()} == set(range(WORKERS)), by_claim
+
+    # The instructor's plain grade run of the new files, from scratch, gives the same scores.
+    service_cells = store.recorded_results(hub.course_dir, ASSIGNMENT, first)[0].cells
+    hub.coursehub("grade", ASSIGNMENT, "--student", first, "--force")
+    plain = store.recorded_results(hub.course_dir, ASSIGNMENT, first)[0]
+    assert not plain.from_cache and plain.score == new_rows[0]["score"] == plain.max_score, (plain, new_rows[0])
     assert [c["auto_score"] for c in plain.cells] == [c["auto_score"] for c in service_cells], (
         plain.cells, service_cells)
 

@@ -1,6 +1,7 @@
-"""Tests for course_lib.notebook.student_lab: a student's lab shows nbgrader's student side, and Validate
-on a lesson does not say "Success". (tests/test_browser.py checks the running lab's extensions,
-tests/test_browser_validate.py its Validate.)"""
+"""Tests for course_lib.notebook.student_lab: a student's lab shows nbgrader's student side, Validate
+on a lesson does not say "Success", and a refused Submit says why without a traceback.
+(tests/test_browser.py checks the running lab's extensions, tests/test_browser_validate.py its
+Validate, tests/test_hub.py a refused Submit's dialog.)"""
 
 import json
 import subprocess
@@ -51,3 +52,39 @@ def test_lessons_are_told_from_assignments(tmp_path):
     # What is not a notebook is left to nbgrader, which says what is wrong with it.
     (tmp_path / "broken.ipynb").write_text("{not json")
     assert not is_lesson_file(tmp_path / "broken.ipynb") and not is_lesson_file(tmp_path / "missing.ipynb")
+
+
+def test_the_lab_serves_the_assignments_panel_with_the_course_manager_instead_of_nbgraders():
+    from nbgrader.server_extensions.assignment_list import handlers as nbgrader_handlers
+
+    from course_lib.notebook.student_lab import assignment_list
+
+    enabled = json.loads((student_lab.CONFIG_DIR / "jupyter_server_config.json").read_text())["ServerApp"][
+        "jpserver_extensions"]
+    assert enabled["nbgrader.server_extensions.assignment_list"] is False
+    assert enabled["course_lib.notebook.student_lab.assignment_list"] is True
+    assert assignment_list._jupyter_server_extension_points() == [
+        {"module": "course_lib.notebook.student_lab.assignment_list"}]
+    assert issubclass(assignment_list.AssignmentList, nbgrader_handlers.AssignmentList)
+
+
+def _traceback_of(error: Exception) -> str:
+    import traceback
+
+    try:
+        raise error
+    except Exception:  # noqa: BLE001 - what nbgrader's panel formats
+        return traceback.format_exc()
+
+
+def test_a_refused_submit_shows_its_reason_alone_in_short_lines():
+    from nbgrader.exchange import ExchangeError
+
+    from course_lib.notebook.student_lab.assignment_list import LINE_WIDTH, refusal
+
+    reason = "brightness allows 2 graded submissions before the due date, and you have made 2: " * 2
+    shown = refusal(_traceback_of(ExchangeError(reason.strip() + "\nSee the page.")))
+    assert " ".join(shown.split()) == " ".join((reason + "See the page.").split()) and "Traceback" not in shown
+    assert shown.endswith("\nSee the page.") and max(len(line) for line in shown.splitlines()) <= LINE_WIDTH
+    # Not a refusal but a fault: nbgrader's traceback stays, for the instructor.
+    assert refusal(_traceback_of(KeyError("assignment_id"))) is None

@@ -25,17 +25,36 @@ def test_rows_are_claimed_in_arrival_order_and_each_by_one_worker(tmp_path):
         _add(queue, f"s{n:02d}", n)
     claimed, lock = [], threading.Lock()
 
-    def work():
-        while (row := queue.claim()) is not None:
+    def work(worker):
+        while (row := queue.claim(worker)) is not None:
             with lock:
                 claimed.append(row.student)
-    threads = [threading.Thread(target=work) for _ in range(4)]
+    threads = [threading.Thread(target=work, args=(n,)) for n in range(4)]
     for thread in threads:
         thread.start()
     for thread in threads:
         thread.join()
     assert sorted(claimed) == [f"s{n:02d}" for n in range(20)]  # each once
     assert {r.state for r in queue.all()} == {"grading"} and queue.busy()
+    # Each row says which worker took it, and when: the claims went oldest first.
+    rows = queue.all()
+    assert [r.claimed for r in rows] == list(range(1, 21)) and {r.worker for r in rows} <= set(range(4))
+
+
+def test_a_queue_file_of_the_first_version_gets_the_worker_columns(tmp_path):
+    import sqlite3
+
+    from autograder.submit_queue import SCHEMA
+
+    (tmp_path / "autograder").mkdir()
+    old = SCHEMA.replace("changed TEXT NOT NULL,", "changed TEXT NOT NULL").split("\n    worker")[0] + "\n)"
+    with sqlite3.connect(tmp_path / "autograder" / "submit_queue.sqlite") as db:
+        db.execute(old)
+        db.execute("INSERT INTO submissions (entry, student, assignment, submitted, attempt, state, changed) "
+                   "VALUES ('ann+brightness+1', 'ann', 'brightness', '2026-03-01', 1, 'queued', 'then')")
+    queue = SubmitQueue(tmp_path)
+    row = queue.claim(1)
+    assert (row.student, row.worker, row.claimed) == ("ann", 1, 1)
 
 
 def test_a_newer_submission_supersedes_the_queued_one_and_the_page_counts_who_is_ahead(tmp_path):

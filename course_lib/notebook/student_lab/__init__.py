@@ -11,7 +11,8 @@ never uses:
 - ``jupyter_server_config.json``: the server does not load the formgrader and course-list
   extensions behind them, and serves Validate with :mod:`course_lib.notebook.student_lab.validate` in
   place of nbgrader's extension (a lesson gets a short answer pointing at its self-check cells,
-  without a kernel; an assignment is validated by nbgrader).
+  without a kernel; an assignment is validated by nbgrader), and the Assignments panel with
+  :mod:`course_lib.notebook.student_lab.assignment_list` (a refused Submit shows its reason, not a traceback).
 
 The same with nbgrader's own commands, for a whole installation::
 
