@@ -27,6 +27,7 @@ LESSON = "02b_packages_launch_parameters.ipynb"
 
 #: The build cells of lessons 02b and 02: a notebook's `!` runs a command in a pseudo-terminal, where
 #: colcon's status line would print ten lines a second; a build that fails shows its errors in full.
+#: (In a terminal colcon also reminds of what it builds every 30 s: "[Processing: brightness]".)
 BUILD_02B = ("cd {WS} && colcon build --symlink-install --packages-select image_stats "
              "--event-handlers status- terminal_title-")
 BUILD_02 = ("cd {WS} && colcon build --symlink-install --packages-select brightness "
@@ -42,7 +43,8 @@ COMMANDS_02B = {
                                                      r"image_stats/package\.xml\nimage_stats/resource/image_stats\n"
                                                      r"image_stats/setup\.cfg\nimage_stats/setup\.py\n",
     "cd {WS}/src/image_stats && mkdir -p launch config": r"^$",
-    BUILD_02B: r"^Starting >>> image_stats\nFinished <<< image_stats \[[\d.]+s\]\n\nSummary: 1 package finished",
+    BUILD_02B: r"^Starting >>> image_stats\n(\[Processing: image_stats\]\n)*Finished <<< image_stats \[[\d.]+s\]\n\n"
+              r"Summary: 1 package finished",
     "ros2 pkg executables image_stats": r"^image_stats camera\nimage_stats dark_fraction\n$",
     "ros2 run image_stats camera --ros-args -r image:=/camera/image_raw -p rate:=10.0": None,
     "ros2 run image_stats dark_fraction --ros-args -r /image:=/camera/image_raw": None,
@@ -83,7 +85,8 @@ COMMANDS_02 = {
         r"package name: brightness\n(.*\n)*dependencies: \['rclpy', 'sensor_msgs', 'std_msgs'\]",
     'grep "<depend>" {WS}/src/brightness/package.xml': r"^  <depend>rclpy</depend>\n  <depend>sensor_msgs</depend>\n"
                                                        r"  <depend>std_msgs</depend>\n$",
-    BUILD_02: r"^Starting >>> brightness\nFinished <<< brightness \[[\d.]+s\]\n\nSummary: 1 package finished",
+    BUILD_02: r"^Starting >>> brightness\n(\[Processing: brightness\]\n)*Finished <<< brightness \[[\d.]+s\]\n\n"
+              r"Summary: 1 package finished",
     "ros2 pkg executables brightness": r"^brightness brightness_node\n$",
     "ros2 run brightness brightness_node --ros-args -r /image:=/camera/image_raw": None,
     "ros2 topic echo /brightness --once": r"^data: \d+\n---\n$",
