@@ -7,7 +7,7 @@
 #   make check   the inner loop (under 2 minutes): set up, lint as make test does, then run the tests
 #                that need no grading run, colcon build, browser, hub or notebook run
 #   make hub     set up, then run the course's JupyterHub for a class (root; course from
-#                `python -m coursehub create-course`, see README)
+#                `python -m coursehub create-course`, see docs/instructors.md)
 
 PYTHON ?= python3
 VENV   := .venv

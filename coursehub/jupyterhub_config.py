@@ -34,7 +34,7 @@ c.Spawner.default_url = "/lab"
 # bash with the course's rc file: ~/.bashrc, then the course's environment first again.
 c.Spawner.args = ["--ServerApp.terminado_settings="
                   + json.dumps({"shell_command": terminal.shell_command("/bin/bash")})]
-# Ten students logging in at once on two cores start in about a minute (README: capacity).
+# Ten students logging in at once on two cores start in about a minute (docs/instructors.md: Capacity).
 c.Spawner.start_timeout = 180
 c.Spawner.http_timeout = 180
 

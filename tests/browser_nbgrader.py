@@ -46,6 +46,8 @@ class Validation:
             validation did not run or raised (the text says why).
         error: nbgrader showed it as an error dialog (anything but success).
         seconds: time from the click until the dialog appeared.
+        labels: what the Validate button said from the click to the dialog, each change once
+            ("Saving...", "Validating...", "Validating: cell 3 of 20", ...).
     """
 
     title: str
@@ -53,6 +55,22 @@ class Validation:
     outcome: str
     error: bool
     seconds: float
+    labels: list[str] = dataclasses.field(default_factory=list)
+
+
+# Records each label the Validate button shows (nbgrader and the course's progress both set the
+# label's innerText) in window.validateLabels, until the next call.
+_WATCH_LABELS_JS = """(buttonSelector) => {
+  const button = document.querySelector(buttonSelector);
+  const label = () => button.querySelector('.jp-ToolbarButtonComponent-label').innerText.trim();
+  window.validateLabels = [label()];
+  if (window.validateLabelsObserver) window.validateLabelsObserver.disconnect();
+  window.validateLabelsObserver = new MutationObserver(() => {
+    const now = label();
+    if (now !== window.validateLabels[window.validateLabels.length - 1]) window.validateLabels.push(now);
+  });
+  window.validateLabelsObserver.observe(button, {childList: true, characterData: true, subtree: true});
+}"""
 
 
 def validate(page, timeout: float, screenshot: Path | None = None) -> Validation:
@@ -68,6 +86,7 @@ def validate(page, timeout: float, screenshot: Path | None = None) -> Validation
     """
     from playwright.sync_api import TimeoutError as PlaywrightTimeout
 
+    page.evaluate(_WATCH_LABELS_JS, f"{NOTEBOOK} .validate-button")
     started = time.monotonic()
     click_toolbar_button(page, "Validate")
     try:
@@ -77,6 +96,7 @@ def validate(page, timeout: float, screenshot: Path | None = None) -> Validation
         raise TimeoutError(f"no nbgrader dialog {timeout:.0f} s after pressing Validate; the button says "
                            f"{label!r} (\"Validating...\": the server is still running the notebook)") from None
     seconds = time.monotonic() - started
+    labels = page.evaluate("() => window.validateLabels")
     page.wait_for_timeout(300)  # the dialog fades in; let the screenshot show it settled
     said = page.evaluate(_VALIDATE_DIALOG_JS, _VALIDATE_DIALOG)
     if screenshot is not None:
@@ -85,7 +105,7 @@ def validate(page, timeout: float, screenshot: Path | None = None) -> Validation
     page.locator(_VALIDATE_DIALOG).locator(".jp-mod-accept").first.click()
     page.locator(_VALIDATE_DIALOG).first.wait_for(state="detached", timeout=60_000)
     return Validation(title=said["title"].strip(), text=said["text"].strip(), outcome=said["outcome"],
-                      error=said["error"], seconds=seconds)
+                      error=said["error"], seconds=seconds, labels=labels)
 
 
 ASSIGNMENT_LISTS = ("released", "fetched", "submitted")

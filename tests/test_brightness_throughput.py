@@ -48,3 +48,18 @@ def test_costs_add_up_over_bursts():
     total.add(0.3, 6)
     total.add(-0.01, 0)  # a process tree that lost a member reads less: never negative
     assert (total.seconds, total.frames) == (0.5, 10) and total.per_frame() == 0.05
+
+
+def test_a_node_that_answers_but_never_right_is_told_to_fix_its_values_not_its_speed():
+    """A node that publishes 0 for every frame has no right answer to count its speed by: the
+    item fails, and says the values are wrong instead of "too slow ... a Python loop"."""
+    from course_lib.checks.brightness_throughput import throughput_item
+
+    passed, words = throughput_item(throughput_verdict(cost(0.54, 0), YARDSTICK), cost(0.54, 0), YARDSTICK, answered=30)
+    assert not passed and "answered 30 frames of the bursts, none with the right brightness" in words, words
+    assert "too slow" not in words and "Python loop" not in words, words
+    # A node too slow to answer any frame in the bursts is slow, as before.
+    passed, words = throughput_item(throughput_verdict(cost(2.5, 0), YARDSTICK), cost(2.5, 0), YARDSTICK, answered=0)
+    assert not passed and words.startswith("too slow:"), words
+    passed, words = throughput_item(True, cost(0.6, 60), YARDSTICK, answered=60)
+    assert passed and "within" in words, words

@@ -13,6 +13,7 @@ started may be left running. A lesson (lesson/, no graded cells) gets a short an
 Screenshots go to artifacts/browser/validate_<student>.png, validate_lesson.png and assignment_list.png.
 """
 
+import json
 import re
 import shutil
 import sys
@@ -107,7 +108,8 @@ def validate_in_lab(browser, lab, path, screenshot):
         left = kernels_left(lab, before)
     finally:
         close_notebook(page, lab, path)
-    print(f"\n{path}: Validate answered after {result.seconds:.1f} s: {result.title}\n{result.text}")
+    print(f"\n{path}: Validate answered after {result.seconds:.1f} s: {result.title}\n{result.text}\n"
+          f"the button said: {result.labels}")
     assert not left, f"Validate on {path} left kernels running:\n" + "\n".join(left)
     return result
 
@@ -125,6 +127,22 @@ def test_validate_says_success_for_the_reference_solution(browser, lab):
     # nbgrader ran the notebook in the student's folder: that is where the module was written.
     assert (lab.root_dir / "correct" / "ros2_ws" / "install" / "brightness").is_dir()
     assert not (lab.root_dir / "ros2_ws").exists()
+    # While it ran (13-18 s), the button said which cell runs, not only "Validating...".
+    assert_button_followed_the_cells(result, lab.root_dir / "correct" / f"{ASSIGNMENT}.ipynb")
+
+
+def assert_button_followed_the_cells(result, notebook: Path) -> None:
+    """The Validate button said "Validating: cell k of m" with m the notebook's code cells and k
+    never going back, and "Validate" again at the end."""
+    from course_lib.notebook.student_lab.validate_progress import code_cells
+
+    cells = len(code_cells(json.loads(notebook.read_text())))
+    shown = [re.fullmatch(r"Validating: cell (\d+) of (\d+)(, then the results)?", label) for label in result.labels]
+    counted = [(int(found[1]), int(found[2])) for found in shown if found]
+    assert counted, f"the button never said which cell runs: {result.labels}"
+    assert {of for _, of in counted} == {cells}, (cells, result.labels)
+    assert [cell for cell, _ in counted] == sorted(cell for cell, _ in counted), result.labels
+    assert result.labels[-1] == "Validate", result.labels
 
 
 @pytest.mark.timeout(VALIDATE_TIMEOUT + 300)

@@ -17,12 +17,21 @@ import subprocess
 from pathlib import Path
 
 import lesson_answers
+import pexpect
 import pytest
 
 from course_lib.ros import colcon, pkg_create, processes, rosenv, session, workspace
 
 NOTEBOOKS = Path(__file__).resolve().parents[1] / "notebooks"
 LESSON = "02b_packages_launch_parameters.ipynb"
+
+#: The build cells of lessons 02b and 02: a notebook's `!` runs a command in a pseudo-terminal, where
+#: colcon's status line would print ten lines a second; a build that fails shows its errors in full.
+#: (In a terminal colcon also reminds of what it builds every 30 s: "[Processing: brightness]".)
+BUILD_02B = ("cd {WS} && colcon build --symlink-install --packages-select image_stats "
+             "--event-handlers status- terminal_title-")
+BUILD_02 = ("cd {WS} && colcon build --symlink-install --packages-select brightness "
+            "--event-handlers status- terminal_title-")
 
 #: Lesson 02b's commands, in the lesson's order: the command ({WS}: the workspace) -> a pattern
 #: its output must contain (None: a long-running command started in the background).
@@ -34,8 +43,8 @@ COMMANDS_02B = {
                                                      r"image_stats/package\.xml\nimage_stats/resource/image_stats\n"
                                                      r"image_stats/setup\.cfg\nimage_stats/setup\.py\n",
     "cd {WS}/src/image_stats && mkdir -p launch config": r"^$",
-    "cd {WS} && colcon build --symlink-install --packages-select image_stats 2>&1 | tail -n 3":
-        r"Summary: 1 package finished",
+    BUILD_02B: r"^Starting >>> image_stats\n(\[Processing: image_stats\]\n)*Finished <<< image_stats \[[\d.]+s\]\n\n"
+              r"Summary: 1 package finished",
     "ros2 pkg executables image_stats": r"^image_stats camera\nimage_stats dark_fraction\n$",
     "ros2 run image_stats camera --ros-args -r image:=/camera/image_raw -p rate:=10.0": None,
     "ros2 run image_stats dark_fraction --ros-args -r /image:=/camera/image_raw": None,
@@ -76,8 +85,8 @@ COMMANDS_02 = {
         r"package name: brightness\n(.*\n)*dependencies: \['rclpy', 'sensor_msgs', 'std_msgs'\]",
     'grep "<depend>" {WS}/src/brightness/package.xml': r"^  <depend>rclpy</depend>\n  <depend>sensor_msgs</depend>\n"
                                                        r"  <depend>std_msgs</depend>\n$",
-    "cd {WS} && colcon build --symlink-install --packages-select brightness 2>&1 | tail -n 3":
-        r"Summary: 1 package finished",
+    BUILD_02: r"^Starting >>> brightness\n(\[Processing: brightness\]\n)*Finished <<< brightness \[[\d.]+s\]\n\n"
+              r"Summary: 1 package finished",
     "ros2 pkg executables brightness": r"^brightness brightness_node\n$",
     "ros2 run brightness brightness_node --ros-args -r /image:=/camera/image_raw": None,
     "ros2 topic echo /brightness --once": r"^data: \d+\n---\n$",
@@ -123,6 +132,16 @@ def run_shell(command: str, ws: Path, env: dict) -> str:
     return done.stdout + done.stderr  # what the terminal shows (ros2 param set prints a refusal to stderr)
 
 
+def run_in_notebook(command: str, ws: Path, env: dict) -> tuple[str, int]:
+    """(output, exit code) of `!command` in a notebook: IPython runs it with pexpect, in a
+    pseudo-terminal, so the program sees a terminal; stdout and stderr arrive as one."""
+    line = command.split("#")[0].replace("{WS}", str(ws))
+    child = pexpect.spawn("bash", ["-c", line], env=env, timeout=120, encoding="utf-8", codec_errors="replace")
+    output = child.read()
+    child.close()
+    return output.replace("\r\n", "\n"), child.exitstatus
+
+
 def run_together(commands, ws: Path, env: dict) -> dict[str, str]:
     """{command: output} of commands started at once (most of a `ros2` command's time is waiting for
     discovery, so side by side they take little longer than one)."""
@@ -155,6 +174,9 @@ def built(tmp_path_factory):
             for path, text in files.items():  # the %%writefile cells ran before the build
                 (root / path).parent.mkdir(parents=True, exist_ok=True)
                 (root / path).write_text(text)
+            outputs[command], code = run_in_notebook(command, ws, env)
+            assert code == 0, outputs[command]
+            continue
         outputs[command] = run_shell(command, ws, env)
     # Lesson 02's exercise: the package brightness, in the same workspace, with a right answer.
     files = lesson_answers.lesson_files(LESSON_02)
@@ -165,6 +187,9 @@ def built(tmp_path_factory):
         if command.startswith("cd {WS} && colcon"):
             for path, text in files.items():
                 (ws / Path(path).relative_to("brightness_ws")).write_text(text)
+            outputs[command], code = run_in_notebook(command, ws, env)
+            assert code == 0, outputs[command]
+            continue
         if command.startswith("ros2 pkg executables"):
             env = workspace.workspace_environment(ws)
         outputs[command] = run_shell(command, ws, env)
@@ -189,6 +214,20 @@ def test_create_and_build_commands(built):
         check(command, output, COMMANDS_02B if command in COMMANDS_02B else COMMANDS_02)
     command = "ros2 pkg executables image_stats"
     check(command, run_shell(command, ws, env))
+
+
+@pytest.mark.slow
+def test_build_cell_shows_a_setup_py_syntax_error_in_full(tmp_path):
+    """Lesson 02's build cell on a setup.py that lacks a comma prints Python's words for it (the
+    last lines of colcon's output hold only its own traceback and summary)."""
+    ws = tmp_path / "brightness_ws"
+    pkg_create.create_package(ws, "brightness", dependencies=["rclpy", "sensor_msgs", "std_msgs"])
+    setup = ws / "src/brightness/setup.py"
+    setup.write_text(setup.read_text().replace("zip_safe=True,", "zip_safe=True"))
+    output, code = run_in_notebook(BUILD_02, ws, dict(os.environ))
+    assert code != 0, output
+    assert "SyntaxError: invalid syntax. Perhaps you forgot a comma?" in output, output
+    assert "Failed   <<< brightness" in output, output
 
 
 def start(command: str, env: dict) -> processes.NodeProcess:

@@ -1,5 +1,5 @@
-"""Repository hygiene: notebooks are committed clean, build products are never committed, and the
-course's packages import each other without cycles."""
+"""Repository hygiene: notebooks are committed clean, build products are never committed, the
+documents' links lead somewhere, and the course's packages import each other without cycles."""
 
 import ast
 import functools
@@ -45,6 +45,31 @@ def test_no_environment_or_colcon_output_is_committed():
 def test_ci_runs_the_readme_test_command():
     assert "make test" in (ROOT / ".ci" / "run").read_text()
     assert "make test" in (ROOT / "README.md").read_text()
+
+
+def heading_anchors(markdown: str) -> set[str]:
+    """The anchors GitHub gives a document's headings: lower case, punctuation dropped, spaces as -."""
+    text = re.sub(r"```.*?```", "", markdown, flags=re.S)
+    return {re.sub(r"[^\w\- ]", "", heading.strip().lower()).replace(" ", "-")
+            for heading in re.findall(r"^#{1,6} (.+)$", text, re.M)}
+
+
+def test_links_of_the_readme_and_the_guides_lead_to_a_file_and_heading():
+    """Every relative link of README.md, docs/ and the folders' READMEs names a file that exists and,
+    with #anchor, a heading of it (the README was split into the guides by reader)."""
+    documents = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md")), ROOT / "assignments" / "README.md",
+                 ROOT / "deploy" / "README.md"]
+    broken = []
+    for document in documents:
+        for target in re.findall(r"\]\(([^)\s]+)\)", document.read_text()):
+            if re.match(r"[a-z]+:", target):
+                continue  # https:, mailto:
+            path, _, anchor = target.partition("#")
+            linked = (document.parent / path).resolve() if path else document
+            if not linked.exists() or (anchor and linked.is_file()
+                                       and anchor not in heading_anchors(linked.read_text())):
+                broken.append(f"{document.relative_to(ROOT)}: {target}")
+    assert not broken, broken
 
 
 # --- the course's packages depend on each other in one direction --------------------------------

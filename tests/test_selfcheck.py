@@ -101,6 +101,14 @@ def test_task3_names_what_is_wrong(wrong, named):
     assert not verdict and named in str(verdict)
 
 
+def test_task3_shows_a_numpy_answer_as_python_shows_it():
+    """uint8 arithmetic that wraps answers np.True_: the verdict says True (and keeps np.uint8 for the arguments)."""
+    verdict = str(selfcheck.task3_brightness_on_change(lambda last, current, threshold:
+                                                       last is None or abs(current - last) > threshold))
+    assert "returned True, expected False" in verdict and "np.True_" not in verdict, verdict
+    assert "np.uint8(103)" in verdict, verdict
+
+
 # --- Task 4 (lesson 03): order four shuffled corners ------------------------------------------
 
 def _order_by_angle(points):

@@ -134,6 +134,10 @@ def test_the_wheel_holds_the_student_package_only(wheel_files):
     assert tops == {"course_lib"}
     assert "course_lib/checks/brightness.py" in wheel_files
     assert "course_lib/checks/recorded/brightness.json" in wheel_files
+    # The student lab's Validate progress: its configuration and lab extension.
+    lab = "course_lib/notebook/student_lab/"
+    assert {lab + "jupyter_server_config.py", lab + "labextensions/@course-lib/validate-progress/package.json",
+            lab + "labextensions/@course-lib/validate-progress/static/remoteEntry.js"} <= set(wheel_files)
 
 
 @pytest.mark.slow

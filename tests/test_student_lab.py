@@ -88,3 +88,36 @@ def test_a_refused_submit_shows_its_reason_alone_in_short_lines():
     assert shown.endswith("\nSee the page.") and max(len(line) for line in shown.splitlines()) <= LINE_WIDTH
     # Not a refusal but a fault: nbgrader's traceback stays, for the instructor.
     assert refusal(_traceback_of(KeyError("assignment_id"))) is None
+
+
+def test_validate_progress_counts_the_code_cells_the_validation_runs():
+    """The step Validate's button shows: 0 of m before the first cell (the kernel starts), then each
+    code cell nbclient runs; empty code cells and markdown are not counted; nothing once it ended."""
+    from course_lib.notebook.student_lab.validate_progress import ValidateProgress
+
+    notebook = nbformat.v4.new_notebook(cells=[
+        nbformat.v4.new_markdown_cell("# Title"), nbformat.v4.new_code_cell("import os\nx = 1"),
+        nbformat.v4.new_code_cell("  \n"), nbformat.v4.new_code_cell("checks.selfcheck('node')")])
+    progress = ValidateProgress()
+    assert progress.of("a/b.ipynb") == {"running": False}
+    progress.start("a/b.ipynb", notebook)
+    assert progress.of("a/b.ipynb") == {"running": True, "cell": 0, "cells": 2, "line": ""}
+    hook = progress.hook("a/b.ipynb")
+    hook(cell=notebook.cells[1], cell_index=1)
+    assert progress.of("a/b.ipynb") == {"running": True, "cell": 1, "cells": 2, "line": "import os"}
+    hook(cell=notebook.cells[3], cell_index=3)
+    assert progress.of("a/b.ipynb")["cell"] == 2 and progress.of("other.ipynb") == {"running": False}
+    progress.finish("a/b.ipynb")
+    assert progress.of("a/b.ipynb") == {"running": False}
+
+
+def test_the_lab_loads_the_validate_progress_extension_from_the_student_config():
+    """Jupyter reads jupyter_server_config.py on the student's config path, which names the folder
+    of the lab extension; JupyterLab finds the extension there (its script is served from it)."""
+    from jupyterlab_server.config import get_federated_extensions
+    from traitlets.config.loader import PyFileConfigLoader
+
+    config = PyFileConfigLoader("jupyter_server_config.py", path=str(student_lab.CONFIG_DIR)).load_config()
+    found = get_federated_extensions(config.LabApp.extra_labextensions_path)
+    extension = found["@course-lib/validate-progress"]
+    assert (Path(extension["ext_path"]) / extension["jupyterlab"]["_build"]["load"]).is_file()

@@ -157,27 +157,40 @@ def measure(ctx, probe, node, yardstick, publisher, replies, yardstick_replies, 
         return
     frames = [image_msgs.image_to_msg(i, "bgr8") for i in images]
     student, reference = CpuCost(), CpuCost()
-    verdict = None
+    verdict, answered = None, 0
     for _ in range(THROUGHPUT_BURSTS):
         student_before, yardstick_before = node.cpu_seconds(), yardstick.cpu_seconds()
         _burst(probe, publisher, replies, yardstick_replies, frames)
+        answered += len(replies)
         student.add(node.cpu_seconds() - student_before, sum(1 for value in replies if value in expected))
         reference.add(yardstick.cpu_seconds() - yardstick_before, len(yardstick_replies))
         verdict = throughput_verdict(student, reference)
         if verdict is not None or not node.running():
             break
+    passed, words = throughput_item(verdict, student, reference, answered)
+    ctx.item(passed, f"{label}: {words}", weight=2.0)
+
+
+def throughput_item(verdict: bool | None, student: CpuCost, reference: CpuCost, answered: int) -> tuple[bool, str]:
+    """The throughput check's item from its verdict (throughput_verdict): passed, and what it says.
+
+    Args:
+        answered: the student's node's answers in the bursts, right or wrong. A node that answered
+            but never right is not called slow: its values are what to fix.
+    """
     measured = (f"your node used {1000 * student.per_frame():.1f} ms of processor time per frame it answered right "
                 f"({student.frames} frames, {student.seconds:.2f} s in all); the grader's yardstick node, which does "
                 f"one numpy sum per frame, used {1000 * reference.per_frame():.1f} ms per frame ({reference.frames} "
                 "frames) of the same bursts")
     if verdict is None:
-        ctx.item(True, f"{label}: not measured, too few frames arrived ({measured}); not held against you",
-                 weight=2.0)
-    elif verdict:
-        ctx.item(True, f"{label}: {measured}: within {THROUGHPUT_CPU_RATIO:g} times the yardstick's cost per frame",
-                 weight=2.0)
-    else:
-        ctx.item(False, f"{label}: too slow: {measured}; at most {THROUGHPUT_CPU_RATIO:g} times the yardstick's "
-                        "cost per frame is allowed. The node answers single frames right but cannot keep up with "
-                        "30 Hz: it has 33 ms per frame of 6 million bytes, which whole-array numpy operations manage "
-                        "and a Python loop over the bytes does not", weight=2.0)
+        return True, f"not measured, too few frames arrived ({measured}); not held against you"
+    if verdict:
+        return True, f"{measured}: within {THROUGHPUT_CPU_RATIO:g} times the yardstick's cost per frame"
+    if student.frames == 0 and answered:
+        return False, (f"the node answered {answered} frames of the bursts, none with the right brightness, so "
+                       "none counts towards its speed: fix the values it publishes first (the items above say what "
+                       "it sent)")
+    return False, (f"too slow: {measured}; at most {THROUGHPUT_CPU_RATIO:g} times the yardstick's "
+                   "cost per frame is allowed. The node answers single frames right but cannot keep up with "
+                   "30 Hz: it has 33 ms per frame of 6 million bytes, which whole-array numpy operations manage "
+                   "and a Python loop over the bytes does not")

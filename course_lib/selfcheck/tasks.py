@@ -100,7 +100,9 @@ def task3_brightness_on_change(function) -> Verdict:
         if problem is not None:
             return problem
         if answer is None or bool(answer) != expected:
-            return _verdict(False, f"should_publish({last_sent!r}, {current!r}, {threshold}) returned {answer!r}, "
+            # A numpy bool shows as Python's (np.True_ reads as a typo); the arguments keep their np.uint8.
+            shown = answer.item() if hasattr(answer, "item") and hasattr(answer, "dtype") else answer
+            return _verdict(False, f"should_publish({last_sent!r}, {current!r}, {threshold}) returned {shown!r}, "
                                    f"expected {expected}: {why}.")
     return _verdict(True, "should_publish publishes the first value and every change of more than threshold, "
                           "up or down, and no other.")

@@ -1,9 +1,9 @@
 """What a student's JupyterLab shows: nbgrader's student side only, and a Validate that is honest
-about lessons.
+about lessons and says which cell it runs.
 
 ``make lab`` puts this folder on ``JUPYTER_CONFIG_PATH`` (a JupyterHub for students can do the
-same). Two configuration files in it switch off nbgrader's instructor side, which a student
-never uses:
+same). The configuration files in it switch off nbgrader's instructor side, which a student
+never uses, and say what Validate does:
 
 - ``labconfig/page_config.json``: JupyterLab leaves out the "Create Assignment" sidebar, the
   formgrader and the course list (the Nbgrader menu keeps "Assignment List", and notebooks keep
@@ -11,8 +11,11 @@ never uses:
 - ``jupyter_server_config.json``: the server does not load the formgrader and course-list
   extensions behind them, and serves Validate with :mod:`course_lib.notebook.student_lab.validate` in
   place of nbgrader's extension (a lesson gets a short answer pointing at its self-check cells,
-  without a kernel; an assignment is validated by nbgrader), and the Assignments panel with
-  :mod:`course_lib.notebook.student_lab.assignment_list` (a refused Submit shows its reason, not a traceback).
+  without a kernel; an assignment is validated by nbgrader, in a thread), and the Assignments panel
+  with :mod:`course_lib.notebook.student_lab.assignment_list` (a refused Submit shows its reason, not a
+  traceback);
+- ``jupyter_server_config.py``: JupyterLab also loads the lab extension in ``labextensions/``,
+  which shows on the Validate button which cell the validation runs (``validate_progress``).
 
 The same with nbgrader's own commands, for a whole installation::
 
