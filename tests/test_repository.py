@@ -224,3 +224,18 @@ def test_every_short_name_is_a_module_of_course_lib():
     from course_lib.imaging import drawing  # course_lib.imaging is imported first, as in a lesson
 
     assert course_lib.vision is drawing
+
+
+def test_every_course_lib_module_the_lessons_and_guides_name_exists():
+    """A dotted name that a lesson, an assignment notebook or a guide runs (``python -m
+    course_lib.x``, ``"course_lib.x:main"`` for processes.python_node) is a module of course_lib:
+    the move into subpackages left lesson 05's camera at a name that no longer imported."""
+    import importlib.util
+
+    pattern = re.compile(r"(?:python -m |[\"'])(course_lib(?:\.\w+)+)(?::\w+)?")
+    texts = [*ROOT.glob("notebooks/*.ipynb"), *ROOT.glob("assignments/source/*/*.ipynb"), *ROOT.glob("docs/*.md"),
+             ROOT / "README.md"]
+    named = {(path.name, name) for path in texts for name in pattern.findall(path.read_text())}
+    assert ("05_recording_and_replaying.ipynb", "course_lib.imaging.camera") in named
+    missing = sorted((file, name) for file, name in named if importlib.util.find_spec(name) is None)
+    assert not missing, f"no such module: {missing}"
