@@ -82,8 +82,12 @@ class Hub:
                 self.process.kill()
                 self.process.wait(10)
 
-    def log_tail(self, lines: int = 40) -> str:
-        return "\n".join(self.log.read_text(errors="replace").splitlines()[-lines:])
+    def log_tail(self, lines: int = 60) -> str:
+        """The hub log's last lines, without the proxy's repeated "404 GET" and connection errors (a
+        service's traceback is what says why a hub did not come up)."""
+        noise = ("[ConfigProxy]", "    at ", "  errno:", "  code:", "  syscall:", "  address:", "  port:", "}")
+        kept = [line for line in self.log.read_text(errors="replace").splitlines() if not line.startswith(noise)]
+        return "\n".join(kept[-lines:])
 
 
 def coursehub(hub_dir: Path, *args: str, timeout: float = 600) -> str:
@@ -97,19 +101,24 @@ def coursehub(hub_dir: Path, *args: str, timeout: float = 600) -> str:
 
 
 def free_port_pair() -> int:
-    """A free port p whose neighbour p + 1 (the proxy's API) is free too."""
+    """A free port p whose neighbour p + 1 (the proxy's API, the grading service) is free too, below
+    the kernel's ephemeral range: a port from bind(("127.0.0.1", 0)) is one the kernel also hands
+    to any program's outgoing connection, which can take p + 1 between this check and the grading
+    service's listen() (a clean-clone run saw the service exit with status 1 as the hub started,
+    and the hub never answered)."""
+    import random
     import socket
 
-    for _ in range(50):
-        with socket.socket() as first:
-            first.bind(("127.0.0.1", 0))
-            port = first.getsockname()[1]
-            with socket.socket() as second:
-                try:
-                    second.bind(("127.0.0.1", port + 1))
-                except OSError:
-                    continue
-            return port
+    low = int(Path("/proc/sys/net/ipv4/ip_local_port_range").read_text().split()[0])
+    for _ in range(200):
+        port = random.randrange(max(1024, low - 12000), low - 2)
+        try:
+            with socket.socket() as first, socket.socket() as second:
+                first.bind(("127.0.0.1", port))
+                second.bind(("127.0.0.1", port + 1))
+        except OSError:
+            continue
+        return port
     raise RuntimeError("no two neighbouring free ports on 127.0.0.1")
 
 
