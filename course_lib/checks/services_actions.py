@@ -49,17 +49,6 @@ def grade(name: str):
     return runner.grade(ASSIGNMENT, name)
 
 
-def expected_search(start: float, pictures) -> list[float]:
-    """The angles the camera looks at after each step of a search from `start` for `pictures`
-    (empty when they are framed at `start` already); the last is where it stops."""
-    wanted = set(pictures) or {"cat", "dog"}
-    pans, pan = [], pan_camera.wrap(start)
-    while not wanted <= set(pan_camera.framed_at(pan)) and len(pans) < round(360 / pan_camera.STEP_DEGREES):
-        pan = pan_camera.wrap(pan + pan_camera.STEP_DEGREES)
-        pans.append(pan)
-    return pans
-
-
 def _start(ctx, start_pan: float | None = None):
     """``ros2 run pan_camera pan_camera_node [--ros-args -p start_pan:=...]``, and its node in the graph."""
     args = () if start_pan is None else ("-p", f"start_pan:={start_pan:.1f}")
@@ -168,7 +157,7 @@ def action(ctx: Context) -> None:
 
     start = round(float(ctx.rng.uniform(-58.0, -30.0)), 1)
     pictures = [["cat"], ["dog"], []][int(ctx.rng.integers(3))]
-    expected = expected_search(start, pictures)
+    expected = pan_camera.search_pans(start, pictures)
     proc = _start(ctx, start)
     packages.use_interfaces(ctx)
     feedback = []
@@ -224,7 +213,7 @@ def cancel(ctx: Context) -> None:
     from action_msgs.msg import GoalStatus
 
     start = round(float(ctx.rng.uniform(-170.0, -120.0)), 1)
-    steps = len(expected_search(start, []))
+    steps = len(pan_camera.search_pans(start, []))
     proc = _start(ctx, start)
     packages.use_interfaces(ctx)
     feedback, canceling = [], []
@@ -237,8 +226,8 @@ def cancel(ctx: Context) -> None:
             ctx.item(False, why, weight=2)
             return
         ctx.waiting_on("the first feedback")
-        gives_up = ctx.no_answer_coming(proc, 5.0)
-        probe.spin_until(lambda: bool(feedback) or not proc.running() or gives_up(), scaled(10.0))
+        gives_up, done = ctx.no_answer_coming(proc, 5.0), handle.get_result_async()
+        probe.spin_until(lambda: bool(feedback) or done.done() or not proc.running() or gives_up(), scaled(10.0))
         if not feedback:
             ctx.item(False, "no feedback arrived, so the check could not cancel after the first step: publish "
                             "feedback after every step", weight=2)

@@ -88,3 +88,16 @@ def frame_at(pan: float) -> np.ndarray:
     pan = wrap(pan)
     shown = max(-_OUT_OF_VIEW + 1, min(_OUT_OF_VIEW - 1, pan))  # beyond: the board is off the frame anyway
     return scenes.render_scene(0, size=FRAME_SIZE, pose=pose_at(shown), look=Look()).frame
+
+
+def search_pans(start: float, pictures) -> list[float]:
+    """The angles a search turns to, a step of STEP_DEGREES at a time from `start`, until every
+    one of `pictures` (empty: both) is framed: what its feedback says, the last being where it
+    stops (no step when they are framed at `start`; a whole turn at most)."""
+    wanted = set(pictures) or set(PICTURES)
+    markers_of(wanted)  # a name that is no picture: ValueError naming the pictures
+    pans, pan = [], wrap(start)
+    while not wanted <= set(framed_at(pan)) and len(pans) < round(360 / STEP_DEGREES):
+        pan = wrap(pan + STEP_DEGREES)
+        pans.append(pan)
+    return pans
