@@ -3,8 +3,8 @@ keeps the feedback, judged against an action server the check runs in the notebo
 
 The check's server is a real rclpy ActionServer under an action name of its own (so the lesson's
 ``/find_pictures`` process is not disturbed); it turns a pan camera of its own from CHECK_START
-without pausing between steps (a check must be instant) and publishes feedback after each step,
-as the lesson's server does.
+and publishes feedback after each step, a step taking STEP_SECONDS as in the lesson's server (a
+burst of feedback without pause loses messages in rclpy's action client: about 1 s in all).
 """
 
 from __future__ import annotations
@@ -18,25 +18,45 @@ CHECK_ACTION = "/selfcheck/find_pictures"
 CHECK_START = pan_camera.START_PAN
 
 
-def _check_server(action_type):
-    """A FindPictures server in the session at CHECK_ACTION (its node is returned; remove it after)."""
-    from rclpy.action import ActionServer
-    from rclpy.node import Node
+class _CheckServer:
+    """A FindPictures server at CHECK_ACTION, spun by an executor of its own in a thread (so its
+    execute may take the head's STEP_SECONDS per step, as the lesson's server does, without
+    holding up the session's executor, which runs the student's client); close() ends it."""
 
-    from course_lib.ros import session
+    def __init__(self, action_type):
+        import threading
 
-    node = session.add_node(Node("selfcheck_find_pictures"))
-    state = {"pan": CHECK_START}
+        from rclpy.action import ActionServer
+        from rclpy.executors import SingleThreadedExecutor
+        from rclpy.node import Node
 
-    def execute(goal_handle):
-        for pan in pan_camera.search_pans(state["pan"], goal_handle.request.pictures):
-            state["pan"] = pan
-            goal_handle.publish_feedback(action_type.Feedback(pan=pan, ids=list(pan_camera.markers_in_view(pan))))
+        from course_lib.ros import session
+
+        session.start()  # the default context the student's client uses
+        self.pan = CHECK_START
+        self.action_type = action_type
+        self.node = Node("selfcheck_find_pictures")
+        self.server = ActionServer(self.node, action_type, CHECK_ACTION, self.execute)
+        self.executor = SingleThreadedExecutor(context=self.node.context)
+        self.executor.add_node(self.node)
+        self.thread = threading.Thread(target=self.executor.spin, name="selfcheck.find_pictures", daemon=True)
+        self.thread.start()
+
+    def execute(self, goal_handle):
+        import time
+
+        for pan in pan_camera.search_pans(self.pan, goal_handle.request.pictures):
+            time.sleep(pan_camera.STEP_SECONDS)  # the head turning (its feedback comes a step apart)
+            self.pan = pan
+            goal_handle.publish_feedback(self.action_type.Feedback(pan=pan, ids=list(pan_camera.markers_in_view(pan))))
         goal_handle.succeed()
-        return action_type.Result(pan=state["pan"], framed=list(pan_camera.framed_at(state["pan"])))
+        return self.action_type.Result(pan=self.pan, framed=list(pan_camera.framed_at(self.pan)))
 
-    node.server = ActionServer(node, action_type, CHECK_ACTION, execute)
-    return node
+    def close(self) -> None:
+        self.executor.shutdown(timeout_sec=2.0)
+        self.thread.join(timeout=2.0)
+        self.server.destroy()
+        self.node.destroy_node()
 
 
 @progress.while_running("self-check: sending your goal")
@@ -51,7 +71,7 @@ def find_pictures_exercise(find_pictures, action_type) -> Verdict:
             "(result, pans).")
     if (problem := _not_a_function(find_pictures, "find_pictures", hint)) is not None:
         return problem
-    server = _check_server(action_type)
+    server = _CheckServer(action_type)
     client_node = None
     try:
         from rclpy.node import Node
@@ -74,9 +94,9 @@ def find_pictures_exercise(find_pictures, action_type) -> Verdict:
         if not isinstance(pans, list) or not pans:
             return _verdict(False, f"The second of the pair is {pans!r}: collect feedback.pan of every feedback "
                                    "message in a list (the feedback_callback gets a message whose .feedback has it).")
-        # Feedback (a topic) and the result (a service) travel apart: the last feedback messages
+        # Feedback (a topic) and the result (a service) travel apart: the last feedback message
         # may reach the callback just after find_pictures returned, into the same list.
-        session.wait_for(lambda: len(pans) >= len(expected), timeout=2.0)
+        session.wait_for(lambda: len(pans) >= len(expected), timeout=5.0)
         if [round(p, 6) for p in pans] != [round(p, 6) for p in expected]:
             return _verdict(False, f"The feedback pans were {[round(p, 1) for p in expected]}, your list holds "
                                    f"{[round(p, 1) for p in pans]}: append feedback.pan once per feedback message.")
@@ -87,9 +107,9 @@ def find_pictures_exercise(find_pictures, action_type) -> Verdict:
                               f"({pans[0]:g} ... {pans[-1]:g}) and returned the result: the cat is framed at pan "
                               f"{result.pan:g}. In a terminal: ros2 action send_goal --feedback ...")
     finally:
-        for node in (client_node, server):
-            if node is not None:
-                try:
-                    session.remove_node(node)
-                except ValueError:  # the student's code removed it already
-                    pass
+        server.close()
+        if client_node is not None:
+            try:
+                session.remove_node(client_node)
+            except ValueError:  # the student's code removed it already
+                pass
