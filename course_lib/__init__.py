@@ -29,7 +29,8 @@ SHORT_NAMES = {
     **{name: f"supervision.{name}" for name in (
         "bounded_log", "process_limits", "process_registry", "process_tree", "supervised_process", "supervisor")},
     **{name: f"imaging.{name}" for name in (
-        "boards", "camera", "camera_views", "images", "marker_board", "photos", "pictures", "scenes", "table")},
+        "boards", "camera", "camera_views", "images", "marker_board", "pan_camera", "photos", "pictures", "scenes",
+        "table")},
     "vision": "imaging.drawing",
     **{name: f"notebook.{name}" for name in ("doctor", "live", "rqt_graph", "student_lab")},
     **{name: name for name in ("launch", "progress", "selfcheck", "waiting")},

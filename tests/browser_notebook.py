@@ -332,9 +332,9 @@ LESSON_RUN_TIMEOUT = 300
 #: The lessons tests/test_browser_lessons.py runs, in a JupyterLab of its own; tests/test_browser.py
 #: runs the others. Under `--dist loadfile` each file goes to one xdist worker, so the two halves
 #: run side by side: all six lessons in one file took 6 of its 8 minutes, the longest file of
-#: the suite. These three build packages with colcon (about half of the lessons' time).
+#: the suite. These four build packages with colcon (about half of the lessons' time).
 SECOND_LAB_LESSONS = ("01b_custom_messages.ipynb", "02_images_and_brightness.ipynb",
-                      "02b_packages_launch_parameters.ipynb")
+                      "02b_packages_launch_parameters.ipynb", "04_services_and_actions.ipynb")
 
 
 def course_lessons(second_lab: bool) -> list[str]:

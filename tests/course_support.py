@@ -93,11 +93,9 @@ def seed_interface_cache(tmp_path_factory, course: Path, assignments: list[str])
     from autograder import build_caches, packages
     from autograder.reference import REFERENCE_SRC
 
-    shared = shared_folder(tmp_path_factory)
     cache, target = build_caches.local_cache(), build_caches.cache_of(course)
-    with _locked(shared / "interface-cache.lock"):
-        for assignment in assignments:
-            packages.reference_interfaces(assignment, cache, shared / "interface-scratch")
+    for assignment in assignments:
+        reference_interface_installs(tmp_path_factory, assignment)
     for assignment in assignments:
         for name in specs.spec(assignment).packages:
             folder = REFERENCE_SRC / name
@@ -105,3 +103,13 @@ def seed_interface_cache(tmp_path_factory, course: Path, assignments: list[str])
                 key = build_caches.content_key(folder)
                 if not target.entry(key).exists():
                     shutil.copytree(cache.entry(key), target.entry(key), symlinks=True)
+
+
+def reference_interface_installs(tmp_path_factory, assignment: str) -> list[Path]:
+    """The install folders of the assignment's reference interface packages, built once into the
+    interface cache of tests and benchmarks (the first worker that needs them builds them)."""
+    from autograder import build_caches, packages
+
+    shared = shared_folder(tmp_path_factory)
+    with _locked(shared / "interface-cache.lock"):
+        return packages.reference_interfaces(assignment, build_caches.local_cache(), shared / "interface-scratch")

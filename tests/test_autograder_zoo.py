@@ -1,10 +1,12 @@
 """Does the autograder grade a zoo of submissions right, in parallel, and survive them all?
 
-One module-scoped grading run (2 workers) is shared by the tests: release the brightness and
-pubsub assignments into a fresh course directory, hand in the zoo (tests/zoo/brightness.py: the
-reference solution with a hostile cell, and hostile submissions; tests/zoo/pubsub.py: mistakes in the
-packages), grade, and check each grade, its reason (for the package mistakes on the feedback
-page), the submitted files, leftover processes, and a second (cached) run.
+One module-scoped grading run (2 workers) is shared by the tests: release the brightness,
+pubsub and services_actions assignments into a fresh course directory, hand in the zoo
+(tests/zoo/brightness.py: the reference solution with a hostile cell, and hostile submissions;
+tests/zoo/pubsub.py: mistakes in the packages; tests/zoo/services_actions.py: the reference, the
+untouched release and the typical mistakes of a service and an action server), grade, and check
+each grade, its reason (for the package mistakes on the feedback page), the submitted files,
+leftover processes, and a second (cached) run.
 """
 
 from __future__ import annotations
@@ -24,8 +26,9 @@ import course_support  # noqa: E402
 import zoo  # noqa: E402
 from zoo import brightness as brightness_zoo  # noqa: E402
 from zoo import pubsub as pubsub_zoo  # noqa: E402
+from zoo import services_actions as services_actions_zoo  # noqa: E402
 
-# The shared grading run (nine submissions, 2 workers) happens in the first test's set-up.
+# The shared grading run (twelve submissions, 2 workers) happens in the first test's set-up.
 pytestmark = [pytest.mark.slow, pytest.mark.timeout(1500)]
 
 
@@ -39,13 +42,15 @@ def graded(tmp_path_factory):
     from autograder import grading
 
     course = course_support.released_course(tmp_path_factory, tmp_path_factory.mktemp("zoo_course"),
-                                            ["brightness", "pubsub"])
-    course_support.seed_interface_cache(tmp_path_factory, course, ["pubsub"])
+                                            ["brightness", "pubsub", "services_actions"])
+    course_support.seed_interface_cache(tmp_path_factory, course, ["pubsub", "services_actions"])
     entries = {k: v for k, v in brightness_zoo.entries(str(course)).items() if v.get("level") != "check"}
     for student, entry in entries.items():
         zoo.submit(course, student, "brightness", entry["edits"])
     for student, entry in pubsub_zoo.entries().items():
         zoo.submit(course, student, "pubsub", entry["edits"])
+    for student, entry in services_actions_zoo.entries(str(course)).items():
+        zoo.submit(course, student, "services_actions", entry["edits"])
     before = _hashes(course / "submitted")
     started = time.monotonic()
     results = grading.grade(course, workers=2, progress=False)
@@ -88,21 +93,27 @@ def test_zoo_entry_gets_its_expected_score_and_reason(graded, student):
     assert any(reason in text for reason in reasons), (reasons, text[-3000:])
 
 
-@pytest.mark.parametrize("student", sorted(pubsub_zoo.entries()))
-def test_package_mistake_is_graded_down_with_its_reasons_on_the_feedback_page(graded, student):
+#: (assignment, zoo module) of the submissions graded per check with the reasons on the feedback page.
+PACKAGE_ZOOS = [("pubsub", pubsub_zoo), ("services_actions", services_actions_zoo)]
+
+
+@pytest.mark.parametrize("assignment, student", [(a, s) for a, z in PACKAGE_ZOOS for s in sorted(z.entries(""))])
+def test_package_submission_gets_its_scores_with_its_reasons_on_the_feedback_page(graded, assignment, student):
     """A mistake in a package (a message field, a missing <depend>, a wrong entry point, a build
-    error) costs the points of the checks it breaks, and the student's feedback page names it."""
+    error, a service or action server that does not keep the contract) costs the points of the
+    checks it breaks, and the student's feedback page names it; the reference gets every point."""
     from autograder import feedback
 
-    entry = pubsub_zoo.entries()[student]
+    entry = dict(PACKAGE_ZOOS)[assignment].entries(str(graded["course"]))[student]
     result = graded["results"][student]
     assert result.status == "graded", result.reason
     scores = _check_scores(result)
-    outputs = zoo.graded_outputs(graded["course"], student, "pubsub")
+    outputs = zoo.graded_outputs(graded["course"], student, assignment)
     for check, expected in entry["scores"].items():
         assert _matches(expected, scores[check]), (check, scores, outputs[-3000:])
-    feedback.write_feedback(graded["course"], student=student, assignment="pubsub")
-    page = (graded["course"] / "feedback" / student / "pubsub" / "pubsub.html").read_text().replace("&#39;", "'")
+    feedback.write_feedback(graded["course"], student=student, assignment=assignment)
+    page = (graded["course"] / "feedback" / student / assignment / f"{assignment}.html").read_text()
+    page = page.replace("&#39;", "'").replace("&quot;", '"')
     for reason in entry["reasons"]:
         assert reason in page, (reason, outputs[-3000:])
 
@@ -150,8 +161,10 @@ def test_grading_report_lists_every_submission(graded):
 
     with open(graded["course"] / "grading_report.csv") as handle:
         rows = list(csv.DictReader(handle))
-    assert {r["student_id"] for r in rows} == set(graded["entries"]) | set(pubsub_zoo.entries())
-    assert all(r["max_score"] == ("11" if r["assignment"] == "brightness" else "10") for r in rows)
+    assert {r["student_id"] for r in rows} == (set(graded["entries"]) | set(pubsub_zoo.entries())
+                                               | set(services_actions_zoo.entries("")))
+    max_scores = {"brightness": "11", "pubsub": "10", "services_actions": "11"}
+    assert all(r["max_score"] == max_scores[r["assignment"]] for r in rows)
     assert {r["student_id"]: float(r["score"]) for r in rows} == {s: r.score for s, r in graded["results"].items()}
 
 

@@ -102,3 +102,41 @@ def test_bad_parameters_are_refused_with_the_fix(domain_id, overrides, message):
                               parameter_overrides=[Parameter(k, value=v) for k, v in overrides.items()])
     finally:
         rclpy.try_shutdown(context=context)
+
+
+def test_snapshot_service_writes_the_last_frame_and_says_where(domain_id, tmp_path):
+    """/image_publisher/snapshot (std_srvs/Trigger) over DDS: refused before the first frame, then
+    the last published frame as a PNG, its path in the response's message."""
+    from std_srvs.srv import Trigger
+
+    context = rclpy.Context()
+    rclpy.init(context=context, domain_id=domain_id)
+    try:
+        overrides = [Parameter("width", value=160), Parameter("height", value=120), Parameter("rate", value=0.01),
+                     Parameter("snapshot_dir", value=str(tmp_path / "shots"))]
+        webcam = camera.WebcamNode(context=context, parameter_overrides=overrides)
+        caller = Node("caller", context=context)
+        client = caller.create_client(Trigger, "/image_publisher/snapshot")
+        executor = SingleThreadedExecutor(context=context)
+        executor.add_node(webcam)
+        executor.add_node(caller)
+
+        def call():
+            future = client.call_async(Trigger.Request())
+            executor.spin_until_future_complete(future, timeout_sec=30.0)
+            assert future.done(), "the snapshot service did not answer within 30 s"
+            return future.result()
+
+        assert client.wait_for_service(timeout_sec=30.0)
+        early = call()
+        assert not early.success and "no frame published yet" in early.message
+        webcam._publish_frame()
+        answer = call()
+        executor.shutdown()
+        webcam.destroy_node()
+        caller.destroy_node()
+    finally:
+        rclpy.try_shutdown(context=context)
+    assert answer.success, answer.message
+    assert answer.message == str(tmp_path / "shots" / "snapshot_0001.png")
+    assert np.array_equal(cv2.imread(answer.message), webcam._last_frame)

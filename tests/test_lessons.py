@@ -11,6 +11,7 @@ from pathlib import Path
 import nbformat
 from rclpy.qos import ReliabilityPolicy
 
+from course_lib.checks import assignments
 from course_lib.imaging import scenes
 from course_lib.ros import session
 
@@ -78,8 +79,8 @@ def test_every_lesson_ends_with_a_summary_that_links_the_next_lesson_and_names_i
             assert f"]({following.name})" in last, f"{lesson.name} does not link {following.name}"
         else:
             assert "the last lesson" in last, lesson.name
-        assert re.search(r"[*`](pubsub|brightness|catdog_warp)[*`]|has none", last), (
-            f"{lesson.name} names no assignment")
+        names = "|".join(assignments.ASSIGNMENTS)
+        assert re.search(rf"[*`]({names})[*`]|has none", last), f"{lesson.name} names no assignment"
 
 
 def test_lesson_02_exercise_uses_the_names_its_self_check_and_the_brightness_assignment_use():
@@ -140,3 +141,12 @@ def test_every_lesson_ends_with_its_quiz_and_an_answer_cell_for_each_question():
         assert f'selfcheck.show_quiz("{key}")' in code, lesson.name
         blank = "{" + ", ".join(f'{number}: ""' for number in range(1, len(quiz_of(key)) + 1)) + "}"
         assert f'quiz = {blank}\nselfcheck.check_quiz("{key}", quiz)' in code, lesson.name
+
+
+def test_lesson_04_defines_the_interfaces_the_services_actions_assignment_gives():
+    """The .srv and .action lesson 04 builds are the reference camera_interfaces, word for word:
+    the assignment's contract is what the lesson taught."""
+    reference = Path(__file__).resolve().parents[1] / "assignments" / "reference_ws" / "src" / "camera_interfaces"
+    code = "\n".join(_cells(NOTEBOOKS / "04_services_and_actions.ipynb", "code"))
+    for name, path in (("MARKERS_IN_VIEW", "srv/MarkersInView.srv"), ("FIND_PICTURES", "action/FindPictures.action")):
+        assert f'{name} = """{(reference / path).read_text()}"""' in code, path

@@ -181,6 +181,43 @@ feedback explains each wrong answer. Run every cell (Run All) before you hand it
 """
 
 
+SERVICES_ACTIONS_INTRO = """
+# Assignment: the pan camera's service and action
+
+The camera of Lesson 04 sits on a pan head in front of the marker board (`course_lib.pan_camera`):
+turned to `pan` degrees (positive to the right) it sees some of the board's markers, and at about
+0 degrees both pictures. You write the node that offers what Lesson 04 taught: a service that answers
+a question at once, and an action that takes a while, reports its progress and can be canceled.
+
+**Contract** (this is exactly what is graded). Your workspace `ros2_ws/src` holds two packages:
+
+1. **`camera_interfaces`** (given, as built in Lesson 04): `srv/MarkersInView.srv` and
+   `action/FindPictures.action`.
+2. **`pan_camera`** (`ament_python`, depending on `rclpy` and `camera_interfaces`) with the
+   executable **`pan_camera_node`** (`pan_camera/pan_camera_node.py`, class `PanCameraNode`, node
+   **`pan_camera`**), whose camera starts at the parameter **`start_pan`** (degrees; default
+   `pan_camera.START_PAN`):
+   - the service **`markers_in_view`** (`camera_interfaces/srv/MarkersInView`): for the request's
+     `pan`, `ids` = `markers_in_view(pan)`, `framed` = `framed_at(pan)` (as lists), `success` true and
+     a short `message`; asking does not turn the camera;
+   - the action **`find_pictures`** (`camera_interfaces/action/FindPictures`): from where the camera
+     is, turn `STEP_DEGREES` (5) per step, one step per `STEP_SECONDS` (0.1 s), until every picture
+     of the goal's `pictures` (empty: both) is framed; after each step publish feedback (`pan`, and the
+     `ids` in view there); then succeed with the result `pan` and `framed`. A goal naming another
+     picture is rejected. A cancel request is accepted, and the search stops before its next step
+     (status CANCELED, the result where it stopped): the service and cancel requests must be served
+     while a goal runs (a `ReentrantCallbackGroup`, spun by the `MultiThreadedExecutor` that `main`
+     already uses).
+
+The grader builds your workspace, starts `ros2 run pan_camera pan_camera_node` (with `-p
+start_pan:=...` for the action) in a ROS domain of its own, asks the service about angles it draws
+fresh, sends goals from start angles it draws fresh, and compares with what `course_lib.pan_camera`
+says the camera sees. Try your node from a terminal, as in Lesson 04:
+`ros2 service call /markers_in_view camera_interfaces/srv/MarkersInView "{pan: -10.0}"` and
+`ros2 action send_goal --feedback /find_pictures camera_interfaces/action/FindPictures "{pictures: [cat]}"`.
+"""
+
+
 #: Every graded assignment, in the order the course teaches them.
 ASSIGNMENTS: dict[str, Assignment] = {spec.name: spec for spec in (
     Assignment("pubsub", {"tutorial_interfaces": (), "pubsub": ("topic_publisher", "topic_subscriber")},
@@ -214,6 +251,14 @@ scene = scenes.render_scene(1)
 print(sorted(crop_pictures(scene.frame)))   # ['cat', 'dog']
 """),
                functions=("readmarker", "readmarker.crop")),
+    Assignment("services_actions", {"camera_interfaces": (), "pan_camera": ("pan_camera_node",)},
+               NotebookText(intro=SERVICES_ACTIONS_INTRO, plain_ros=(
+                   "In plain ROS 2 the packages come from `ros2 pkg create --build-type ament_cmake camera_interfaces` "
+                   "(then the edits of Lesson 04) and `ros2 pkg create --build-type ament_python --dependencies rclpy "
+                   "camera_interfaces --node-name pan_camera_node pan_camera`."),
+                   checks={"service": ("the service `markers_in_view`",),
+                           "action": ("the action `find_pictures`",),
+                           "cancel": ("canceling a goal",)})),
     Assignment("quiz", {}, NotebookText(intro=QUIZ_INTRO, checks={"answers": ("your answers",)}),
                questions=QUIZ_QUESTIONS, answers="secret"),
 )}

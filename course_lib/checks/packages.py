@@ -26,7 +26,7 @@ from pathlib import Path
 
 from course_lib import contract
 from course_lib.checks.assignments import WORKSPACE
-from course_lib.checks.context import StudentError
+from course_lib.checks.context import StudentError, clip, scaled
 from course_lib.checks.student_processes import student_env as _student_env
 from course_lib.ros import package_files
 
@@ -91,6 +91,23 @@ def run(ctx, package: str, executable: str, *ros_args: str, tag: str = ""):
     # name (course_lib.ros.processes), and the checks of a grading run at the same time.
     return ctx.students.start(command, name=f"student-{package}-{executable}{tag}-{ctx.spec.name}", cwd=ctx.workdir,
                               domain_id=ctx.domain_id, wall_seconds=ctx.remaining() + 5, env=student_env(ctx, ws))
+
+
+def wait_node(ctx, probe, proc, name: str) -> bool:
+    """A precondition item: node `name` of the student's process `proc` shows in `probe`'s graph
+    (ctx.wait_for_node); else a failed item that says why (the process ended, with its log, or
+    no node of that name, with the names seen). True when it shows."""
+    found = ctx.wait_for_node(probe, proc, name)
+    if not proc.running():
+        ctx.item(False, f"the process ended ({proc.describe_exit()}) before node {name} appeared:\n"
+                        f"{clip(proc.log_tail(6))}")
+        return False
+    if not found:
+        names = sorted(n for n, _ in probe.node.get_node_names_and_namespaces() if not n.startswith("autograder"))
+        ctx.item(False, f"no node named {name} within {scaled(25):.0f} s (nodes seen: {names}): pass '{name}' "
+                        "to super().__init__()")
+        return False
+    return ctx.precondition(True, f"node {name} runs")
 
 
 def endpoints(ctx, module: str, class_name: str) -> dict:

@@ -24,7 +24,7 @@ from itertools import pairwise
 
 from course_lib import waiting
 from course_lib.checks import packages, runner
-from course_lib.checks.context import Context, StudentError, clip, scaled
+from course_lib.checks.context import Context, StudentError, scaled
 from course_lib.checks.registry import check
 
 ASSIGNMENT = "pubsub"
@@ -81,20 +81,6 @@ def _queue_depth(ctx, module: str, class_name: str, kind: str) -> None:
              f"; the contract asks for a queue depth of {QUEUE_DEPTH}: pass {QUEUE_DEPTH} as the QoS argument"))
 
 
-def _wait_node(ctx, probe, proc, name: str) -> bool:
-    found = ctx.wait_for_node(probe, proc, name)
-    if not proc.running():
-        ctx.item(False, f"the process ended ({proc.describe_exit()}) before node {name} appeared:\n"
-                        f"{clip(proc.log_tail(6))}")
-        return False
-    if not found:
-        names = sorted(n for n, _ in probe.node.get_node_names_and_namespaces() if not n.startswith("autograder"))
-        ctx.item(False, f"no node named {name} within {scaled(25):.0f} s (nodes seen: {names}): pass '{name}' to "
-                        "super().__init__()")
-        return False
-    return ctx.precondition(True, f"node {name} runs")
-
-
 def _start(ctx, executable: str, tag: str = ""):
     """``ros2 run pubsub <executable>`` (raises StudentError when the workspace did not build)."""
     return packages.run(ctx, PACKAGE, executable, tag=tag)
@@ -114,7 +100,7 @@ def publisher(ctx: Context) -> None:
         with ctx.probe() as probe:
             messages = []
             probe.node.create_subscription(MsgTutorial, TOPIC, messages.append, 100)
-            if not _wait_node(ctx, probe, proc, "topic_publisher"):
+            if not packages.wait_node(ctx, probe, proc, "topic_publisher"):
                 return
             types = dict(probe.node.get_topic_names_and_types())
             if not probe.spin_until(lambda: len(messages) > 0 or not proc.running(), scaled(5.0)):
@@ -162,7 +148,7 @@ def subscriber(ctx: Context) -> None:
     try:
         with ctx.probe() as probe:
             pub = probe.node.create_publisher(MsgTutorial, TOPIC, 100)
-            if not _wait_node(ctx, probe, proc, "topic_subscriber"):
+            if not packages.wait_node(ctx, probe, proc, "topic_subscriber"):
                 return
             if not probe.spin_until(lambda: pub.get_subscription_count() > 0 or not proc.running(), scaled(5.0)):
                 ctx.item(False, f"topic_subscriber does not subscribe {TOPIC}: "

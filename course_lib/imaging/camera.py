@@ -9,6 +9,10 @@ Where the frames come from is the ``source`` parameter:
 
 Run it as a process (``python -m course_lib.imaging.camera --ros-args -p rate:=15.0``) or create a
 ``WebcamNode`` in a notebook session.
+
+It offers one service, ``~/snapshot`` (``std_srvs/srv/Trigger``, so ``/image_publisher/snapshot``):
+the last frame it published is written as a PNG into the ``snapshot_dir`` folder, and the
+response's message is the file's path.
 """
 
 from __future__ import annotations
@@ -20,6 +24,7 @@ import rclpy
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from sensor_msgs.msg import Image
+from std_srvs.srv import Trigger
 
 from course_lib.imaging import images, scenes
 
@@ -34,6 +39,7 @@ class WebcamNode(Node):
         width, height (int, 640, 480): frame size; frames from files or devices are resized to it.
         source (string, "sim"): "sim", a video file path, or a camera index such as "0".
         seed (int, 0): chooses the simulated camera path.
+        snapshot_dir (string, "snapshots"): where ``~/snapshot`` writes its PNG files.
 
     Raises:
         ValueError: a non-positive rate or size, or a source that cannot be opened (the message
@@ -47,6 +53,7 @@ class WebcamNode(Node):
         height = int(self.declare_parameter("height", 480).value)
         source = str(self.declare_parameter("source", "sim").value)
         seed = int(self.declare_parameter("seed", 0).value)
+        self.snapshot_dir = str(self.declare_parameter("snapshot_dir", "snapshots").value)
         if rate <= 0:
             raise ValueError(f"rate must be above 0 frames per second, not {rate}; for example rate:=30.0")
         if width < 1 or height < 1:
@@ -61,6 +68,9 @@ class WebcamNode(Node):
             self._capture = _open_capture(source, self.size)
         self._start = self.get_clock().now()
         self.frames_published = 0
+        self._last_frame = None
+        self.snapshots = 0
+        self._snapshot_service = self.create_service(Trigger, "~/snapshot", self._snapshot)
         self._publisher = self.create_publisher(Image, "image", 10)
         self._timer = self.create_timer(1.0 / rate, self._publish_frame)
         self.get_logger().info(f"Publishing {width}x{height} frames from {source!r} at {rate:g} Hz on "
@@ -95,6 +105,19 @@ class WebcamNode(Node):
                 raise
             return
         self.frames_published += 1
+        self._last_frame = frame
+
+    def _snapshot(self, request, response):
+        """Trigger: write the last published frame to snapshot_dir/snapshot_NNNN.png."""
+        if self._last_frame is None:
+            response.success, response.message = False, "no frame published yet: call again in a moment"
+            return response
+        os.makedirs(self.snapshot_dir, exist_ok=True)
+        self.snapshots += 1
+        path = os.path.abspath(os.path.join(self.snapshot_dir, f"snapshot_{self.snapshots:04d}.png"))
+        response.success = bool(cv2.imwrite(path, self._last_frame))
+        response.message = path if response.success else f"could not write {path}: is snapshot_dir writable?"
+        return response
 
     def destroy_node(self):
         if self._capture is not None:

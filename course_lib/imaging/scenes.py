@@ -218,11 +218,17 @@ def scene_pose(seed: int | Sequence[int] = 0, *, size: tuple[int, int] = (640, 4
 def framed_from(pose: Pose, *, size: tuple[int, int] = (640, 480), board: Board | None = None) -> tuple[str, ...]:
     """The pictures whose four markers are detectable from `pose` when all are printed and none is
     covered: a scene's fully_framed with that pose is these or fewer. Draws nothing."""
+    return _framed(detectable_from(pose, size=size, board=board))
+
+
+def detectable_from(pose: Pose, *, size: tuple[int, int] = (640, 480), board: Board | None = None) -> tuple[int, ...]:
+    """The picture markers detectable from `pose` (a scene's detectable_ids with that pose, when
+    all are printed and none is covered), ascending. Draws nothing."""
     size = _check_size(size, "frame size")
     board = board or default_board()
     H = pose.homography(board.size, size)
     corners = {i: _marker_corners(board, H, i) for ids in PICTURES.values() for i in ids}
-    return _framed(_detectable_ids(corners, size))
+    return _detectable_ids(corners, size)
 
 
 def _generators(seed) -> list[np.random.Generator]:

@@ -11,6 +11,7 @@ A lesson calls them as ``selfcheck.<name>``; they live by kind of answer:
 - :mod:`.node_exercises`: a node class run in the notebook's session (lessons 01 and 01b);
 - :mod:`.launch_exercise`: a YAML launch file (lesson 02b);
 - :mod:`.brightness_package`: a package built and run as ``ros2 run`` (lesson 02);
+- :mod:`.action_exercise`: an action client, against an action server of the check's (lesson 04);
 - :mod:`.bag_exercise`: a function that reads a recorded bag (lesson 05);
 - :mod:`.lesson_quiz`: the short quiz at the end of each lesson (``show_quiz``, ``check_quiz``),
   with course_lib.checks.multiple_choice (a question and a well-formed answer), which the graded
@@ -18,6 +19,7 @@ A lesson calls them as ``selfcheck.<name>``; they live by kind of answer:
 - :mod:`.verdicts`: the :class:`Verdict` they return and the helpers they share.
 """
 
+from course_lib.selfcheck.action_exercise import find_pictures_exercise
 from course_lib.selfcheck.bag_exercise import read_topic_exercise
 from course_lib.selfcheck.brightness_package import (
                                                      BRIGHTNESS_ENTRY_POINT,
@@ -41,6 +43,6 @@ from course_lib.selfcheck.verdicts import PLACEHOLDERS, Verdict
 
 __all__ = ["BRIGHTNESS_ENTRY_POINT", "BRIGHTNESS_EXECUTABLE", "BRIGHTNESS_PACKAGE", "CHECK_CAMERA_TOPIC",
            "PLACEHOLDERS", "PYTHON_DEPENDENCIES", "Verdict", "brightness_package_exercise", "check_quiz",
-           "publisher_exercise", "read_topic_exercise", "show_quiz", "subscriber_exercise", "task1_node_name",
-           "task2_echo", "task3_brightness_on_change", "task4_order_corners", "task_launch_yaml",
+           "find_pictures_exercise", "publisher_exercise", "read_topic_exercise", "show_quiz", "subscriber_exercise",
+           "task1_node_name", "task2_echo", "task3_brightness_on_change", "task4_order_corners", "task_launch_yaml",
            "task_picture_corners"]

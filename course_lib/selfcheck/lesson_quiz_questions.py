@@ -133,6 +133,28 @@ LESSON_QUIZZES: dict[str, tuple[Answered, ...]] = {
             "d": "in any order"}),
             "a", "The order follows the marker, not the picture: a turned marker's corner 0 is still its top-left."),
     ),
+    "04": (
+        Answered(Question("A node should answer \"which markers would the camera see at 30 degrees?\" at once. "
+                          "Which pattern fits?", {
+            "a": "a topic the node publishes on at 10 Hz",
+            "b": "a service: one request, one response",
+            "c": "an action with feedback",
+            "d": "a parameter"}),
+            "b", "A quick question with one answer is a service; an action is for jobs that take a while."),
+        Answered(Question("An action server's `execute` runs for seconds; the node is spun by `rclpy.spin(node)` "
+                          "(one thread). What happens to a cancel request sent meanwhile?", {
+            "a": "it stops the goal at once",
+            "b": "it waits until `execute` has returned: the single thread is busy (a MultiThreadedExecutor "
+                 "and a ReentrantCallbackGroup let it in)",
+            "c": "it raises an exception in the client",
+            "d": "it is lost"}),
+            "b", "One thread runs one callback at a time; the cancel callback runs only after execute ended."),
+        Answered(Question("What does `ros2 action send_goal --feedback /find_pictures "
+                          "camera_interfaces/action/FindPictures \"{pictures: [cat]}\"` print before the result?", {
+            "a": "nothing", "b": "each feedback message the server publishes while the goal runs",
+            "c": "the goal's type definition", "d": "the list of action servers"}),
+            "b", "--feedback prints every feedback message; then the result and the goal's final status."),
+    ),
     "05": (
         Answered(Question("What does `ros2 bag record -o run1 /camera/image_raw /brightness` write on Jazzy?", {
             "a": "a folder `run1` with `metadata.yaml` and `run1_0.mcap`",

@@ -8,7 +8,7 @@ has edits of the reference packages (see tests/zoo/__init__.py), the expected po
 from __future__ import annotations
 
 
-def entries() -> dict[str, dict]:
+def entries(course_dir: str = "") -> dict[str, dict]:
     return {
         # A package.xml without the message package, and a setup.py that installs the subscriber
         # under another name: the build succeeds; each mistake costs its items, and the feedback

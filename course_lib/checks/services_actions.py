@@ -1,0 +1,253 @@
+"""Checks of the services_actions assignment: the pan camera's service and action, in a package.
+
+The contract (also in the notebook and in assignments/README.md). The workspace ``ros2_ws/src``
+holds two packages:
+
+- ``camera_interfaces`` (given): ``srv/MarkersInView.srv`` (``float64 pan`` -> ``int32[] ids``,
+  ``string[] framed``, ``bool success``, ``string message``) and ``action/FindPictures.action``
+  (goal ``string[] pictures``; result ``float64 pan``, ``string[] framed``; feedback ``float64
+  pan``, ``int32[] ids``);
+- ``pan_camera`` (ament_python), executable ``pan_camera_node`` (module
+  ``pan_camera/pan_camera_node.py``, node ``pan_camera``, parameter ``start_pan``): the service
+  ``markers_in_view`` answers what course_lib.pan_camera sees at the angle asked for, success true;
+  the action ``find_pictures`` turns the camera STEP_DEGREES at a time from where it is until the
+  pictures asked for (empty: both) are framed, with feedback after every step, and stops when
+  canceled (status CANCELED, the result where it stopped).
+
+The expected answers are the simulation's own (course_lib.pan_camera), for angles and start
+angles drawn from the check's seed. The checker's nodes use the reference interfaces.
+"""
+
+from __future__ import annotations
+
+import math
+
+from course_lib.checks import packages, runner
+from course_lib.checks.context import Context, scaled
+from course_lib.checks.registry import check
+from course_lib.imaging import pan_camera
+
+ASSIGNMENT = "services_actions"
+PACKAGE = "pan_camera"
+EXECUTABLE = "pan_camera_node"
+NODE = "pan_camera"
+SERVICE = "/markers_in_view"
+SERVICE_TYPE = "camera_interfaces/srv/MarkersInView"
+ACTION = "/find_pictures"
+ACTION_TYPE = "camera_interfaces/action/FindPictures"
+#: Angles the service is asked about per check: most near the board, one past 180 degrees (wrapped).
+SERVICE_QUESTIONS = 6
+
+
+def selfcheck(name: str):
+    """Run check `name` with the self-check seed and print what is right and wrong."""
+    return runner.selfcheck(ASSIGNMENT, name)
+
+
+def grade(name: str):
+    """Run check `name` with a fresh seed (grading)."""
+    return runner.grade(ASSIGNMENT, name)
+
+
+def _start(ctx, start_pan: float | None = None):
+    """``ros2 run pan_camera pan_camera_node [--ros-args -p start_pan:=...]``, and its node in the graph."""
+    args = () if start_pan is None else ("-p", f"start_pan:={start_pan:.1f}")
+    return packages.run(ctx, PACKAGE, EXECUTABLE, *args)
+
+
+def _endpoint_item(ctx, probe, proc, name: str, wanted: str, kind: str) -> bool:
+    """A precondition: the node offers `name` (a service or an action) of type `wanted`; else an
+    item that names what it offers instead."""
+    from rclpy.action import get_action_names_and_types
+
+    def offered():
+        if kind == "action":
+            return dict(get_action_names_and_types(probe.node))
+        return {n: t for n, t in probe.node.get_service_names_and_types() if not n.startswith(f"/{NODE}/")}
+
+    probe.spin_until(lambda: name in offered() or not proc.running(), scaled(5.0))
+    found = offered()
+    if name not in found:
+        others = sorted(n for n in found if not n.startswith("/autograder"))
+        create = ("self.create_service(MarkersInView, 'markers_in_view', callback)" if kind == "service" else
+                  "ActionServer(self, FindPictures, 'find_pictures', self.execute, ...)")
+        return ctx.item(False, f"node {NODE} offers no {kind} {name} (it offers {others or 'none'}): {create}")
+    if found[name] != [wanted]:
+        return ctx.item(False, f"{kind} {name} is a {found[name]}; the contract says {wanted}")
+    return ctx.precondition(True, f"{kind} {name} ({wanted})")
+
+
+@check(points=4, timeout=60)
+def service(ctx: Context) -> None:
+    """markers_in_view answers success with the markers and pictures in view at angles drawn fresh."""
+    proc = _start(ctx)
+    packages.use_interfaces(ctx)
+    from camera_interfaces.srv import MarkersInView
+
+    packages.dependency_items(ctx, PACKAGE)
+    pans = [round(float(ctx.rng.uniform(-25.0, 25.0)), 1) for _ in range(SERVICE_QUESTIONS - 1)]
+    pans.append(round(float(ctx.rng.uniform(355.0, 365.0)), 1))  # the same as -5..5 degrees
+    answers = []
+    with ctx.probe() as probe:
+        if not packages.wait_node(ctx, probe, proc, NODE) or not _endpoint_item(
+                ctx, probe, proc, SERVICE, SERVICE_TYPE, "service"):
+            return
+        client = probe.node.create_client(MarkersInView, SERVICE)
+        for pan in pans:
+            future = client.call_async(MarkersInView.Request(pan=pan))
+            ctx.waiting_on(f"the answer of {SERVICE} for pan {pan:g}")
+            gives_up = ctx.no_answer_coming(proc, 5.0)
+            probe.spin_until(lambda f=future, g=gives_up: f.done() or not proc.running() or g(), scaled(10.0))
+            if not future.done():
+                ctx.item(False, f"{SERVICE} did not answer pan {pan:g} "
+                                f"({'the process ended' if not proc.running() else 'no answer'}): the callback must "
+                                "return the response", weight=4)
+                return
+            answers.append(future.result())
+    failed = [(pan, a) for pan, a in zip(pans, answers, strict=True) if not a.success]
+    ctx.item(not failed, f"success true for all {len(pans)} angles" if not failed else
+             f"pan {failed[0][0]:g} answered success=False ({failed[0][1].message!r}): set response.success = True "
+             "when the question is answered")
+    wrong_ids = [(pan, list(a.ids), list(pan_camera.markers_in_view(pan))) for pan, a in zip(pans, answers, strict=True)
+                 if list(a.ids) != list(pan_camera.markers_in_view(pan))]
+    ctx.item(not wrong_ids, f"ids right at all {len(pans)} angles ({', '.join(f'{p:g}' for p in pans)})"
+             if not wrong_ids else f"at pan {wrong_ids[0][0]:g} the response's ids are {wrong_ids[0][1]}, the markers "
+             f"in view are {wrong_ids[0][2]}: response.ids = list(markers_in_view(request.pan))", weight=2)
+    wrong_framed = [(pan, list(a.framed), list(pan_camera.framed_at(pan))) for pan, a in zip(pans, answers, strict=True)
+                    if list(a.framed) != list(pan_camera.framed_at(pan))]
+    ctx.item(not wrong_framed, "framed right at all angles" if not wrong_framed else
+             f"at pan {wrong_framed[0][0]:g} the response's framed is {wrong_framed[0][1]}, the pictures framed are "
+             f"{wrong_framed[0][2]}: response.framed = list(framed_at(request.pan))")
+
+
+def _send_goal(ctx, probe, proc, pictures, on_feedback):
+    """(goal handle, None) once the node accepted a FindPictures goal, or (None, why not)."""
+    from camera_interfaces.action import FindPictures
+    from rclpy.action import ActionClient
+
+    client = ActionClient(probe.node, FindPictures, ACTION)
+    if not probe.spin_until(lambda: client.server_is_ready() or not proc.running(), scaled(10.0)):
+        return None, f"the action server {ACTION} is not ready"
+    sent = client.send_goal_async(FindPictures.Goal(pictures=list(pictures)),
+                                  feedback_callback=lambda message: on_feedback(message.feedback))
+    ctx.waiting_on(f"the answer to a goal sent to {ACTION}")
+    probe.spin_until(lambda: sent.done() or not proc.running(), scaled(10.0))
+    if not sent.done():
+        return None, f"{ACTION} did not answer the goal (accepted or rejected): is the node spinning?"
+    if not sent.result().accepted:
+        return None, f"{ACTION} rejected the goal {{pictures: {list(pictures)}}}: accept goals that name cat or dog"
+    return sent.result(), None
+
+
+def _wait_result(ctx, probe, proc, handle, seconds: float):
+    """The (status, result) of an accepted goal, or None when it does not end."""
+    future = handle.get_result_async()
+    ctx.waiting_on(f"the result of the goal sent to {ACTION}")
+    gives_up = ctx.no_answer_coming(proc, seconds)
+    probe.spin_until(lambda: future.done() or not proc.running() or gives_up(), scaled(seconds))
+    if not future.done():
+        return None
+    return future.result().status, future.result().result
+
+
+@check(points=5, timeout=90)
+def action(ctx: Context) -> None:
+    """find_pictures turns from a fresh start angle step by step, feedback after each, until the pictures are framed."""
+    from action_msgs.msg import GoalStatus
+
+    start = round(float(ctx.rng.uniform(-58.0, -30.0)), 1)
+    pictures = [["cat"], ["dog"], []][int(ctx.rng.integers(3))]
+    expected = pan_camera.search_pans(start, pictures)
+    proc = _start(ctx, start)
+    packages.use_interfaces(ctx)
+    feedback = []
+    with ctx.probe() as probe:
+        if not packages.wait_node(ctx, probe, proc, NODE) or not _endpoint_item(
+                ctx, probe, proc, ACTION, ACTION_TYPE, "action"):
+            return
+        handle, why = _send_goal(ctx, probe, proc, pictures, feedback.append)
+        if handle is None:
+            ctx.item(False, why, weight=5)
+            return
+        seconds = len(expected) * pan_camera.STEP_SECONDS + 5.0
+        ended = _wait_result(ctx, probe, proc, handle, seconds)
+        # Feedback and result travel apart: the last feedback may come just after the result.
+        probe.spin_until(lambda: len(feedback) >= len(expected) or not proc.running(), scaled(2.0))
+    asked = f"{{pictures: {pictures}}} from start_pan {start:g}"
+    if ended is None:
+        ctx.item(False, f"the goal {asked} did not end within {seconds:.0f} s ({len(feedback)} feedback messages): "
+                        "call goal_handle.succeed() and return a FindPictures.Result() once the pictures are framed",
+                 weight=2)
+    else:
+        status, result = ended
+        ok = status == GoalStatus.STATUS_SUCCEEDED
+        ctx.item(ok, f"the goal {asked} succeeded" if ok else
+                 f"the goal {asked} ended with status {_STATUS.get(status, status)}: call goal_handle.succeed() when "
+                 "the pictures are framed")
+        stop = expected[-1] if expected else pan_camera.wrap(start)
+        right = math.isclose(result.pan, stop, abs_tol=1e-6) and list(result.framed) == list(pan_camera.framed_at(stop))
+        ctx.item(right, f"result: pan {result.pan:g}, framed {list(result.framed)}" + ("" if right else
+                 f"; the camera should stop at the first step where {pictures or ['cat', 'dog']} are framed, pan "
+                 f"{stop:g}, framed {list(pan_camera.framed_at(stop))}"))
+    pans = [round(f.pan, 6) for f in feedback]
+    if not feedback:
+        ctx.item(False, f"no feedback arrived ({len(expected)} steps from {start:g}): "
+                        "goal_handle.publish_feedback(FindPictures.Feedback(pan=..., ids=...)) after every step",
+                 weight=2)
+        ctx.consequence("feedback pans and ids")
+        return
+    ok = pans == [round(p, 6) for p in expected]
+    ctx.item(ok, f"feedback after each of the {len(expected)} steps: pan {pans[0]:g} ... {pans[-1]:g}" if ok else
+             f"feedback pans {pans[:5]}{'...' if len(pans) > 5 else ''}; expected one after each step of "
+             f"{pan_camera.STEP_DEGREES:g} degrees from {start:g}: {expected[:5]}{'...' if len(expected) > 5 else ''}",
+             weight=2)
+    wrong = [(f.pan, list(f.ids)) for f in feedback if list(f.ids) != list(pan_camera.markers_in_view(f.pan))]
+    ctx.item(not wrong, "feedback ids are the markers in view at each pan" if not wrong else
+             f"feedback at pan {wrong[0][0]:g} has ids {wrong[0][1]}, the markers in view are "
+             f"{list(pan_camera.markers_in_view(wrong[0][0]))}")
+
+
+@check(points=2, timeout=60)
+def cancel(ctx: Context) -> None:
+    """A find_pictures goal canceled after its first feedback stops there: cancel accepted, status CANCELED."""
+    from action_msgs.msg import GoalStatus
+
+    start = round(float(ctx.rng.uniform(-170.0, -120.0)), 1)
+    steps = len(pan_camera.search_pans(start, []))
+    proc = _start(ctx, start)
+    packages.use_interfaces(ctx)
+    feedback, canceling = [], []
+    with ctx.probe() as probe:
+        if not packages.wait_node(ctx, probe, proc, NODE) or not _endpoint_item(
+                ctx, probe, proc, ACTION, ACTION_TYPE, "action"):
+            return
+        handle, why = _send_goal(ctx, probe, proc, [], feedback.append)
+        if handle is None:
+            ctx.item(False, why, weight=2)
+            return
+        ctx.waiting_on("the first feedback")
+        gives_up, done = ctx.no_answer_coming(proc, 5.0), handle.get_result_async()
+        probe.spin_until(lambda: bool(feedback) or done.done() or not proc.running() or gives_up(), scaled(10.0))
+        if not feedback:
+            ctx.item(False, "no feedback arrived, so the check could not cancel after the first step: publish "
+                            "feedback after every step", weight=2)
+            return
+        future = handle.cancel_goal_async()
+        probe.spin_until(lambda: future.done() or not proc.running(), scaled(10.0))
+        if future.done():
+            canceling = list(future.result().goals_canceling)
+        ended = _wait_result(ctx, probe, proc, handle, steps * pan_camera.STEP_SECONDS + 5.0)
+    ctx.item(bool(canceling), "the cancel request was accepted" if canceling else
+             "the cancel request was refused: ActionServer(..., cancel_callback=...) returning CancelResponse.ACCEPT")
+    if ended is None:
+        ctx.consequence("the canceled goal did not end")
+        return
+    status, result = ended
+    ok = status == GoalStatus.STATUS_CANCELED and not set(pan_camera.framed_at(result.pan)) >= {"cat", "dog"}
+    ctx.item(ok, f"the goal ended CANCELED at pan {result.pan:g}" if ok else
+             f"the goal ended {_STATUS.get(status, status)} at pan {result.pan:g}: before each step check "
+             "goal_handle.is_cancel_requested, then goal_handle.canceled() and return the result (and spin a "
+             "MultiThreadedExecutor with a ReentrantCallbackGroup, so the cancel request is served while execute runs)")
+
+
+_STATUS = {1: "ACCEPTED", 2: "EXECUTING", 3: "CANCELING", 4: "SUCCEEDED", 5: "CANCELED", 6: "ABORTED"}
