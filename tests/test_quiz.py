@@ -80,7 +80,7 @@ def test_the_self_check_saves_the_answers_and_judges_only_their_form(tmp_path, m
     monkeypatch.setattr(checks, "_notebook_namespace", lambda: {"q1": "b", "q2": "z", "q3": 3, "unrelated": 1})
     checks.selfcheck("answers")
     said = capsys.readouterr()
-    assert "1 of 15 answers are well-formed" in said.err and "q1 = 'b'" in said.err
+    assert "1 of 16 answers are well-formed" in said.err and "q1 = 'b'" in said.err
     assert "q2: 'z' is not one of the choices" in said.err and "q4: not answered yet" in said.err
     assert " right" not in said.err.replace("whether they are right", "")  # it never says right or wrong
     assert checks.read_answers(tmp_path) == {**dict.fromkeys(QUIZ_QUESTIONS), "q1": "b", "q2": "z", "q3": 3}

@@ -32,6 +32,9 @@ KEY = {
     "q14": ("b", "61 frames in 2 s of recording: about 30 frames a second. 92 counts the messages of both topics."),
     "q15": ("a", "31 brightness values for 61 frames: the node answered about every second frame (too slow "
                  "a callback, or a frame dropped on the way); it should be about 61."),
+    "q16": ("c", "A long task with progress and a way to stop it is an action (lesson 04): the goal starts it, "
+                 "feedback says how far it got, cancel stops it, the result ends it. A service call blocks until "
+                 "its one response and cannot be stopped; a topic or a parameter has no reply at all."),
 }
 
 

@@ -170,8 +170,8 @@ seen, and compares your crops with the true ones (`marker_board.crop_similarity`
 QUIZ_INTRO = """
 # Quiz: lessons 00-05
 
-Fifteen multiple-choice questions on what the lessons taught: ROS 2's concepts, reading what the
-`ros2` command prints, choosing a QoS, reading a launch file, images, markers and bags. Each has one
+Sixteen multiple-choice questions on what the lessons taught: ROS 2's concepts, reading what the
+`ros2` command prints, choosing a QoS, reading a launch file, images, markers, actions and bags. Each has one
 right answer and earns one point.
 
 **How to answer:** write the letter of your choice as a string into the cell under the question,

@@ -151,4 +151,11 @@ QUIZ_QUESTIONS: dict[str, Question] = {
         "b": "it answered every frame",
         "c": "it answered more often than the camera sent",
         "d": "nothing: a bag cannot tell"}),
+    "q16": Question("A node turns the camera until both pictures are in view, which takes a few seconds; the "
+                    "caller wants to see how far it got and must be able to stop it half-way. What should the "
+                    "node offer?", {
+        "a": "a topic the caller publishes the goal on",
+        "b": "a service whose response says when the pictures are in view",
+        "c": "an action: a goal, feedback while it turns, a result, and cancel",
+        "d": "a parameter the caller sets to the angle"}),
 }
