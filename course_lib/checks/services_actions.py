@@ -139,12 +139,22 @@ def _send_goal(ctx, probe, proc, pictures, on_feedback):
     return sent.result(), None
 
 
-def _wait_result(ctx, probe, proc, handle, seconds: float):
-    """The (status, result) of an accepted goal, or None when it does not end."""
+def _wait_result(ctx, probe, proc, handle, seconds: float, feedback: list):
+    """The (status, result) of an accepted goal, or None when it does not end: when the node waits
+    for `seconds` without a result or a new feedback message. Each feedback starts the wait
+    again (the goal is moving), so a goal of many steps on a busy machine is not cut short for
+    taking longer than its steps' sleeps add up to."""
     future = handle.get_result_async()
     ctx.waiting_on(f"the result of the goal sent to {ACTION}")
-    gives_up = ctx.no_answer_coming(proc, seconds)
-    probe.spin_until(lambda: future.done() or not proc.running() or gives_up(), scaled(seconds))
+    waited = {"feedback": len(feedback), "gives_up": ctx.no_answer_coming(proc, seconds)}
+
+    def gives_up() -> bool:
+        if len(feedback) != waited["feedback"]:
+            waited.update(feedback=len(feedback), gives_up=ctx.no_answer_coming(proc, seconds))
+        return waited["gives_up"]()
+
+    # The check's own time limit (scaled with the load) is the backstop, less a moment to report.
+    probe.spin_until(lambda: future.done() or not proc.running() or gives_up(), max(1.0, ctx.remaining() - 2.0))
     if not future.done():
         return None
     return future.result().status, future.result().result
@@ -170,12 +180,13 @@ def action(ctx: Context) -> None:
             ctx.item(False, why, weight=5)
             return
         seconds = len(expected) * pan_camera.STEP_SECONDS + 5.0
-        ended = _wait_result(ctx, probe, proc, handle, seconds)
+        ended = _wait_result(ctx, probe, proc, handle, seconds, feedback)
         # Feedback and result travel apart: the last feedback may come just after the result.
         probe.spin_until(lambda: len(feedback) >= len(expected) or not proc.running(), scaled(2.0))
     asked = f"{{pictures: {pictures}}} from start_pan {start:g}"
     if ended is None:
-        ctx.item(False, f"the goal {asked} did not end within {seconds:.0f} s ({len(feedback)} feedback messages): "
+        ctx.item(False, f"the goal {asked} did not end: no result, and no new feedback for {seconds:.0f} s "
+                        f"while the node waited ({len(feedback)} feedback messages): "
                         "call goal_handle.succeed() and return a FindPictures.Result() once the pictures are framed",
                  weight=2)
     else:
@@ -236,7 +247,7 @@ def cancel(ctx: Context) -> None:
         probe.spin_until(lambda: future.done() or not proc.running(), scaled(10.0))
         if future.done():
             canceling = list(future.result().goals_canceling)
-        ended = _wait_result(ctx, probe, proc, handle, steps * pan_camera.STEP_SECONDS + 5.0)
+        ended = _wait_result(ctx, probe, proc, handle, steps * pan_camera.STEP_SECONDS + 5.0, feedback)
     ctx.item(bool(canceling), "the cancel request was accepted" if canceling else
              "the cancel request was refused: ActionServer(..., cancel_callback=...) returning CancelResponse.ACCEPT")
     if ended is None:
