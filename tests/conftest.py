@@ -1,7 +1,8 @@
 """Fixtures shared by the test modules: a browser, a marker for a test's own processes, a
-package for launch files."""
+package for launch files; and the last resort against a test stuck in native code."""
 
 import contextlib
+import faulthandler
 import os
 import tempfile
 
@@ -15,6 +16,27 @@ from autograder import answers
 # The tests run graded checks (runner.execute(..., mode="graded")) as the grader does: the grader
 # hands its checks the answer keys through the contract (course_lib.checks.answers).
 os.environ.update(answers.environment())
+
+
+#: Seconds after pytest-timeout's limit at which a test still running ends its worker process.
+HARD_STOP_AFTER = 60
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_protocol(item, nextitem):
+    """pytest-timeout interrupts a test through a signal, which Python handles only between
+    bytecodes: a test stuck in native code holding the GIL (Fast DDS 2.14 can deadlock while a
+    DDS participant is destroyed) would hold its worker, and the whole run, forever. Past the
+    limit plus HARD_STOP_AFTER, faulthandler's own thread prints every thread's stack and ends the
+    worker; xdist reports the test as failed and goes on with a new worker."""
+    marker = item.get_closest_marker("timeout")
+    limit = float(marker.args[0]) if marker and marker.args else float(item.config.getini("timeout") or 0)
+    if limit > 0:
+        faulthandler.dump_traceback_later(limit + HARD_STOP_AFTER, exit=True)
+    try:
+        yield
+    finally:
+        faulthandler.cancel_dump_traceback_later()
 
 
 @pytest.fixture(scope="module")

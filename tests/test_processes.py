@@ -117,6 +117,32 @@ def test_a_node_is_not_taken_for_an_earlier_one_when_its_wait_comes_late(talker_
         session.stop()
 
 
+WAITS_FOR_GO = """
+import pathlib, sys, time
+go = pathlib.Path(sys.argv[1])
+while not go.exists():
+    time.sleep(0.05)
+import course_talker
+course_talker.main()
+"""
+
+
+def test_a_killed_nodes_name_is_not_taken_for_the_next_node_of_that_name(talker_dir, domain_id):
+    """A node killed a moment ago stays in the graph until its lease ends: the next process's
+    wait_for_node waits for that process's own node, not the dead one's name."""
+    with python_node("course_talker:main", cwd=talker_dir, domain_id=domain_id) as first:
+        first.wait_for_node("talker", timeout=30)
+        os.killpg(first.pid, signal.SIGKILL)
+        first.stop()
+    (talker_dir / "waits.py").write_text(WAITS_FOR_GO)
+    go = talker_dir / "go"
+    with NodeProcess([sys.executable, "waits.py", str(go)], cwd=talker_dir, domain_id=domain_id) as second:
+        with pytest.raises(TimeoutError, match="'talker' did not appear"):
+            second.wait_for_node("talker", timeout=2.0)  # its node does not exist yet
+        go.touch()
+        second.wait_for_node("talker", timeout=30)
+
+
 LEFT_RUNNING = """
 import sys, time
 from course_lib.ros.processes import NodeProcess
