@@ -3,7 +3,8 @@
 One JupyterLab server and one headless Chromium serve the whole module. The server's root is a
 scratch directory holding a copy of notebooks/ (outputs never reach the repository) and the
 checker's own small notebooks, which prove that the checker passes a good notebook and fails
-one that raises. Screenshots go to artifacts/browser/<notebook>.png. The lessons that build
+one that raises, and a small notebook whose live image view (course_lib.notebook.live) must change
+while the camera runs. Screenshots go to artifacts/browser/<notebook>.png. The lessons that build
 packages run in tests/test_browser_lessons.py, beside this file (browser_notebook.SECOND_LAB_LESSONS).
 """
 
@@ -19,6 +20,7 @@ from browser_notebook import (
     click_menu,
     click_toolbar_button,
     close_notebook,
+    code_cell_count,
     copy_lessons,
     course_lessons,
     open_notebook,
@@ -77,6 +79,21 @@ class Listener(Node):
 ]
 
 
+# The virtual camera as a process, its /image in live.image_view.
+CAMERA_SIZE = (320, 240)
+LIVE_NOTEBOOK = [
+    "from course_lib import live, processes\n"
+    f"camera = processes.python_node('course_lib.imaging.camera:main', '--ros-args', '-p', 'width:={CAMERA_SIZE[0]}', "
+    f"'-p', 'height:={CAMERA_SIZE[1]}',\n"
+    "                               '-p', 'rate:=10.0', name='camera')\n"
+    "camera.wait_for_node('image_publisher', timeout=60)",
+    # Explicit bounds: under test a view would stop after live.LIMITED_UPDATES redraws.
+    "view = live.image_view('/image', updates=3000, seconds=300)\nview",
+]
+# The <img> of the ipywidgets Image in the live view's output.
+PICTURE = f"{NOTEBOOK} .jp-OutputArea .widget-image"
+
+
 def lesson_line(notebook: str, start: str) -> str:
     """The one source line of a lesson that starts with `start` (a test then runs it as the lesson does)."""
     import nbformat
@@ -97,6 +114,7 @@ def lab(tmp_path_factory):
         write_notebook(root / "checker" / name, sources)
     write_notebook(root / "checker" / "rerun_node.ipynb", RERUN_NOTEBOOK)
     write_notebook(root / "checker" / "progress.ipynb", PROGRESS_NOTEBOOK)
+    write_notebook(root / "checker" / "live_view.ipynb", LIVE_NOTEBOOK)
     # Lesson 02's camera, started as lesson 02 starts it; and lesson 03's, as lesson 03 does.
     write_notebook(root / "checker" / "lesson02_left_running.ipynb", [
         "from course_lib import processes", lesson_line("02_images_and_brightness.ipynb", "CAMERA_ARGS = "),
@@ -256,3 +274,37 @@ def test_toolbar_buttons_are_clicked_by_their_label(browser, lab):
             click_toolbar_button(page, "No such button")
     finally:
         close_notebook(page, lab, "checker/prints.ipynb")
+
+
+@pytest.mark.timeout(400)
+def test_live_image_view_picture_changes_while_the_camera_runs(browser, lab):
+    """The live image view's picture is the camera's size, its status names the topic, and the
+    picture on screen changes from one frame to the next. Screenshots: live_image_view-<n>.png."""
+    path = "checker/live_view.ipynb"
+    page = open_notebook(browser, lab, path)
+    try:
+        run = run_notebook(page, path, code_cell_count(lab.root_dir / path), 240)
+        # The live picture is replaced about ten times a second, so the generic check may catch
+        # it between two frames (a new source not yet decoded); the waits below check it instead.
+        problems = [p for p in run.problems() if p != "image does not render in cell 1"]
+        assert not problems, problems
+        picture = page.locator(PICTURE)
+        page.wait_for_function(f"""() => {{ const img = document.querySelector('{PICTURE}');
+                                   return img && img.complete && img.naturalWidth === {CAMERA_SIZE[0]}; }}""",
+                               timeout=60_000)
+        status = page.locator(f"{NOTEBOOK} .jp-OutputArea .widget-label").first.inner_text()
+        assert "/image · 320x240 bgr8" in status, status
+        shots, sources = [], []
+        for number in (1, 2):
+            if sources:  # the next frame: a new blob URL in src, decoded
+                page.wait_for_function("""([selector, before]) => { const img = document.querySelector(selector);
+                                          return img.src !== before && img.complete && img.naturalWidth > 0; }""",
+                                       arg=[PICTURE, sources[-1]], timeout=30_000)
+            sources.append(picture.get_attribute("src"))
+            target = SCREENSHOTS / f"live_image_view-{number}.png"
+            target.parent.mkdir(parents=True, exist_ok=True)
+            shots.append(picture.screenshot(path=str(target)))
+        assert sources[0] != sources[1]
+        assert shots[0] != shots[1], "the picture on screen changed (the simulated camera moves)"
+    finally:
+        close_notebook(page, lab, path)
