@@ -37,7 +37,8 @@ def shared_folder(tmp_path_factory) -> Path:
 
 
 @contextlib.contextmanager
-def _locked(path: Path):
+def locked(path: Path):
+    """Hold an exclusive lock on the file `path` (made if missing), across the processes of the run."""
     with open(path, "a") as handle:
         fcntl.flock(handle, fcntl.LOCK_EX)
         try:
@@ -56,7 +57,7 @@ def released_course(tmp_path_factory, course: Path, assignments: list[str]) -> P
     assert not unknown, f"course_support releases {ASSIGNMENTS}, not {sorted(unknown)}"
     shared = shared_folder(tmp_path_factory)
     template = shared / "released"
-    with _locked(shared / "released.lock"):
+    with locked(shared / "released.lock"):
         if not (template / ".complete").is_file():
             shutil.rmtree(template, ignore_errors=True)
             release.release(template, list(ASSIGNMENTS))
@@ -111,5 +112,5 @@ def reference_interface_installs(tmp_path_factory, assignment: str) -> list[Path
     from autograder import build_caches, packages
 
     shared = shared_folder(tmp_path_factory)
-    with _locked(shared / "interface-cache.lock"):
+    with locked(shared / "interface-cache.lock"):
         return packages.reference_interfaces(assignment, build_caches.local_cache(), shared / "interface-scratch")

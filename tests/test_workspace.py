@@ -1,8 +1,8 @@
 """Tests for course_lib.ros.workspace: a built workspace sourced and its nodes run (and the real colcon build of it).
 
-The slow tests share one workspace, built once per test run by the `built_ws` fixture: the
-interface package tutorial_interfaces (msg/MsgTutorial.msg) and the ament_python package
-tutorial_nodes that uses it.
+The slow tests share one workspace, built once per test run (tests/tutorial_workspace.py, shared
+with tests/test_ros2cli_interface_builds.py): the interface package tutorial_interfaces
+(msg/MsgTutorial.msg among others) and the ament_python package tutorial_nodes that uses it.
 """
 
 import os
@@ -15,99 +15,16 @@ import time
 from pathlib import Path
 
 import pytest
+import tutorial_workspace
 
-from course_lib.ros import colcon, pkg_create, rosenv, workspace
-
-MSG_TUTORIAL = "builtin_interfaces/Time stamp\nint32 data\n"
-
-PUBLISHER = '''import rclpy
-from rclpy.executors import ExternalShutdownException
-from rclpy.node import Node
-
-from tutorial_interfaces.msg import MsgTutorial
-
-
-class TopicPublisher(Node):
-    """Publish MsgTutorial at 10 Hz with a growing counter."""
-
-    def __init__(self):
-        super().__init__('topic_publisher')
-        self.count = self.declare_parameter('start', 0).value
-        self.publisher = self.create_publisher(MsgTutorial, 'topic', 100)
-        self.timer = self.create_timer(0.1, self.publish)
-
-    def publish(self):
-        msg = MsgTutorial()
-        msg.stamp = self.get_clock().now().to_msg()
-        msg.data = self.count
-        self.publisher.publish(msg)
-        self.count += 1
-
-
-def main(args=None):
-    rclpy.init(args=args)
-    node = None
-    try:
-        node = TopicPublisher()
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
-'''
-
-SUBSCRIBER = '''import rclpy
-from rclpy.executors import ExternalShutdownException
-from rclpy.node import Node
-
-from tutorial_interfaces.msg import MsgTutorial
-
-
-class TopicSubscriber(Node):
-    """Log every field of each MsgTutorial received."""
-
-    def __init__(self):
-        super().__init__('topic_subscriber')
-        self.subscription = self.create_subscription(MsgTutorial, 'topic', self.listen, 100)
-
-    def listen(self, msg):
-        self.get_logger().info(
-            f'Received: stamp={msg.stamp.sec}.{msg.stamp.nanosec:09d} data={msg.data}')
-
-
-def main(args=None):
-    rclpy.init(args=args)
-    node = None
-    try:
-        node = TopicSubscriber()
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
-'''
-
-
-def make_tutorial_workspace(ws: Path) -> None:
-    pkg_create.create_interface_package(ws, "tutorial_interfaces", {"MsgTutorial": MSG_TUTORIAL})
-    package = pkg_create.create_package(ws, "tutorial_nodes", dependencies=["rclpy", "tutorial_interfaces"],
-                                       node_name=["hello_node", "topic_publisher", "topic_subscriber"])
-    (package / "tutorial_nodes" / "topic_publisher.py").write_text(PUBLISHER)
-    (package / "tutorial_nodes" / "topic_subscriber.py").write_text(SUBSCRIBER)
+from course_lib.ros import rosenv, workspace
 
 
 @pytest.fixture(scope="session")
 def built_ws(tmp_path_factory):
-    """A workspace with tutorial_interfaces and tutorial_nodes, built once with the real colcon."""
-    ws = tmp_path_factory.mktemp("tutorial_ws")
-    make_tutorial_workspace(ws)
-    result = colcon.build(ws, timeout=600)
-    print(f"\ncolcon built {result.finished} in {result.seconds:.1f} s")
-    return ws
+    """The tutorial workspace (tutorial_interfaces and tutorial_nodes), built once per test run with
+    the real colcon (tests/tutorial_workspace.py)."""
+    return tutorial_workspace.built(tmp_path_factory)[0]
 
 
 def wait_for_log(process, pattern: str, count: int, timeout: float) -> list[re.Match]:
@@ -252,10 +169,11 @@ def test_publisher_reaches_subscriber_across_two_processes(built_ws, domain_id):
 
 
 @pytest.mark.slow
-def test_command_line_build_prints_what_to_source(built_ws):
-    done = subprocess.run([sys.executable, "-m", "course_lib", "build", str(built_ws),
-                           "--packages-select", "tutorial_nodes"],
-                          capture_output=True, text=True, timeout=300, env=rosenv.ros_environment())
+def test_command_line_build_prints_what_to_source(built_ws, tmp_path_factory):
+    with tutorial_workspace.rebuilding(tmp_path_factory):
+        done = subprocess.run([sys.executable, "-m", "course_lib", "build", str(built_ws),
+                               "--packages-select", "tutorial_nodes"],
+                              capture_output=True, text=True, timeout=300, env=rosenv.ros_environment())
     assert done.returncode == 0, done.stdout + done.stderr
     assert "Finished <<< tutorial_nodes" in done.stdout
     assert f"source {built_ws / 'install' / 'setup.bash'}" in done.stdout
