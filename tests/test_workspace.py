@@ -16,6 +16,7 @@ from pathlib import Path
 
 import pytest
 import tutorial_workspace
+from ros2cli_support import ros2
 
 from course_lib.ros import rosenv, workspace
 
@@ -100,7 +101,11 @@ def test_generated_node_logs_and_takes_remaps(built_ws, domain_id):
     reader = threading.Thread(target=read, daemon=True)
     reader.start()
     try:
-        greeted.wait(timeout=30)  # the node spins forever: stop it once it has greeted
+        greeted.wait(timeout=30)
+        # "Node started!" comes before rclpy.spin(): a SIGINT then ends the context before the
+        # executor is made (rclpy raises RCLError). Its parameter service answers once it spins.
+        answer = ros2("param", "get", "/renamed_hello", "use_sim_time", env=env).stdout
+        assert answer.strip() == "Boolean value is: False", answer
     finally:
         process.send_signal(signal.SIGINT)
         try:
