@@ -7,8 +7,9 @@ a changed due date changes the penalty, and a partial re-grade (one student, one
 with a seed) keeps every other grade in every file. (nbgrader's own autograde, which the grader
 runs in its sandbox here, refuses outside it: tests/test_guard.py.)
 
-Three submissions are graded in the sandbox (pubsub twice, brightness once); the renamed one is
-not run at all.
+Three submissions are graded in the sandbox (pubsub twice, the quiz once: no ROS, no build; the
+brightness reference's whole grading is tests/test_autograder_zoo.py's); the renamed one is not
+run at all.
 """
 
 from __future__ import annotations
@@ -78,7 +79,7 @@ def term(tmp_path_factory):
     downloads = tmp_path_factory.mktemp("downloads")
     (downloads / "roster.csv").write_text(ROSTER)
     _run("roster", str(course), str(downloads / "roster.csv"))
-    _run("release", str(course), "--assignment", "pubsub", "--assignment", "brightness", "--duedate", DUE)
+    _run("release", str(course), "--assignment", "pubsub", "--assignment", "quiz", "--duedate", DUE)
     course_support.seed_interface_cache(tmp_path_factory, course, ["pubsub"])  # built once per test run
     settings = config.write_config(course)
     settings.write_text(settings.read_text() + f"c.LatePenalty.per_day = {{'pubsub': {PER_DAY}}}\n")
@@ -87,9 +88,9 @@ def term(tmp_path_factory):
         ("bob", LATE, "pubsub.ipynb"): BROKEN_SUBSCRIBER,
         ("carol", ON_TIME, "pubsub (1).ipynb"): [],
     })
-    brightness = _lms_zip(course, downloads, "brightness", {("alice", ON_TIME, "brightness.ipynb"): []})
+    quiz = _lms_zip(course, downloads, "quiz", {("alice", ON_TIME, "quiz.ipynb"): []})
     collected = _run("collect", str(course), "pubsub", str(pubsub)).stdout
-    _run("collect", str(course), "brightness", str(brightness))
+    _run("collect", str(course), "quiz", str(quiz))
     graded = _run("grade", str(course), "--workers", "2")
     results = {(r.student, r.assignment): r for r in store.recorded_results(course)}
     return {"course": course, "collected": collected, "results": results, "grade_output": graded.stdout + graded.stderr}
@@ -100,7 +101,7 @@ def test_collect_keeps_the_submission_time_and_names_the_renamed_notebook(term):
     timestamp.txt; the notebook the LMS renamed is reported at once, with the fix."""
     course = term["course"]
     assert (course / "submitted" / "bob" / "pubsub" / "timestamp.txt").read_text().startswith("2025-03-16 09:30:00")
-    assert (course / "submitted" / "alice" / "brightness" / "timestamp.txt").is_file()
+    assert (course / "submitted" / "alice" / "quiz" / "timestamp.txt").is_file()
     assert "'pubsub (1).ipynb', not 'pubsub.ipynb'" in term["collected"]
     assert "mv " in term["collected"]
 
@@ -118,7 +119,7 @@ def test_formgrader_shows_graded_submissions_as_graded_with_the_graders_scores(t
         zoo.graded_outputs(course, "alice", "pubsub")
     assert 0 < results["bob", "pubsub"].score < 10, zoo.graded_outputs(course, "bob", "pubsub")
     api = NbGraderAPI(config=config.load(course))
-    for assignment in ("pubsub", "brightness"):
+    for assignment in ("pubsub", "quiz"):
         for submission in api.get_submissions(assignment):
             if not submission["submitted"]:
                 continue
@@ -150,7 +151,7 @@ def test_export_has_every_student_and_assignment_with_the_late_penalty(term):
     score per started day (2 days); names with a comma stay one field."""
     results = term["results"]
     rows = _rows(term["course"] / "grades.csv")
-    assert set(rows) == {(s, a) for s in ("alice", "bob", "carol", "dave") for a in ("pubsub", "brightness")}
+    assert set(rows) == {(s, a) for s in ("alice", "bob", "carol", "dave") for a in ("pubsub", "quiz")}
     bob = rows["bob", "pubsub"]
     raw = results["bob", "pubsub"].score
     assert float(bob["raw_score"]) == pytest.approx(raw)
@@ -219,16 +220,16 @@ def test_partial_regrade_keeps_every_other_grade(term, feedback):
     """Re-grading one student's assignment with a seed (grade --student --assignment --force) and
     writing that feedback only runs that submission and keeps every other row of the report,
     grades.csv, the student's other assignment and the other students' feedback pages. (alice's
-    brightness is the one re-graded: the cheapest submission of the term to grade again.)"""
+    quiz is the one re-graded: the cheapest submission of the term to grade again.)"""
     course = term["course"]
-    regraded = ("alice", "brightness")
+    regraded = ("alice", "quiz")
     report_before = _rows(course / "grading_report.csv")
     export_before = _rows(course / "grades.csv")
     bob_page = (feedback / "bob" / "index.html").read_text()
     alice_pubsub = (course / "autograded" / "alice" / "pubsub" / "pubsub.ipynb").stat().st_mtime_ns
-    _run("grade", str(course), "--student", "alice", "--assignment", "brightness", "--force",
+    _run("grade", str(course), "--student", "alice", "--assignment", "quiz", "--force",
          env={"AUTOGRADER_SEED": "4242"})
-    _run("feedback", str(course), "--student", "alice", "--assignment", "brightness")
+    _run("feedback", str(course), "--student", "alice", "--assignment", "quiz")
     report, export = _rows(course / "grading_report.csv"), _rows(course / "grades.csv")
     assert set(report) == set(report_before) and set(export) == set(export_before)
     same = ("score", "max_score", "status", "reason")
@@ -244,4 +245,4 @@ def test_partial_regrade_keeps_every_other_grade(term, feedback):
     assert (feedback / "bob" / "index.html").read_text() == bob_page
     # One assignment's feedback for everyone keeps the other assignments in each index.
     _run("feedback", str(course), "--assignment", "pubsub")
-    assert "<td>brightness</td>" in (feedback / "alice" / "index.html").read_text()
+    assert "<td>quiz</td>" in (feedback / "alice" / "index.html").read_text()
