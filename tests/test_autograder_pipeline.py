@@ -15,7 +15,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import course_support  # noqa: E402
 import zoo  # noqa: E402
-from test_autograder import ASSIGNMENTS, CATDOG_CHECK, CATDOG_MISTAKES, FULL_RUN, PUBSUB_MISTAKES  # noqa: E402
+from test_autograder import ASSIGNMENTS, CATDOG_CHECK, CATDOG_MISTAKES, FULL_RUN  # noqa: E402
 from zoo.quiz import answered  # noqa: E402
 
 from autograder import grading  # noqa: E402
@@ -27,7 +27,6 @@ from autograder.answers import quiz as quiz_key  # noqa: E402
 FULL_RUN_MISTAKES = {
     "catdog_warp": (CATDOG_MISTAKES[FULL_RUN["catdog_warp"]][0], CATDOG_CHECK,
                     CATDOG_MISTAKES[FULL_RUN["catdog_warp"]][1]),
-    "pubsub": PUBSUB_MISTAKES[FULL_RUN["pubsub"]],
 }
 
 #: The quiz handed in with every answer right but QUIZ_WRONG's (no ROS, no build: a cheap grading).
