@@ -33,8 +33,7 @@ def write_feedback(course_dir, assignment: str | None = None, student: str | Non
     course = Path(course_dir).resolve()
     chosen = store.recorded_results(course, assignment, student)
     for name in sorted({r.assignment for r in chosen if r.status != "failed"}):
-        nbgrader_cli.run_nbgrader(["generate_feedback", name, "--force", *(["--student", student] if student else [])],
-                             course)
+        nbgrader_cli.generate_feedback(course, name, student)
     return _finish(course, chosen)
 
 

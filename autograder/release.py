@@ -6,8 +6,7 @@ from __future__ import annotations
 import shutil
 from pathlib import Path
 
-from autograder import config
-from autograder.nbgrader_cli import run_nbgrader
+from autograder import config, nbgrader_cli
 
 REPO = Path(__file__).resolve().parent.parent
 REPO_SOURCE = REPO / "assignments" / "source"
@@ -41,7 +40,7 @@ def release(course_dir, assignments: list[str] | None = None, duedate: str | Non
     course = prepare_course(course_dir)
     written = []
     for name in assignments or assignments_in(course):
-        run_nbgrader(["generate_assignment", name, "--force"], course)
+        nbgrader_cli.generate_assignment(course, name)
         if duedate:
             late.set_duedate(course, name, duedate)
         written.append(course / "release" / name)
@@ -54,7 +53,8 @@ def release_to_exchange(course_dir, exchange, assignments: list[str]) -> None:
     missing: students see them in Nbgrader > Assignment List (nbgrader release_assignment)."""
     Path(exchange).mkdir(parents=True, exist_ok=True)
     for name in assignments:
-        run_nbgrader(["release_assignment", name, "--force", f"--Exchange.root={exchange}"], Path(course_dir))
+        nbgrader_cli.run_nbgrader(["release_assignment", name, "--force", f"--Exchange.root={exchange}"],
+                                  Path(course_dir))
 
 
 def release_for_lab(lab_root=REPO, assignments: list[str] | None = None) -> list[str]:
