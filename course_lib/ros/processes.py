@@ -17,9 +17,9 @@ small process each NodeProcess starts as the node's direct parent.
 
 from __future__ import annotations
 
+import itertools
 import os
 import sys
-import threading
 import time
 from collections.abc import Callable
 
@@ -35,32 +35,7 @@ from course_lib.supervision.supervised_process import (  # noqa: F401 (Limits, s
     stop_together,
 )
 
-#: This process's graph watcher per ROS domain: {domain id: (pid, context, node)}. It lives as
-#: long as the process. A context made and shut down per wait destroyed its DDS participant just
-#: as the awaited process was being discovered, the moment Fast DDS 2.14 can deadlock in
-#: (DomainParticipant::set_listener spins with the GIL held while a discovery callback waits for
-#: its lock), and every new participant costs every other one on the machine a discovery round.
-_WATCHERS: dict[int, tuple] = {}
-_WATCHERS_LOCK = threading.Lock()
-
-
-def _graph_watcher(domain_id: int, make: bool = True):
-    """The node that reads the ROS graph of domain_id for wait_for_node, made once per process
-    (None if there is none yet and make is False)."""
-    import rclpy
-    from rclpy.context import Context
-
-    with _WATCHERS_LOCK:
-        pid, _, node = _WATCHERS.get(domain_id, (None, None, None))
-        if pid != os.getpid():  # none yet, or inherited through fork()
-            if not make:
-                return None
-            context = Context()
-            rclpy.init(context=context, domain_id=domain_id)
-            node = rclpy.create_node(f"_course_lib_wait_{os.getpid()}", context=context, enable_rosout=False,
-                                     start_parameter_services=False)
-            _WATCHERS[domain_id] = (os.getpid(), context, node)
-        return node
+_WATCHER_IDS = itertools.count()
 
 
 class NodeProcess(SupervisedProcess):
@@ -105,7 +80,6 @@ class NodeProcess(SupervisedProcess):
         self.domain_id = int(self.env["ROS_DOMAIN_ID"])
         self.warned_duplicate = False  # start() said that another program runs one of this name
         self._nodes_before: dict[str, str] = {}  # the session's nodes when start() began, by /rosout gid
-        self._watched_before: dict[str, str] = {}  # the same from this process's graph watcher
 
     def _before_start(self) -> None:
         """A named process replaces a running one of the same name (a re-run cell); the session's
@@ -115,11 +89,6 @@ class NodeProcess(SupervisedProcess):
                 if other is not self and getattr(other, "_explicit_name", False) and other.name == self.name:
                     other.stop()
         self._nodes_before = _session_nodes(self.domain_id)
-        # A node that ended a moment ago (killed: its participant is not gone until its lease ends)
-        # may still be in the watcher's graph; a node of its name must then be a new one.
-        watcher = _graph_watcher(self.domain_id, make=False)
-        self._watched_before = ({} if watcher is None else
-                                {str(endpoint.endpoint_gid): full for endpoint, full in _rosout_publishers(watcher)})
 
     def _after_start(self) -> None:
         if self._explicit_name:
@@ -143,6 +112,9 @@ class NodeProcess(SupervisedProcess):
             RuntimeError: the child exited first (the message has its exit code and last output).
             TimeoutError: the node did not appear (the message has the child's last output).
         """
+        import rclpy
+        from rclpy.context import Context
+
         self._require_started()
         if node_name.startswith("/"):
             namespace, _, node_name = node_name.rpartition("/")
@@ -150,33 +122,35 @@ class NodeProcess(SupervisedProcess):
         elif namespace is not None:
             namespace = "/" + namespace.strip("/")
         wanted = node_name if namespace is None else f"{namespace.rstrip('/')}/{node_name}"
+        already_running = {gid: full for gid, full in self._nodes_before.items()
+                           if full.rsplit("/", 1)[-1] == node_name and (namespace is None or full == wanted)}
+        context = Context()
+        rclpy.init(context=context, domain_id=self.domain_id)
+        watcher = None
+        try:
+            watcher = rclpy.create_node(f"_course_lib_wait_{os.getpid()}_{next(_WATCHER_IDS)}",
+                                        context=context, enable_rosout=False,
+                                        start_parameter_services=False)
+            def appeared() -> bool:
+                # The graph is filled in by DDS discovery threads; no spinning needed to read it.
+                return any(name == node_name and namespace in (None, ns)
+                           for name, ns in watcher.get_node_names_and_namespaces())
 
-        def wanted_name(full: str) -> bool:
-            return full.rsplit("/", 1)[-1] == node_name and (namespace is None or full == wanted)
-
-        already_running = {gid: full for gid, full in self._nodes_before.items() if wanted_name(full)}
-        seen_before = {gid for gid, full in self._watched_before.items() if wanted_name(full)}
-        watcher = _graph_watcher(self.domain_id)
-
-        def appeared() -> bool:
-            # The graph is filled in by DDS discovery threads; no spinning needed to read it.
-            if not any(name == node_name and namespace in (None, ns)
-                       for name, ns in watcher.get_node_names_and_namespaces()):
-                return False
-            return not seen_before or any(str(endpoint.endpoint_gid) not in seen_before and wanted_name(full)
-                                          for endpoint, full in _rosout_publishers(watcher))
-
-        if waiting.spin_until(lambda: appeared() or not self.running(), timeout) and appeared():
-            if already_running and not self.warned_duplicate:
-                _warn_if_still_running(already_running, self)
-            return
-        if not self.running():
-            raise RuntimeError(f"{self.name} ended ({self.describe_exit()}) before node {wanted!r} "
-                               f"appeared. Last output:\n{self.log_tail()}")
-        raise TimeoutError(
-            f"Node {wanted!r} did not appear in ROS domain {self.domain_id} within {timeout} s, "
-            f"although {self.name} still runs: check the node name it passes to Node() and "
-            f"that it calls rclpy.init(). Last output:\n{self.log_tail()}")
+            if waiting.spin_until(lambda: appeared() or not self.running(), timeout) and appeared():
+                if already_running and not self.warned_duplicate:
+                    _warn_if_still_running(already_running, self)
+                return
+            if not self.running():
+                raise RuntimeError(f"{self.name} ended ({self.describe_exit()}) before node {wanted!r} "
+                                   f"appeared. Last output:\n{self.log_tail()}")
+            raise TimeoutError(
+                f"Node {wanted!r} did not appear in ROS domain {self.domain_id} within {timeout} s, "
+                f"although {self.name} still runs: check the node name it passes to Node() and "
+                f"that it calls rclpy.init(). Last output:\n{self.log_tail()}")
+        finally:
+            if watcher is not None:
+                watcher.destroy_node()
+            context.try_shutdown()
 
     def _note_running(self) -> None:
         """Record this named process machine-wide, and warn plainly when another program (a
