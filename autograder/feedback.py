@@ -58,7 +58,6 @@ def write_in_process(course_dir, assignment: str, students: list[str], scores_on
 
     from nbconvert.preprocessors import CSSHTMLHeaderPreprocessor
     from nbgrader.converters import GenerateFeedback
-    from nbgrader.coursedir import CourseDirectory
     from nbgrader.preprocessors import GetGrades
 
     from autograder import config
@@ -70,9 +69,7 @@ def write_in_process(course_dir, assignment: str, students: list[str], scores_on
     settings = config.load(course)
     settings.GenerateFeedback.preprocessors = [GetGrades, CSSHTMLHeaderPreprocessor,
                                                *([hide.ScoresOnly] if scores_only else [])]
-    coursedir = CourseDirectory(config=settings, root=str(course))
-    coursedir.assignment_id = assignment
-    converter = GenerateFeedback(coursedir=coursedir, config=settings)
+    converter = nbgrader_cli.converter_for(GenerateFeedback, course, assignment, settings=settings)
     converter.force = False
     converter.start()
     chosen = [r for student in students for r in store.recorded_results(course, assignment, student)]

@@ -34,22 +34,26 @@ def run_nbgrader(args: list[str], course: Path, timeout: float = 300) -> str:
     return done.stdout + done.stderr
 
 
-
-def _run_converter(converter_class, course: Path, assignment: str, student: str | None = None) -> str:
-    """Run an nbgrader converter on one assignment of the course (and one student's submission, if
-    given) with the course's configuration; its log; RuntimeError with the log on failure."""
+def converter_for(converter_class, course: Path, assignment: str, student: str | None = None, settings=None):
+    """An nbgrader converter (GenerateAssignment, GenerateFeedback, ...) for one assignment of the
+    course (and one student's submission, if given), with the course's configuration or `settings`."""
     from nbgrader.coursedir import CourseDirectory
-    from nbgrader.utils import capture_log
 
     from autograder import config
 
-    settings = config.load(course)
-    settings.CourseDirectory.root = str(course)
-    coursedir = CourseDirectory(config=settings)
+    settings = config.load(course) if settings is None else settings
+    coursedir = CourseDirectory(config=settings, root=str(course))
     coursedir.assignment_id = assignment
     if student:
         coursedir.student_id = student
-    converter = converter_class(coursedir=coursedir, config=settings)
+    return converter_class(coursedir=coursedir, config=settings)
+
+
+def _run_converter(converter_class, course: Path, assignment: str, student: str | None = None) -> str:
+    """Run a converter as its command does with --force; its log; RuntimeError with the log on failure."""
+    from nbgrader.utils import capture_log
+
+    converter = converter_for(converter_class, course, assignment, student)
     converter.force = True
     outcome = capture_log(converter)
     log = outcome.get("log", "")
