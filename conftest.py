@@ -16,6 +16,8 @@ os.environ["ROS_DOMAIN_ID"] = str(_reservation.domain_id)
 os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
 os.environ.pop("ROS_LOCALHOST_ONLY", None)
 os.environ[contract.UNDER_TEST_ENV] = "1"
+# The xdist workers start after this file is read, and every process the suite starts inherits it.
+os.environ.update({name: os.environ.get(name, value) for name, value in rosenv.BLAS_THREADS.items()})
 
 
 def pytest_addoption(parser, pluginmanager):

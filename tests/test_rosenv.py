@@ -101,6 +101,16 @@ def test_a_small_dev_shm_keeps_fast_dds_defaults(monkeypatch):
     assert not set(rosenv.FASTDDS_USER_SETTINGS) & set(env)
 
 
+def test_child_processes_import_numpy_with_one_blas_thread_unless_the_user_chose():
+    """OpenBLAS's threads (one per core, spinning at import) are left out of the course's ROS processes."""
+    count_threads = "import os, numpy; print(len(os.listdir('/proc/self/task')))"
+    env = rosenv.ros_environment(base={"PATH": os.environ["PATH"]})
+    assert env["OPENBLAS_NUM_THREADS"] == "1"
+    done = subprocess.run([sys.executable, "-c", count_threads], env=env, capture_output=True, text=True, check=True)
+    assert done.stdout == "1\n", "numpy started threads of its own"
+    assert rosenv.ros_environment(base={"PATH": "/usr/bin", "OPENBLAS_NUM_THREADS": "4"})["OPENBLAS_NUM_THREADS"] == "4"
+
+
 def without_fast_dds_settings() -> dict:
     return {k: v for k, v in os.environ.items() if k not in rosenv.FASTDDS_USER_SETTINGS}
 

@@ -49,6 +49,12 @@ FASTDDS_USER_SETTINGS = ("FASTRTPS_DEFAULT_PROFILES_FILE", "FASTDDS_BUILTIN_TRAN
 #: the fourth process would print errors and fall back to UDP.
 SHARED_MEMORY_NEEDED_MB = 512
 
+#: numpy's OpenBLAS starts a thread per core when numpy is imported, and those threads spin before
+#: they sleep: about 0.1 s of processor time in every process that imports numpy (rclpy does),
+#: for nothing, since ROS nodes and image code do no BLAS work worth threads. The course's ROS
+#: processes run with one BLAS thread unless the user chose a number.
+BLAS_THREADS = {"OPENBLAS_NUM_THREADS": "1"}
+
 
 @dataclasses.dataclass(frozen=True)
 class RosInstall:
@@ -149,8 +155,9 @@ def ros_environment(domain_id: int | None = None, base: dict[str, str] | None = 
 
     Returns:
         A new dict: discovery limited to this machine, the ament index of the install
-        reachable through AMENT_PREFIX_PATH, this interpreter's bin/ first on PATH, and
-        unbuffered Python output so that logs arrive while the node runs.
+        reachable through AMENT_PREFIX_PATH, this interpreter's bin/ first on PATH,
+        unbuffered Python output so that logs arrive while the node runs, and one BLAS
+        thread (BLAS_THREADS) unless the base environment chose a number.
     """
     env = dict(os.environ if base is None else base)
     install = install or detect_install()
@@ -168,6 +175,8 @@ def ros_environment(domain_id: int | None = None, base: dict[str, str] | None = 
     path = env.get("PATH", "").split(os.pathsep)
     env["PATH"] = os.pathsep.join([bindir] + [p for p in path if p and p != bindir])
     env["PYTHONUNBUFFERED"] = "1"
+    for name, value in BLAS_THREADS.items():
+        env.setdefault(name, value)
     env.update(large_data_environment(env))
     return env
 
