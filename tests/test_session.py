@@ -3,6 +3,7 @@
 import subprocess
 import sys
 import threading
+import time
 
 import pytest
 import rclpy
@@ -313,3 +314,49 @@ def test_the_session_stops_itself_when_the_interpreter_exits(domain_id):
     assert result.returncode == 0, result.stderr
     assert "started: True" in result.stdout
     assert "running at exit: False" in result.stdout
+
+
+class SlowToNote:
+    """An action client's handle that, after sending a goal request, holds the sending thread a
+    moment, as a busy machine may between rclpy's send and its note of the request's number."""
+
+    def __init__(self, handle):
+        self._handle = handle
+
+    def __getattr__(self, name):
+        return getattr(self._handle, name)
+
+    def __enter__(self):
+        return self._handle.__enter__()
+
+    def __exit__(self, *exc):
+        return self._handle.__exit__(*exc)
+
+    def send_goal_request(self, request):
+        number = self._handle.send_goal_request(request)
+        time.sleep(0.3)  # the session's thread meanwhile gets the server's answer
+        return number
+
+
+def test_a_goal_answered_before_the_client_noted_its_request_still_completes(domain_id):
+    """rclpy issue #1123 (course_lib.ros.rclpy_backports): a goal sent from a cell while the
+    session's thread spins the client completes even when the answer comes before rclpy has
+    noted the request (without the fix rclpy drops it as from 'more than one action server')."""
+    from rclpy.action import ActionClient, ActionServer
+    from test_msgs.action import Fibonacci
+
+    def execute(goal_handle):
+        goal_handle.succeed()
+        return Fibonacci.Result(sequence=[0, 1])
+
+    session.start(domain_id=domain_id)
+    node = session.add_node(Node("goal_pair"))
+    ActionServer(node, Fibonacci, "fibonacci", execute)
+    client = ActionClient(node, Fibonacci, "fibonacci")
+    assert session.wait_for(client.server_is_ready, timeout=30)
+    client._client_handle = SlowToNote(client._client_handle)
+    sent = client.send_goal_async(Fibonacci.Goal(order=1))
+    assert session.wait_for(sent.done, timeout=30), "the goal's answer was dropped"
+    assert sent.result().accepted
+    finished = sent.result().get_result_async()
+    assert session.wait_for(finished.done, timeout=30) and list(finished.result().result.sequence) == [0, 1]

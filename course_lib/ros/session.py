@@ -47,7 +47,7 @@ import traceback
 from collections.abc import Callable
 
 from course_lib import waiting
-from course_lib.ros import node_logs, node_names, rosenv
+from course_lib.ros import node_logs, node_names, rclpy_backports, rosenv
 
 #: Name of the session's hidden helper node (a leading "_" hides it from node listings).
 TOOL_NODE_NAME = "_course_tools"
@@ -172,6 +172,7 @@ def start(domain_id: int | None = None) -> None:
         _state = state
         _stopped = False
         _install_node_hook()
+        rclpy_backports.install()  # action clients spun by this thread while cells send goals
         state.thread.start()
         if not _atexit_registered:
             atexit.register(stop)
