@@ -1,6 +1,6 @@
 """Fixes that later rclpy releases have and the ros-jazzy wheels on PyPI lack, applied to this process.
 
-rclpy issue #1123 (fixed upstream by pull request #1308, and in Jazzy by its backport #1519): an
+rclpy issue #1123 (fixed upstream by pull request #1308, backported in 2025 by #1517 and #1519): an
 ActionClient's ``send_goal_async``, ``get_result_async`` and ``cancel_goal_async`` send their
 request and only then note its sequence number. When an executor spins the client in another
 thread, as the course's session does (course_lib.ros.session), the answer can be taken in
