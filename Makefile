@@ -40,9 +40,13 @@ HUB_DIR ?= /srv/ros2cv-hub
 
 setup: $(VENV)/.setup-done
 
-# jsonschema's optional IRI checker rfc3987-syntax (pulled in by jupyter-events) compiles ~30
-# Lark parsers at import: 2-4 s of CPU in every process that imports nbformat (nbgrader, nbclient,
-# Jupyter, the test workers). Nothing here validates IRIs, so the override leaves it out.
+# jsonschema's optional format checkers (pulled in by jupyter-events' jsonschema[format-nongpl]) are
+# imported with jsonschema, so in every process that imports nbformat (nbgrader, nbclient, Jupyter,
+# the test workers): rfc3987-syntax compiles ~30 Lark parsers (2-4 CPU-s), and the others (arrow's
+# date parser through isoduration, the URI and colour checkers) cost about 0.1 CPU-s more. Only
+# jsonschema imports them, and nothing here checks those formats: the overrides leave them out.
+OPTIONAL_FORMAT_CHECKERS := rfc3987-syntax isoduration arrow fqdn uri-template webcolors jsonpointer \
+                            rfc3986-validator rfc3339-validator
 $(VENV)/.setup-done: Makefile environment.txt pyproject.toml course_lib/ros/wheelfix.py course_lib/ros2cli/install.py \
                      course_lib/ros/underlay.py
 	@$(PYTHON) -c 'import sys; v = sys.version_info[:2]; ok = (3, 10) <= v <= (3, 13); \
@@ -54,9 +58,9 @@ $(VENV)/.setup-done: Makefile environment.txt pyproject.toml course_lib/ros/whee
 	@test -x $(PY) || $(PYTHON) -m venv $(VENV_FLAGS) $(VENV)
 	@test -x $(UV) || $(PY) -m pip install --quiet --disable-pip-version-check uv==$(UV_VERSION)
 	@if [ "$(ROS)" != pip ]; then grep -v -E '^(ros-jazzy-|colcon-)' environment.txt > $(REQUIREMENTS); fi
-	@printf 'rfc3987-syntax ; sys_platform == "never"\n' > $(VENV)/overrides.txt
+	@printf '%s ; sys_platform == "never"\n' $(OPTIONAL_FORMAT_CHECKERS) > $(VENV)/overrides.txt
 	$(UV) pip install --quiet --python $(PY) -r $(REQUIREMENTS) --overrides $(VENV)/overrides.txt -e .
-	@$(UV) pip uninstall --quiet --python $(PY) rfc3987-syntax 2>/dev/null || true  # from a venv made before
+	@$(UV) pip uninstall --quiet --python $(PY) $(OPTIONAL_FORMAT_CHECKERS) 2>/dev/null || true  # from a venv made before
 	$(PY) -m course_lib repair-wheels
 	$(PY) -m course_lib install-ros2
 	$(PY) -m course_lib underlay
