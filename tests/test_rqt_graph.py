@@ -1,8 +1,6 @@
 """Tests for course_lib.notebook.rqt_graph: the picture of the ROS graph, rqt_graph's stand-in."""
 
 import pytest
-from matplotlib.figure import Figure
-from matplotlib.text import Annotation
 from rclpy.node import Node
 from std_msgs.msg import String
 
@@ -32,6 +30,9 @@ def test_layered_layout_is_layered_and_survives_cycles():
 
 def test_draw_graph_shows_nodes_and_topics_left_to_right(local_session):
     """draw_graph() draws talker -> /chatter -> listener, and leaves out /rosout and tool node."""
+    from matplotlib.figure import Figure  # here, not at collection, where every test worker would pay it
+    from matplotlib.text import Annotation
+
     session.add_node(Node("talker")).create_publisher(String, "chatter", 10)
     session.add_node(Node("listener")).create_subscription(String, "chatter", lambda msg: None, 10)
     figure = rqt_graph.draw_graph()

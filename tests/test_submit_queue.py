@@ -9,7 +9,6 @@ import threading
 from datetime import datetime, timedelta
 
 from autograder.submit_queue import SubmitQueue
-from coursehub import grading_status
 
 T0 = datetime(2026, 3, 1, 12, 0)
 
@@ -58,6 +57,8 @@ def test_a_queue_file_of_the_first_version_gets_the_worker_columns(tmp_path):
 
 
 def test_a_newer_submission_supersedes_the_queued_one_and_the_page_counts_who_is_ahead(tmp_path):
+    from coursehub import grading_status  # here, not at collection: it imports JupyterHub (about 1.5 CPU-s)
+
     queue = SubmitQueue(tmp_path)
     _add(queue, "ann", 0)
     old = _add(queue, "bob", 1)
