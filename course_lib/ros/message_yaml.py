@@ -7,7 +7,8 @@ from __future__ import annotations
 import array
 import functools
 import importlib
-import sys
+
+import numpy as np
 
 # --- message types ----------------------------------------------------------------------
 
@@ -46,13 +47,6 @@ def message_class(type_name: str, kind: str = "msg"):
 
 
 
-def _numpy():
-    """numpy if this process has imported it, else None. A field holds a numpy array or scalar only
-    after its message's module imported numpy, so a verb that meets none (ros2 node list, param get)
-    is spared numpy's import: about 0.15 CPU-s in every ros2 call."""
-    return sys.modules.get("numpy")
-
-
 def message_to_dict(msg, truncate_length: int | None = 128, no_arr: bool = False,
                     no_str: bool = False):
     """A message as plain dicts, lists and numbers (for printing, JSON or comparisons).
@@ -80,8 +74,7 @@ def message_to_dict(msg, truncate_length: int | None = 128, no_arr: bool = False
             return f"<string length: <{len(msg)}>>"
         cut = truncate_length is not None and len(msg) > truncate_length
         return msg[:truncate_length] + "..." if cut else msg
-    np = _numpy()
-    if isinstance(msg, array.array) or (np is not None and isinstance(msg, np.ndarray)):
+    if isinstance(msg, (np.ndarray, array.array)):
         msg = msg.tolist()
     if isinstance(msg, (list, tuple)):
         items = list(msg)
@@ -89,7 +82,7 @@ def message_to_dict(msg, truncate_length: int | None = 128, no_arr: bool = False
         items = [message_to_dict(item, truncate_length, no_arr, no_str)
                  for item in (items[:truncate_length] if cut else items)]
         return items + ["..."] if cut else items
-    if np is not None and isinstance(msg, np.generic):
+    if isinstance(msg, np.generic):
         return msg.item()
     return msg
 
@@ -189,7 +182,7 @@ def _fill(msg, values, setters: list, path: str) -> None:
             value = items
         elif isinstance(current, array.array):
             value = _converted(functools.partial(array.array, current.typecode), where, fields[field], value)
-        elif (np := _numpy()) is not None and isinstance(current, np.ndarray):
+        elif isinstance(current, np.ndarray):
             value = _converted(functools.partial(np.array, dtype=current.dtype), where, fields[field], value)
         elif not isinstance(current, list) and type(value) is not type(current):
             value = _converted(type(current), where, fields[field], value)
