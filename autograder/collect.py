@@ -78,7 +78,7 @@ def collect(course_dir, assignment: str, archives: list) -> list[str]:
                                     "notebooks)")
         shutil.copy2(archive, inbox / archive.name)
     before = _files(course, assignment)
-    log = nbgrader_cli.run_nbgrader(["zip_collect", assignment, "--force"], course)
+    log = nbgrader_cli.zip_collect(course, assignment)
     after = _files(course, assignment)
     students = sorted({path.parent.parent.name for path, stamp in after.items() if before.get(path) != stamp})
     if not students:

@@ -1,12 +1,14 @@
-"""nbgrader on a course directory: its command line, run with this repository importable, and its
-converters run in this process (``generate_assignment``, ``generate_feedback``) as its formgrader
-runs them, which spares a Python start and a second ``import nbgrader`` (1.5-3 s of processor time)
-per call."""
+"""nbgrader on a course directory: the environment of its processes (this repository importable),
+and the steps of its commands run in this process with the course's configuration, as its formgrader runs
+them (the converters of ``generate_assignment`` and ``generate_feedback``, ``zip_collect``'s app,
+``release_assignment``'s exchange step), which spares a Python start and a second ``import
+nbgrader`` (1.5-3 s of processor time on an idle machine) per call."""
 
 from __future__ import annotations
 
+import contextlib
+import logging
 import os
-import subprocess
 import sys
 from pathlib import Path
 
@@ -16,6 +18,7 @@ REPO = Path(__file__).resolve().parent.parent
 
 
 def env_for_tools() -> dict:
+    """This process's environment with this repository on PYTHONPATH and this Python's folder on PATH."""
     env = dict(os.environ)
     path = [str(REPO)] + [p for p in env.get("PYTHONPATH", "").split(os.pathsep) if p and p != str(REPO)]
     env["PYTHONPATH"] = os.pathsep.join(path)
@@ -23,44 +26,66 @@ def env_for_tools() -> dict:
     return env
 
 
-def run_nbgrader(args: list[str], course: Path, timeout: float = 300) -> str:
-    """Run the nbgrader CLI on a course directory; raise RuntimeError with its output on failure."""
-    command = [sys.executable, "-m", "nbgrader", *args, f"--CourseDirectory.root={course}"]
-    done = subprocess.run(command, cwd=course, env=env_for_tools(), capture_output=True, text=True,
-                          timeout=timeout)
-    if done.returncode != 0:
-        raise RuntimeError(f"nbgrader {' '.join(args)} failed (exit code {done.returncode}):\n"
-                           f"{(done.stdout + done.stderr)[-3000:]}")
-    return done.stdout + done.stderr
-
-
 def converter_for(converter_class, course: Path, assignment: str, student: str | None = None, settings=None):
     """An nbgrader converter (GenerateAssignment, GenerateFeedback, ...) for one assignment of the
     course (and one student's submission, if given), with the course's configuration or `settings`."""
-    from nbgrader.coursedir import CourseDirectory
-
     from autograder import config
 
     settings = config.load(course) if settings is None else settings
+    return converter_class(coursedir=_course_directory(course, assignment, settings, student), config=settings)
+
+
+def _course_directory(course: Path, assignment: str, settings, student: str | None = None):
+    """nbgrader's CourseDirectory of the course with `settings`, set to one assignment (and student)."""
+    from nbgrader.coursedir import CourseDirectory
+
     coursedir = CourseDirectory(config=settings, root=str(course))
     coursedir.assignment_id = assignment
     if student:
         coursedir.student_id = student
-    return converter_class(coursedir=coursedir, config=settings)
+    return coursedir
+
+
+def _run_in_process(step, what: str) -> str:
+    """Start an nbgrader app, converter or exchange step; its log; RuntimeError with the log on failure
+    (an app's ``fail`` exits, which is caught here like any error)."""
+    from nbgrader.utils import capture_log
+
+    outcome = capture_log(step)
+    log = outcome.get("log", "")
+    if not outcome["success"]:
+        raise RuntimeError(f"nbgrader {what} failed:\n{(log + outcome.get('error', ''))[-3000:]}")
+    return log
 
 
 def _run_converter(converter_class, course: Path, assignment: str, student: str | None = None) -> str:
     """Run a converter as its command does with --force; its log; RuntimeError with the log on failure."""
-    from nbgrader.utils import capture_log
-
     converter = converter_for(converter_class, course, assignment, student)
     converter.force = True
-    outcome = capture_log(converter)
-    log = outcome.get("log", "")
-    if not outcome["success"]:
-        raise RuntimeError(f"nbgrader {converter_class.__name__} of {assignment} failed:\n"
-                           f"{(log + outcome.get('error', ''))[-3000:]}")
+    return _run_in_process(converter, f"{converter_class.__name__} of {assignment}")
+
+
+def _command_log(command: str) -> logging.Logger:
+    """A logger at the command's level (INFO) that prints nothing: what it logs is returned (an
+    app's own logger would print to this process's stderr, a plain step's drop the INFO lines)."""
+    log = logging.getLogger(f"autograder.nbgrader_cli.{command}")
+    log.propagate = False
+    log.setLevel(logging.INFO)
     return log
+
+
+@contextlib.contextmanager
+def _course_importable(course: Path):
+    """The course directory on sys.path, as the command has its working directory (there), so that a
+    plugin the course's nbgrader_config.py names from a module beside it is found."""
+    added = str(course) not in sys.path
+    if added:
+        sys.path.insert(0, str(course))
+    try:
+        yield
+    finally:
+        if added:
+            sys.path.remove(str(course))
 
 
 def generate_assignment(course: Path, assignment: str) -> str:
@@ -77,3 +102,38 @@ def generate_feedback(course: Path, assignment: str, student: str | None = None)
     from nbgrader.converters import GenerateFeedback
 
     return _run_converter(GenerateFeedback, Path(course), assignment, student)
+
+
+def zip_collect(course: Path, assignment: str) -> str:
+    """``nbgrader zip_collect ASSIGNMENT --force``: the files in downloaded/ASSIGNMENT/archive/
+    extracted and copied to submitted/<student>/ASSIGNMENT/ by the course's collector plugin."""
+    from nbgrader.apps.zipcollectapp import ZipCollectApp
+
+    from autograder import config
+
+    course = Path(course)
+    settings = config.load(course)
+    settings.ZipCollectApp.force = settings.ExtractorPlugin.force = True  # --force
+    app = ZipCollectApp(config=settings, log=_command_log("zip_collect"))
+    app.coursedir = _course_directory(course, assignment, settings)
+    with _course_importable(course):
+        return _run_in_process(app, f"zip_collect {assignment}")
+
+
+def release_assignment(course: Path, assignment: str, exchange: Path) -> str:
+    """``nbgrader release_assignment ASSIGNMENT --force --Exchange.root=EXCHANGE``: the assignment's
+    release/ folder into the exchange's outbound/, as the files of this process's user."""
+    from nbgrader.auth import Authenticator
+    from nbgrader.exchange import ExchangeFactory
+
+    from autograder import config
+
+    course = Path(course)
+    settings = config.load(course)
+    settings.Exchange.root = str(exchange)
+    settings.ExchangeReleaseAssignment.force = True  # --force
+    step = ExchangeFactory(config=settings).ReleaseAssignment(
+        coursedir=_course_directory(course, assignment, settings), authenticator=Authenticator(config=settings),
+        config=settings, log=_command_log("release_assignment"))
+    with _course_importable(course):
+        return _run_in_process(step, f"release_assignment {assignment}")

@@ -53,8 +53,7 @@ def release_to_exchange(course_dir, exchange, assignments: list[str]) -> None:
     missing: students see them in Nbgrader > Assignment List (nbgrader release_assignment)."""
     Path(exchange).mkdir(parents=True, exist_ok=True)
     for name in assignments:
-        nbgrader_cli.run_nbgrader(["release_assignment", name, "--force", f"--Exchange.root={exchange}"],
-                                  Path(course_dir))
+        nbgrader_cli.release_assignment(Path(course_dir), name, Path(exchange))
 
 
 def release_for_lab(lab_root=REPO, assignments: list[str] | None = None) -> list[str]:
