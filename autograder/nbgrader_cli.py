@@ -114,9 +114,9 @@ def zip_collect(course: Path, assignment: str) -> str:
     course = Path(course)
     settings = config.load(course)
     settings.ZipCollectApp.force = settings.ExtractorPlugin.force = True  # --force
-    app = ZipCollectApp(config=settings, log=_command_log("zip_collect"))
-    app.coursedir = _course_directory(course, assignment, settings)
-    with _course_importable(course):
+    with _course_importable(course):  # the plugins are imported when the app reads its settings
+        app = ZipCollectApp(config=settings, log=_command_log("zip_collect"))
+        app.coursedir = _course_directory(course, assignment, settings)
         return _run_in_process(app, f"zip_collect {assignment}")
 
 
@@ -132,8 +132,8 @@ def release_assignment(course: Path, assignment: str, exchange: Path) -> str:
     settings = config.load(course)
     settings.Exchange.root = str(exchange)
     settings.ExchangeReleaseAssignment.force = True  # --force
-    step = ExchangeFactory(config=settings).ReleaseAssignment(
-        coursedir=_course_directory(course, assignment, settings), authenticator=Authenticator(config=settings),
-        config=settings, log=_command_log("release_assignment"))
-    with _course_importable(course):
+    with _course_importable(course):  # the exchange and authenticator classes are imported with the settings
+        step = ExchangeFactory(config=settings).ReleaseAssignment(
+            coursedir=_course_directory(course, assignment, settings), authenticator=Authenticator(config=settings),
+            config=settings, log=_command_log("release_assignment"))
         return _run_in_process(step, f"release_assignment {assignment}")

@@ -4,13 +4,14 @@ the submission time kept in timestamp.txt; what nbgrader would not grade is repo
 from __future__ import annotations
 
 import datetime
+import sys
 import zipfile
 
 import course_support
 import pytest
 from traitlets.config import Config
 
-from autograder import collect, roster
+from autograder import collect, config, nbgrader_cli, roster
 
 
 @pytest.mark.parametrize("zone, hour", [("UTC", 9), ("Europe/Berlin", 8)])
@@ -77,3 +78,27 @@ def test_collect_without_a_release_or_matching_names_says_what_to_do(course, tmp
         collect.collect(course, "pubsub", [zip_path])
     with pytest.raises(FileNotFoundError, match="does not exist"):
         collect.collect(course, "pubsub", [tmp_path / "missing.zip"])
+
+
+def test_a_collector_plugin_beside_the_course_config_is_used_as_by_the_command(tmp_path):
+    """nbgrader zip_collect, run in the course folder, finds a plugin module kept there; the grader's
+    in-process zip_collect finds it too, and leaves sys.path as it was."""
+    course = tmp_path / "course"
+    course.mkdir()
+    settings = config.write_config(course)
+    settings.write_text(settings.read_text() + 'c.ZipCollectApp.collector_plugin = "own_names.OwnNames"\n')
+    (course / "own_names.py").write_text(
+        "from nbgrader.plugins import FileNameCollectorPlugin\n\n\n"
+        "class OwnNames(FileNameCollectorPlugin):\n"
+        "    def collect(self, submitted_file):\n"
+        "        student, name = submitted_file.rsplit('/', 1)[1].split('--')\n"
+        "        return {'student_id': student, 'file_id': name, 'timestamp': '2025-03-15 08:00:00'}\n")
+    inbox = course / "downloaded" / "a" / "archive"
+    inbox.mkdir(parents=True)
+    (inbox / "erin--a.ipynb").write_text("{}")
+    path_before = list(sys.path)
+    log = nbgrader_cli.zip_collect(course, "a")
+    assert "Using file collector: OwnNames" in log
+    assert (course / "submitted" / "erin" / "a" / "a.ipynb").read_text() == "{}"
+    assert (course / "submitted" / "erin" / "a" / "timestamp.txt").read_text() == "2025-03-15 08:00:00"
+    assert sys.path == path_before
