@@ -20,6 +20,10 @@ import threading
 #: requests that note their sequence number after sending.
 LOCKED_METHODS = ("take_data", "send_goal_async", "_cancel_goal_async", "_get_result_async")
 
+#: The attribute of an ActionClient that holds its lock (made at its first locked call: clients
+#: made before install() get one too).
+_LOCK = "_course_lib_lock"
+
 _installed = False
 _installing = threading.Lock()
 
@@ -42,8 +46,10 @@ def install() -> None:
 def _holding_the_clients_lock(method):
     @functools.wraps(method)
     def locked(client, *args, **kwargs):
-        # dict.setdefault is atomic: two threads that meet here first get the same lock.
-        with client.__dict__.setdefault("_course_lib_lock", threading.RLock()):
+        lock = client.__dict__.get(_LOCK)
+        if lock is None:  # the client's first call; setdefault is atomic, so two threads get one lock
+            lock = client.__dict__.setdefault(_LOCK, threading.RLock())
+        with lock:
             return method(client, *args, **kwargs)
 
     return locked
