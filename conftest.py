@@ -18,7 +18,7 @@ os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
 os.environ.pop("ROS_LOCALHOST_ONLY", None)
 os.environ[contract.UNDER_TEST_ENV] = "1"
 # The xdist workers start after this file is read, and every process the suite starts inherits it.
-os.environ.update({name: os.environ.get(name, value) for name, value in rosenv.BLAS_THREADS.items()})
+rosenv.keep_blas_to_one_thread(os.environ)
 # The workers outnumber the cores, so OpenCV's thread pool in a worker only adds switching: the
 # scene and photo tests take 41 CPU-s with it and 32 without. Processes the tests start keep theirs.
 cv2.setNumThreads(1)

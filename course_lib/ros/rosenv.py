@@ -175,10 +175,16 @@ def ros_environment(domain_id: int | None = None, base: dict[str, str] | None = 
     path = env.get("PATH", "").split(os.pathsep)
     env["PATH"] = os.pathsep.join([bindir] + [p for p in path if p and p != bindir])
     env["PYTHONUNBUFFERED"] = "1"
-    for name, value in BLAS_THREADS.items():
-        env.setdefault(name, value)
+    keep_blas_to_one_thread(env)
     env.update(large_data_environment(env))
     return env
+
+
+def keep_blas_to_one_thread(environ) -> None:
+    """Give an environment (a dict, or os.environ for this process's children) BLAS_THREADS
+    where the user has not chosen a number of threads."""
+    for name, value in BLAS_THREADS.items():
+        environ.setdefault(name, value)
 
 
 def large_data_environment(environ: dict[str, str] | None = None) -> dict[str, str]:
