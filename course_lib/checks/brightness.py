@@ -281,7 +281,8 @@ def node(ctx: Context) -> None:
             _remapped(ctx, probe, remapped, remapped_image)
             # Stopped before the burst: a node that did not take the remapped names would answer it too.
             remapped.stop(timeout=2)
-            brightness_throughput.measure(ctx, probe, node, yardstick, publisher, replies, yardstick_replies, burst)
+            brightness_throughput.measure(ctx, probe, node, yardstick, publisher, replies, yardstick_replies, burst,
+                                          frozenset(earlier))
             if _node_died(ctx, node):
                 crashed = True
                 ctx.items.pop()  # the throughput item: the crash is its cause
