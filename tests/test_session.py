@@ -360,3 +360,26 @@ def test_a_goal_answered_before_the_client_noted_its_request_still_completes(dom
     assert sent.result().accepted
     finished = sent.result().get_result_async()
     assert session.wait_for(finished.done, timeout=30) and list(finished.result().result.sequence) == [0, 1]
+
+
+@pytest.mark.parametrize("end", ["remove_node", "stop"])
+def test_a_node_with_an_action_client_and_server_leaves_the_graph(domain_id, end):
+    """Jazzy's destroy_node() leaves the action clients and servers made on a node, and they keep
+    the node in the graph; the session destroys them with the node. (A client a cell made and
+    never destroyed kept the lesson 04 check's node in the domain, where a later check saw it.)"""
+    from rclpy.action import ActionClient, ActionServer
+    from test_msgs.action import Fibonacci
+
+    from course_lib.checks.probe import RosProbe
+
+    session.start(domain_id=domain_id)
+    node = session.add_node(Node("with_actions"))
+    ActionClient(node, Fibonacci, "fibonacci")
+    ActionServer(node, Fibonacci, "fibonacci", lambda goal_handle: Fibonacci.Result())
+    with RosProbe(domain_id) as probe:
+        def listed():
+            return "with_actions" in [name for name, _ in probe.node.get_node_names_and_namespaces()]
+
+        assert probe.spin_until(listed, 30.0), "the node never appeared"
+        session.remove_node(node) if end == "remove_node" else session.stop()
+        assert probe.spin_until(lambda: not listed(), 30.0), f"the node stayed in the graph after {end}()"

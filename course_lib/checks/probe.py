@@ -51,8 +51,10 @@ class RosProbe:
 
     def close(self) -> None:
         try:
+            from course_lib.ros import teardown
+
             self.executor.shutdown(timeout_sec=1.0)
-            self.node.destroy_node()
+            teardown.destroy_node(self.node)  # with the action clients a check made on it
         finally:
             self.context.try_shutdown()
 

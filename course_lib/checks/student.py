@@ -72,6 +72,8 @@ def _endpoints(request: dict) -> dict:
     "reliability", "durability"}]}} of node class request["class"], constructed without arguments."""
     import rclpy
 
+    from course_lib.ros import teardown
+
     module = importlib.import_module(request["module"])
     rclpy.init()
     try:
@@ -83,7 +85,7 @@ def _endpoints(request: dict) -> dict:
                              "reliability": e.qos_profile.reliability.name,
                              "durability": e.qos_profile.durability.name}
                             for e in endpoints_of_kind if not e.topic_name.startswith(("/rosout", "/parameter_events"))]
-        node.destroy_node()
+        teardown.destroy_node(node)  # with the action servers a node class makes in __init__
     finally:
         rclpy.try_shutdown()
     return {"endpoints": report}

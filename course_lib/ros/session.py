@@ -47,7 +47,7 @@ import traceback
 from collections.abc import Callable
 
 from course_lib import waiting
-from course_lib.ros import node_logs, node_names, rclpy_backports, rosenv
+from course_lib.ros import node_logs, node_names, rclpy_backports, rosenv, teardown
 
 #: Name of the session's hidden helper node (a leading "_" hides it from node listings).
 TOOL_NODE_NAME = "_course_tools"
@@ -220,20 +220,13 @@ def _teardown(timeout: float) -> None:
                   file=sys.stderr)
     state.executor.shutdown(timeout_sec=0)
     for node in list(state.nodes.values()) + ([state.tool] if state.tool is not None else []):
-        _destroy(node)
+        teardown.destroy_node(node)
     state.nodes.clear()
     state.tool = None
     if state.context is rclpy.utilities.get_default_context():
         rclpy.try_shutdown()
     else:  # someone replaced the default context meanwhile; shut down only our own
         state.context.try_shutdown()
-
-
-def _destroy(node) -> None:
-    try:
-        node.destroy_node()
-    except Exception:  # already destroyed, or its context is gone: nothing left to free
-        pass
 
 
 def _spin(state: _State) -> None:
@@ -374,10 +367,10 @@ def _remove(state: _State, name: str) -> None:
     node = state.nodes.pop(name)
     state.executor.remove_node(node)  # wakes the executor, which then lets go of spin_lock
     if threading.current_thread() is state.thread:  # a callback removes a node: lock is ours
-        _destroy(node)
+        teardown.destroy_node(node)
         return
     with state.spin_lock:
-        _destroy(node)
+        teardown.destroy_node(node)
 
 
 def remove_node(node_or_name) -> None:

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from course_lib import progress
 from course_lib.imaging import pan_camera
+from course_lib.ros import teardown
 from course_lib.selfcheck.verdicts import Verdict, _not_a_function, _verdict
 
 #: The check's own action name, and where its camera starts (the lesson's START_PAN).
@@ -55,8 +56,7 @@ class _CheckServer:
     def close(self) -> None:
         self.executor.shutdown(timeout_sec=2.0)
         self.thread.join(timeout=2.0)
-        self.server.destroy()
-        self.node.destroy_node()
+        teardown.destroy_node(self.node)  # with its action server
 
 
 @progress.while_running("self-check: sending your goal")
