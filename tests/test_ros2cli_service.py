@@ -13,9 +13,10 @@ from ros2cli_support import ROS2, node_script, ros2, ros2_together
 from course_lib.ros import processes, rosenv
 
 # ros2service's test/fixtures/echo_server.py, written anew: answers a BasicTypes request with
-# the same values.
+# the same values (after a sleep of float64_value seconds when string_value is 'slow').
 ECHO_SERVER = node_script('''
 import sys
+import time
 
 import rclpy
 from rclpy.executors import ExternalShutdownException
@@ -30,6 +31,8 @@ class EchoServer(Node):
         self.create_service(BasicTypes, 'echo', self.echo)
 
     def echo(self, request, response):
+        if request.string_value == 'slow':
+            time.sleep(request.float64_value)
         for field in request.get_fields_and_field_types():
             setattr(response, field, getattr(request, field))
         return response
@@ -124,6 +127,20 @@ def test_call(servers):
     assert empty.returncode == 0 and empty.stdout.removeprefix(waiting) == echo_call_output()
     assert filled.returncode == 0 and filled.stdout.removeprefix(waiting) == echo_call_output(
         bool_value=False, int32_value=-1, float64_value=0.1, string_value="bazbar")
+
+
+def test_an_answer_slower_than_the_loop_limit_is_awaited_under_test(servers):
+    """Under test a verb's loops end after the loop limit (a `!ros2 topic hz` cell cannot hang a
+    lesson's run), but the answer of a server it has found is awaited: it comes unless the server is
+    broken, and a busy machine must not turn a slow answer into a failed test."""
+    from course_lib.ros2cli.common import loop_limit
+
+    seconds = loop_limit(None) + 1.0
+    assert seconds < 30, "the loop limit applies under test (COURSE_LIB_UNDER_TEST=1)"
+    values = f"{{float64_value: {seconds}, string_value: slow}}"
+    done = ros2("service", "call", "/my_ns/echo", "test_msgs/srv/BasicTypes", values, env=servers.env, check=False)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.endswith(echo_call_output(float64_value=seconds, string_value="slow")), done.stdout
 
 
 def test_repeated_call_goes_on_until_ctrl_c(servers):

@@ -8,6 +8,7 @@ from course_lib.ros2cli.common import (
     print_names,
     print_types_of,
     run_group,
+    wait_for_answer,
     wait_for_whole_graph,
     wait_until,
 )
@@ -140,7 +141,7 @@ def _send_goal(args) -> str | None:
             return f"No action server for '{args.action_name}' (time limit under test or grading)"
         print(f"Sending goal:\n     {_yaml(goal)}")
         sent = client.send_goal_async(goal, show_feedback if args.feedback else None)
-        if not wait_until(sent.done):
+        if not wait_for_answer(sent.done):
             return "The goal was not answered (time limit under test or grading)"
         handle = sent.result()
         if handle is None:
@@ -155,7 +156,7 @@ def _send_goal(args) -> str | None:
             for feedback in early:
                 print(f"Feedback:\n    {_yaml(feedback.feedback)}")
         finished = handle.get_result_async()
-        if not wait_until(finished.done):
+        if not wait_for_answer(finished.done):
             return "The goal did not finish (time limit under test or grading)"
         result = finished.result()
         if result is None:

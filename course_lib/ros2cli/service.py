@@ -12,6 +12,7 @@ from course_lib.ros2cli.common import (
     print_names_of_type,
     print_types_of,
     run_group,
+    wait_for_answer,
     wait_for_name,
     wait_for_whole_graph,
     wait_until,
@@ -148,7 +149,7 @@ def _call(args) -> str | None:
             print(f"requester: making request: {request!r}\n")
             last_call = time.monotonic()
             future = client.call_async(request)
-            if not wait_until(future.done):
+            if not wait_for_answer(future.done):
                 return f"No response from '{args.service_name}' (time limit under test or grading)"
             if future.result() is None:
                 return f"Exception while calling service: {future.exception()!r}"
