@@ -60,6 +60,7 @@ def _client(node_name: str, timeout: float):
 
 
 def _result(future, node_name: str, timeout: float):
+    timeout = session.answer_limit(timeout)  # the node's answer, once its services were found
     if not session.wait_for(future.done, timeout=timeout, poll=0.005):
         raise TimeoutError(f"Node {_full_name(node_name)} did not answer its parameter service "
                            f"within {timeout} s: is its executor busy (a callback that never returns)?")

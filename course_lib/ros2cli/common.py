@@ -28,12 +28,6 @@ COMPLETE_SECONDS = 4.0
 #: (course_lib.ros.discovery), which ends as soon as the graph has stopped changing.
 DISCOVERY_BACKSTOP = 5
 
-#: Seconds a verb waits, under the test suite, for the answer of a server it has found (a
-#: service's response, a goal's acceptance and result) before it gives up: the answer ends the
-#: wait, and this only keeps a server that never answers from hanging a lesson's run. It is far
-#: from any answer's time on a busy machine, as the loop limit (about 7 s) was not.
-ANSWER_BACKSTOP = 60.0
-
 
 class Unsupported(Exception):
     """A command, verb or option the course's ros2 does not have; str() is the one line to print."""
@@ -253,14 +247,13 @@ def wait_until(done: typing.Callable[[], bool], seconds: float | None = None) ->
 
 
 def wait_for_answer(done: typing.Callable[[], bool]) -> bool:
-    """Wait until ``done()``: the answer of a server this verb has found, which comes unless the
-    server is broken. Live, as long as it takes (Ctrl-C ends it); under grading, within the loop
-    limit as every wait (a notebook's grading stays short, and a ``!ros2`` cell's output is not
-    graded); under test, within ANSWER_BACKSTOP, so that a busy machine cannot make a test fail."""
-    from course_lib.ros import rosenv, session
+    """Wait until ``done()``: the answer of a server this verb has found. Live, as long as it
+    takes (Ctrl-C ends it); under grading within the loop limit, as every wait; under test within
+    course_lib.ros.session.answer_limit (the loop limit, about 7 s, could decide a test on a busy
+    machine)."""
+    from course_lib.ros import session
 
-    limit = ANSWER_BACKSTOP if rosenv.under_test() and not rosenv.under_grading() else loop_limit(None)
-    return session.wait_for(done, timeout=limit, poll=0.02)
+    return session.wait_for(done, timeout=session.answer_limit(loop_limit(None)), poll=0.02)
 
 
 @contextlib.contextmanager
