@@ -249,6 +249,29 @@ def test_a_verb_started_with_ampersand_by_a_script_ends_on_a_signal(live, tmp_pa
     assert "Traceback" not in output.read_text()
 
 
+@pytest.mark.parametrize("interruption, code", [(KeyboardInterrupt, 2), ("Terminated", 15)])
+def test_an_error_while_cleaning_up_after_a_signal_still_ends_with_the_signals_code(monkeypatch, capsys,
+                                                                                   interruption, code):
+    """Ctrl-C raises KeyboardInterrupt wherever a verb is, and the verb's clean-up (unsubscribing)
+    may then fail in rclpy ('cannot use Destroyable ...'): the command was ended by the signal
+    all the same, exit code 2 (15 for SIGTERM), not 1 with the clean-up's error."""
+    from course_lib.ros2cli import cli, topic
+
+    signal_error = cli.Terminated if interruption == "Terminated" else interruption
+
+    def verb(argv):
+        try:
+            raise signal_error()
+        finally:
+            raise RuntimeError("cannot use Destroyable because destruction was requested")
+
+    monkeypatch.setattr(topic, "main", verb)
+    assert cli.main(["topic", "bw", "/words"]) == code
+    assert "Destroyable" not in capsys.readouterr().err
+    monkeypatch.setattr(topic, "main", lambda argv: (_ for _ in ()).throw(RuntimeError("no such topic")))
+    assert cli.main(["topic", "bw", "/words"]) == 1, "an error of its own is still the verb's failure"
+
+
 def test_topic_info(live):
     short, verbose = (done.stdout for done in ros2_together(["topic", "info", "/cli_chatter"],
                                                             ["topic", "info", "-v", "/cli_chatter"], env=live.env))

@@ -97,7 +97,7 @@ def test_bw(talker):
     assert printed[0] == "Subscribed to [/words]", errors
     assert re.fullmatch(r"\d+ B/s from \d+ messages", printed[1]), printed
     assert printed[2] == "\tMessage size mean: 20 B min: 20 B max: 20 B"
-    assert code == 2
+    assert code == 2, errors
 
 
 def test_delay(talker):
@@ -106,7 +106,7 @@ def test_delay(talker):
     printed, code, errors = first_report(talker, ["delay", "/stamped"], 2)
     assert re.fullmatch(r"average delay: -?\d+\.\d{3}", printed[0]), (printed, errors)
     assert re.fullmatch(r"\tmin: -?\d+\.\d{3}s max: -?\d+\.\d{3}s std dev: \d+\.\d{5}s window: \d+", printed[1])
-    assert code == 2
+    assert code == 2, errors
     no_header = subprocess.run([str(ROS2), "topic", "delay", "/words"], env=talker.env, capture_output=True,
                                text=True, timeout=120, stdin=subprocess.DEVNULL)
     assert (no_header.returncode, no_header.stderr) == (1, "msg does not have header\n")
