@@ -14,11 +14,14 @@ from __future__ import annotations
 def destroy_node(node) -> None:
     """Destroy the action clients and servers made on ``node``, then the node. Safe on a node
     (or waitable) destroyed already."""
+    from rclpy.action import ActionClient, ActionServer
+
     for waitable in list(node.waitables):
-        try:
-            waitable.destroy()
-        except Exception:  # destroyed already, or a waitable without destroy(): nothing to free
-            pass
+        if isinstance(waitable, (ActionClient, ActionServer)):  # not the QoS event handlers: destroy_node's
+            try:
+                waitable.destroy()
+            except Exception:  # destroyed already: nothing to free
+                pass
     try:
         node.destroy_node()
     except Exception:  # already destroyed, or its context is gone: nothing left to free
