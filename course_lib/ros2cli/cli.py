@@ -109,9 +109,7 @@ def _interruption(error: BaseException) -> int | None:
     destruction was requested", seen once in about 50 runs of ``ros2 topic bw`` stopped by Ctrl-C
     on a busy machine). The new error then replaces the KeyboardInterrupt, which Python keeps as
     its ``__context__``: the command was still ended by the signal (ros2cli's exit code 2)."""
-    seen = set()
-    while error is not None and id(error) not in seen:
-        seen.add(id(error))
+    while error is not None:  # Python breaks cycles when it sets __context__
         if isinstance(error, KeyboardInterrupt):
             return int(signal.SIGINT)
         if isinstance(error, Terminated):
