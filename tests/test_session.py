@@ -376,6 +376,27 @@ def test_a_goal_answered_before_the_client_noted_its_request_still_completes(dom
     assert session.wait_for(finished.done, timeout=30) and list(finished.result().result.sequence) == [0, 1]
 
 
+FIX_ON_IMPORT = """
+import sys
+from course_lib.ros import rclpy_backports
+rclpy_backports.install()
+print("numpy" in sys.modules, "rclpy.action" in sys.modules)
+from rclpy.action import ActionClient
+fixed_upstream = "_lock" in ActionClient.__init__.__code__.co_names
+print(fixed_upstream or all(hasattr(getattr(ActionClient, name), "__wrapped__")
+                            for name in rclpy_backports.LOCKED_METHODS))
+"""
+
+
+def test_the_fix_is_applied_when_rclpy_action_is_imported_after_the_session_started():
+    """A process that starts the session before it imports rclpy.action (a ros2 command, a cell
+    that makes its first action client) gets the fix at that import; until then neither rclpy.action
+    nor numpy is imported (a fifth of a ros2 command's processor time)."""
+    done = subprocess.run([sys.executable, "-c", FIX_ON_IMPORT], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split() == ["False", "False", "True"], done.stdout + done.stderr
+
+
 @pytest.mark.parametrize("end", ["remove_node", "stop"])
 def test_a_node_with_an_action_client_and_server_leaves_the_graph(domain_id, end):
     """Jazzy's destroy_node() leaves the action clients and servers made on a node, and they keep

@@ -7,8 +7,7 @@ from __future__ import annotations
 import array
 import functools
 import importlib
-
-import numpy as np
+import sys
 
 # --- message types ----------------------------------------------------------------------
 
@@ -74,7 +73,7 @@ def message_to_dict(msg, truncate_length: int | None = 128, no_arr: bool = False
             return f"<string length: <{len(msg)}>>"
         cut = truncate_length is not None and len(msg) > truncate_length
         return msg[:truncate_length] + "..." if cut else msg
-    if isinstance(msg, (np.ndarray, array.array)):
+    if isinstance(msg, array.array) or _is_numpy(msg, "ndarray"):
         msg = msg.tolist()
     if isinstance(msg, (list, tuple)):
         items = list(msg)
@@ -82,9 +81,17 @@ def message_to_dict(msg, truncate_length: int | None = 128, no_arr: bool = False
         items = [message_to_dict(item, truncate_length, no_arr, no_str)
                  for item in (items[:truncate_length] if cut else items)]
         return items + ["..."] if cut else items
-    if isinstance(msg, np.generic):
+    if _is_numpy(msg, "generic"):
         return msg.item()
     return msg
+
+
+def _is_numpy(value, kind: str) -> bool:
+    """Whether value is a numpy ``kind`` ("ndarray", "generic"). Only a process that has imported
+    numpy has numpy values (message classes with array fields import it), and a ``ros2`` command
+    that handles none spares the import, a fifth of its processor time."""
+    numpy = sys.modules.get("numpy")
+    return numpy is not None and isinstance(value, getattr(numpy, kind))
 
 
 def _field_to_plain(value, slot_type, truncate_length, no_arr, no_str):
@@ -182,8 +189,9 @@ def _fill(msg, values, setters: list, path: str) -> None:
             value = items
         elif isinstance(current, array.array):
             value = _converted(functools.partial(array.array, current.typecode), where, fields[field], value)
-        elif isinstance(current, np.ndarray):
-            value = _converted(functools.partial(np.array, dtype=current.dtype), where, fields[field], value)
+        elif _is_numpy(current, "ndarray"):
+            value = _converted(functools.partial(sys.modules["numpy"].array, dtype=current.dtype), where,
+                               fields[field], value)
         elif not isinstance(current, list) and type(value) is not type(current):
             value = _converted(type(current), where, fields[field], value)
         _converted(functools.partial(setattr, msg, field), where, fields[field], value)

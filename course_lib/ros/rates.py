@@ -5,8 +5,6 @@ from __future__ import annotations
 import dataclasses
 import math
 
-import numpy as np
-
 # --- ros2 topic hz ----------------------------------------------------------------------
 
 @dataclasses.dataclass(frozen=True)
@@ -45,6 +43,8 @@ def rate_statistics(times, window: int | None = None) -> RateStatistics:
     Raises:
         ValueError: fewer than two times, or times that go backwards.
     """
+    import numpy as np  # here, not at the top: graph imports this module, and most ros2 verbs need no numpy
+
     times = np.asarray(times, dtype=float)
     if times.ndim != 1 or times.size < 2:
         raise ValueError(f"Need at least two arrival times to measure a rate, got {times.size}: "

@@ -14,6 +14,9 @@ fix does; with an rclpy that has the fix (its ActionClient makes a ``_lock``) it
 from __future__ import annotations
 
 import functools
+import importlib.abc
+import importlib.util
+import sys
 import threading
 
 #: The ActionClient methods that must not interleave: the executor's take of answers, and the
@@ -29,18 +32,61 @@ _installing = threading.Lock()
 
 
 def install() -> None:
-    """Apply the fixes to rclpy in this process (once; later calls do nothing)."""
-    from rclpy.action.client import ActionClient
-
-    global _installed
+    """Apply the fixes to rclpy in this process (once; later calls do nothing): now, when
+    ``rclpy.action.client`` is imported already, else when it is imported. Importing it costs
+    numpy's import, a fifth of a ``ros2`` command's processor time, and a process that never imports
+    it has no action client to fix."""
     with _installing:
-        if _installed:
-            return
-        _installed = True
-        if "_lock" in ActionClient.__init__.__code__.co_names:  # this rclpy has the upstream fix
-            return
-        for name in LOCKED_METHODS:
-            setattr(ActionClient, name, _holding_the_clients_lock(getattr(ActionClient, name)))
+        if "rclpy.action.client" in sys.modules:
+            _fix(sys.modules["rclpy.action.client"].ActionClient)
+        elif not any(isinstance(finder, _FixOnImport) for finder in sys.meta_path):
+            sys.meta_path.insert(0, _FixOnImport())
+
+
+def _fix(action_client) -> None:
+    global _installed
+    if _installed:
+        return
+    _installed = True
+    if "_lock" in action_client.__init__.__code__.co_names:  # this rclpy has the upstream fix
+        return
+    for name in LOCKED_METHODS:
+        setattr(action_client, name, _holding_the_clients_lock(getattr(action_client, name)))
+
+
+class _FixOnImport(importlib.abc.MetaPathFinder):
+    """Finds ``rclpy.action.client`` as the other finders do, and fixes its ActionClient as soon as
+    the module has run, before any code can make a client."""
+
+    def find_spec(self, name, path=None, target=None):
+        if name != "rclpy.action.client":
+            return None
+        sys.meta_path.remove(self)  # once; and the finders after it find the spec
+        spec = importlib.util.find_spec(name)
+        if spec is None or spec.loader is None:
+            return spec
+        run_module = spec.loader.exec_module
+
+        def exec_module(module):
+            run_module(module)
+            with _installing:
+                _fix(module.ActionClient)
+
+        spec.loader = _Loader(spec.loader, exec_module)
+        return spec
+
+
+class _Loader(importlib.abc.Loader):
+    """The module's own loader, with exec_module replaced."""
+
+    def __init__(self, loader, exec_module):
+        self._loader, self.exec_module = loader, exec_module
+
+    def create_module(self, spec):
+        return self._loader.create_module(spec)
+
+    def __getattr__(self, name):  # get_code, get_source, is_package...: the module's own loader's
+        return getattr(self._loader, name)
 
 
 def _holding_the_clients_lock(method):

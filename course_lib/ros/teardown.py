@@ -10,14 +10,16 @@ ROS domain in that process saw the left-over node as the student's.
 
 from __future__ import annotations
 
+import sys
+
 
 def destroy_node(node) -> None:
     """Destroy the action clients and servers made on ``node``, then the node. Safe on a node
     (or waitable) destroyed already."""
-    from rclpy.action import ActionClient, ActionServer
-
+    action = sys.modules.get("rclpy.action")  # not imported: the process has no action client or server
+    kinds = (action.ActionClient, action.ActionServer) if action is not None else ()
     for waitable in list(node.waitables):
-        if isinstance(waitable, (ActionClient, ActionServer)):  # not the QoS event handlers: destroy_node's
+        if isinstance(waitable, kinds):  # not the QoS event handlers: destroy_node's
             try:
                 waitable.destroy()
             except Exception:  # destroyed already: nothing to free
