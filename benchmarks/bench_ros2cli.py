@@ -7,7 +7,9 @@ asserting them. Compare rows measured in the same run.
 
 Two live nodes (a talker with parameters and a listener, each in a process of its own) run in
 a reserved ROS domain. Each command runs --runs times as a new process, as a student types it,
-alternating with the others; the table shows the median wall time and its ratio to the floor:
+alternating with the others; the table shows the median wall time and processor time (user and
+system, which the machine's load moves much less; the test suite is bound by it) and their ratios
+to the floor:
 a new Python process that imports rclpy and creates one node (what every ros2 command pays
 before it can look at the graph). ``python -c pass`` shows what the interpreter alone costs.
 
@@ -22,6 +24,7 @@ from __future__ import annotations
 import argparse
 import os
 import platform
+import resource
 import statistics
 import subprocess
 import sys
@@ -75,6 +78,12 @@ def commands(ros2: str) -> list[tuple[str, list[str]]]:
     ]
 
 
+def _children_cpu() -> float:
+    """Processor seconds (user and system) of this process's ended children so far."""
+    used = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return used.ru_utime + used.ru_stime
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", type=int, default=5, help="runs of each command (default 5)")
@@ -94,12 +103,14 @@ def main(argv: list[str] | None = None) -> int:
             for process, name in zip(nodes, ("bench_talker", "bench_listener"), strict=True):
                 process.wait_for_node(name, timeout=60)
             times: dict[str, list[float]] = {label: [] for label, _ in commands(ros2)}
+            processor: dict[str, list[float]] = {label: [] for label, _ in commands(ros2)}
             answers: dict[str, str] = {}
             for _ in range(args.runs):
                 for label, command in commands(ros2):
-                    began = time.perf_counter()
+                    began, used = time.perf_counter(), _children_cpu()
                     done = subprocess.run(command, env=env, capture_output=True, text=True, timeout=120)
                     times[label].append(time.perf_counter() - began)
+                    processor[label].append(_children_cpu() - used)
                     if (done.returncode != 0) != label.startswith("fails: "):
                         sys.exit(f"{label} ended with exit code {done.returncode}: {done.stderr}")
                     answers[label] = done.stdout
@@ -107,13 +118,14 @@ def main(argv: list[str] | None = None) -> int:
             for process in nodes:
                 process.stop()
     floor = statistics.median(times["floor: python, import rclpy, one node"])
+    floor_cpu = statistics.median(processor["floor: python, import rclpy, one node"])
     print(f"Python {platform.python_version()}, {platform.machine()}, {os.cpu_count()} cores, "
           f"median of {args.runs} runs, load average before: {load:.2f}\n")
-    print("| command | median wall time | ratio to the floor |")
-    print("|---|---:|---:|")
+    print("| command | median wall time | ratio to the floor | median processor time | ratio to the floor |")
+    print("|---|---:|---:|---:|---:|")
     for label, _ in commands(ros2):
-        median = statistics.median(times[label])
-        print(f"| {label} | {median:.2f} s | {median / floor:.2f} |")
+        median, cpu = statistics.median(times[label]), statistics.median(processor[label])
+        print(f"| {label} | {median:.2f} s | {median / floor:.2f} | {cpu:.2f} s | {cpu / floor_cpu:.2f} |")
     listed = answers["ros2 node list"].split()
     print(f"\nros2 node list answered {listed} (both nodes: {listed == ['/bench_listener', '/bench_talker']})")
     return 0
