@@ -29,6 +29,10 @@ from pathlib import Path
 
 import pytest
 
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+
+from course_lib.supervision import process_tree  # noqa: E402
+
 #: The folder in which the plugin writes, per worker process (file name: its pid), the test it runs.
 CURRENT_ENV = "BENCH_SUITE_CPU_DIR"
 BETWEEN = "(between tests)"
@@ -58,13 +62,10 @@ def pytest_runtest_protocol(item, nextitem):
 
 # --- the sampler -------------------------------------------------------------------------------
 
-def _stat(pid: int) -> tuple[int, int, int, str]:
-    """(parent pid, processor ticks with those of the children it waited for, start time, name)."""
-    with open(f"/proc/{pid}/stat") as handle:
-        text = handle.read()
-    name = text[text.index("(") + 1:text.rindex(")")]
-    fields = text[text.rindex(")") + 2:].split()
-    return int(fields[1]), sum(int(v) for v in fields[11:15]), int(fields[19]), name
+def _stat(pid: int) -> tuple[int, int, int]:
+    """(parent pid, processor ticks with those of the children it waited for, start time)."""
+    fields = process_tree.stat_fields(pid)
+    return int(fields[1]), sum(int(v) for v in fields[11:15]), int(fields[19])
 
 
 def _busy_ticks() -> int:
@@ -73,13 +74,14 @@ def _busy_ticks() -> int:
     return sum(values) - values[3] - values[4]  # all but idle and iowait
 
 
-def _program(pid: int, name: str) -> str:
+def _program(pid: int) -> str:
     """What a process is: python by its module (-m) or script, chromium by its --type."""
     try:
-        with open(f"/proc/{pid}/cmdline", "rb") as handle:
-            argv = handle.read().decode(errors="replace").split("\0")
+        with open(f"/proc/{pid}/comm") as handle:
+            name = handle.read().strip()
     except OSError:
-        return name
+        return "(gone)"
+    argv = process_tree.command_line(pid)
     if name.startswith("python"):
         for flag, value in zip(argv, argv[1:], strict=False):
             if flag == "-m":
@@ -87,7 +89,7 @@ def _program(pid: int, name: str) -> str:
             if flag == "-c":
                 entry = value.split("sys.argv[0] = '", 1)[-1].split("'", 1)[0] if "sys.argv[0] = '" in value else ""
                 return f"python {entry}" if entry else "python -c (xdist worker or inline code)"
-        script = next((a for a in argv[1:] if a and not a.startswith("-")), "")
+        script = next((a for a in argv[1:] if not a.startswith("-")), "")
         return f"python {Path(script).name}" if script else "python"
     if name == "chromium":
         kind = next((a for a in argv if a.startswith("--type=")), "")
@@ -126,7 +128,7 @@ class Sampler:
                     pass
         alive = {(pid, info[2]) for pid, info in processes.items()}
         self._hand_up_the_ended(alive)
-        for pid, (ppid, ticks, start, name) in processes.items():
+        for pid, (ppid, ticks, start) in processes.items():
             key = (pid, start)
             self.parent[key] = (ppid, processes[ppid][2]) if ppid in processes else None
             if key not in self.owner:
@@ -136,7 +138,7 @@ class Sampler:
                 self.owner[key] = worker
                 # A worker counts from now; a process born since the last sample, from its start.
                 self.counted[key] = ticks if (pid in tests or self.samples == 0) else 0
-                self.program[key] = _program(pid, name)
+                self.program[key] = _program(pid)
                 if self.counted[key]:
                     continue
             if key not in self.counted:

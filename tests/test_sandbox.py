@@ -13,6 +13,7 @@ import pytest
 
 from autograder import sandbox
 from course_lib.ros import processes
+from course_lib.supervision import process_tree
 
 needs_namespaces = pytest.mark.skipif(sandbox.isolation() == "none",
                                       reason="no namespaces here (not root, no user namespaces): "
@@ -175,8 +176,7 @@ def test_a_stop_reaches_the_command_once_and_its_signal_comes_through():
 
 def _group_of(pid: str) -> int | None:
     try:
-        with open(f"/proc/{pid}/stat") as handle:
-            return int(handle.read().rsplit(")", 1)[1].split()[2])
+        return int(process_tree.stat_fields(int(pid))[2])
     except (OSError, IndexError, ValueError):
         return None
 

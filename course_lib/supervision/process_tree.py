@@ -47,6 +47,18 @@ def signal_tree(pid: int, sig: int) -> None:
         pass
 
 
+def stat_fields(pid: int) -> list[str]:
+    """The fields of /proc/PID/stat after the command name (which may hold spaces and parentheses):
+    proc(5)'s field 3 (the state) is [0], the parent's pid [1], the process group [2], utime,
+    stime, cutime and cstime [11:15] (clock ticks), the start time [19].
+
+    Raises:
+        OSError: the process has gone.
+    """
+    with open(f"/proc/{pid}/stat") as handle:
+        return handle.read().rsplit(")", 1)[1].split()
+
+
 def children_of(pid: int) -> list[int]:
     """Direct children of process `pid` (read from /proc; exact when `pid` has a single thread)."""
     try:
@@ -57,11 +69,10 @@ def children_of(pid: int) -> list[int]:
         for entry in os.listdir("/proc"):
             if entry.isdigit():
                 try:
-                    with open(f"/proc/{entry}/stat") as handle:
-                        stat = handle.read()
-                except OSError:
+                    parent = int(stat_fields(int(entry))[1])
+                except (OSError, IndexError):
                     continue
-                if int(stat.rsplit(")", 1)[1].split()[1]) == pid:
+                if parent == pid:
                     found.append(int(entry))
         return found
 
@@ -107,12 +118,9 @@ def cpu_seconds(pid: int, include_self: bool = True) -> float:
     total = 0
     for member in ([pid] if include_self else []) + descendants_of(pid):
         try:
-            with open(f"/proc/{member}/stat") as handle:
-                fields = handle.read().rsplit(")", 1)[1].split()
+            total += sum(int(value) for value in stat_fields(member)[11:15])  # utime, stime, cutime, cstime
         except (OSError, IndexError):
             continue
-        # Fields 14-17 of proc(5): utime, stime, cutime, cstime (after the name: indexes 11-14).
-        total += sum(int(value) for value in fields[11:15])
     return total / tick
 
 
