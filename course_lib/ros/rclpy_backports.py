@@ -72,21 +72,8 @@ class _FixOnImport(importlib.abc.MetaPathFinder):
             with _installing:
                 _fix(module.ActionClient)
 
-        spec.loader = _Loader(spec.loader, exec_module)
+        spec.loader.exec_module = exec_module  # a loader of this spec's own: the finders make one per spec
         return spec
-
-
-class _Loader(importlib.abc.Loader):
-    """The module's own loader, with exec_module replaced."""
-
-    def __init__(self, loader, exec_module):
-        self._loader, self.exec_module = loader, exec_module
-
-    def create_module(self, spec):
-        return self._loader.create_module(spec)
-
-    def __getattr__(self, name):  # get_code, get_source, is_package...: the module's own loader's
-        return getattr(self._loader, name)
 
 
 def _holding_the_clients_lock(method):
