@@ -194,6 +194,20 @@ def test_a_listing_stops_waiting_for_a_process_that_has_ended():
                                           [os.getpid(), int(ended.stdout)])
 
 
+def test_a_listing_does_not_wait_for_a_zombie():
+    """Two `ros2` commands started together by one program that reaps them in turn: the one that
+    ended first stays a zombie until its parent waits for it. The other one waited for it until
+    its backstop (12 s under load) in a suite run."""
+    ended = subprocess.Popen([sys.executable, "-S", "-c", "pass"])
+    try:
+        os.waitid(os.P_PID, ended.pid, os.WEXITED | os.WNOWAIT)  # it has ended; not reaped yet
+        assert os.path.exists(f"/proc/{ended.pid}")
+        assert discovery._every_process_shown(_Graph(named=[os.getpid()], readers=[os.getpid()]),
+                                              [os.getpid(), ended.pid])
+    finally:
+        ended.wait(timeout=10)
+
+
 def test_a_lone_socket_on_a_participants_port_is_no_participant(domain_id):
     """A participant binds two ports, for discovery and for data. Domain 101's ports reach the
     kernel's ephemeral ones, which any program's socket may get: counting single ports, a

@@ -1,5 +1,6 @@
 """Tests for course_lib.supervision.process_tree, the one way the course ends a process tree."""
 
+import os
 import signal
 import subprocess
 import sys
@@ -84,6 +85,16 @@ time.sleep(60)
     finally:
         process_tree.signal_tree(parent.pid, signal.SIGKILL)
         parent.wait(timeout=10)
+
+
+def test_a_zombie_does_not_run():
+    """A process that has ended runs no more, though /proc keeps it until its parent reaps it."""
+    assert process_tree.running(os.getpid())
+    proc = subprocess.Popen([sys.executable, "-S", "-c", "pass"])
+    os.waitid(os.P_PID, proc.pid, os.WEXITED | os.WNOWAIT)  # ended, not reaped
+    assert os.path.exists(f"/proc/{proc.pid}") and not process_tree.running(proc.pid)
+    proc.wait(timeout=10)
+    assert not process_tree.running(proc.pid)
 
 
 def test_cpu_seconds_of_a_process_that_has_gone_is_zero():

@@ -12,6 +12,7 @@ import time
 
 from course_lib import waiting
 from course_lib.ros import rosenv, session
+from course_lib.supervision import process_tree
 
 #: Seconds a newly started tool node waits for discovery at least before its first answer
 #: (then until every process here has shown its nodes, up to COMPLETE_SECONDS). Lower it to 0
@@ -135,9 +136,11 @@ def _every_process_shown(node, here: list[int | None]) -> bool:
     Participants are matched by their process, not counted: a listing started beside other
     `ros2` commands counted the quick ones that appeared after it looked, and answered before the
     slow process it was waiting for had shown its subscriptions ("Subscription count: 0").
+    A process that has ended is not waited for, even while it is a zombie that its parent has not
+    reaped yet (two `ros2` commands started together by one program that reaps them in turn).
     """
     shown = _processes_shown(node)
-    known = {pid & 0xFFFF for pid in here if pid is not None and os.path.exists(f"/proc/{pid}")}
+    known = {pid & 0xFFFF for pid in here if pid is not None and process_tree.running(pid)}
     unknown = sum(1 for pid in here if pid is None)  # another user's process: its sockets cannot be traced
     return known <= shown and len(shown - known) >= unknown
 

@@ -59,6 +59,16 @@ def stat_fields(pid: int) -> list[str]:
         return handle.read().rsplit(")", 1)[1].split()
 
 
+def running(pid: int) -> bool:
+    """Whether process `pid` still runs: it exists and has not ended. An ended process stays in
+    /proc as a zombie (state Z) until its parent waits for it, but it holds nothing any more: no
+    sockets, no memory, no DDS participant."""
+    try:
+        return stat_fields(pid)[0] not in ("Z", "X")
+    except (OSError, IndexError):
+        return False
+
+
 def children_of(pid: int) -> list[int]:
     """Direct children of process `pid` (read from /proc; exact when `pid` has a single thread)."""
     try:
