@@ -13,7 +13,7 @@ from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
 from std_msgs.msg import String
 
-from course_lib.ros import discovery, graph, graph_info, message_yaml, rosenv, session
+from course_lib.ros import announcements, discovery, graph, graph_info, message_yaml, rosenv, session
 
 # A talker in another process: a 10 Hz timer publishing "hello N" on /far_chatter.
 FAR_TALKER = """
@@ -127,85 +127,17 @@ def test_discovery_counts_a_process_holding_three_nodes_as_one_participant(domai
         assert session.wait_for(lambda: {"one", "two", "three"} <= set(tool.get_node_names()), timeout=15)
         here = discovery._participants_here(domain_id)
         assert sorted(here) == sorted([os.getpid(), process.pid])  # this process and the other one
-        assert session.wait_for(lambda: discovery._every_process_shown(tool, here), timeout=30)
-        assert discovery._processes_shown(tool) == {os.getpid() & 0xFFFF, process.pid & 0xFFFF}
-        session.add_node(Node("four"))
-        assert session.wait_for(lambda: "four" in tool.get_node_names(), timeout=30)
-        assert len(discovery._processes_shown(tool)) == 2
+        with announcements.Announcements(tool) as heard:
+            assert session.wait_for(lambda: discovery._every_process_shown(tool, heard, here), timeout=30)
+            assert process.pid & 0xFFFF in discovery._processes_shown(tool, heard.latest())
+            session.add_node(Node("four"))
+            assert session.wait_for(lambda: "four" in tool.get_node_names(), timeout=30)
+            assert session.wait_for(lambda: discovery._processes_shown(tool, heard.latest()) ==
+                                    {os.getpid() & 0xFFFF, process.pid & 0xFFFF}, timeout=30)
     finally:
         process.kill()
         process.wait(timeout=10)
         process.stdout.close()
-
-
-class _Graph:
-    """What a tool node's graph shows, for the rule that tells when a process has shown its nodes:
-    each endpoint belongs to the participant of one process (its id in the GUID prefix)."""
-
-    def __init__(self, named, unnamed=(), readers=()):
-        self.named, self.unnamed, self.readers = named, unnamed, readers
-
-    @staticmethod
-    def endpoint(pid, node_name="talker"):
-        import types
-
-        prefix = bytes(4) + (pid & 0xFFFF).to_bytes(2, "little") + bytes(6)
-        return types.SimpleNamespace(endpoint_gid=list(prefix + bytes(4)), node_name=node_name)
-
-    def get_publishers_info_by_topic(self, topic):
-        if topic != "/rosout":
-            return []
-        return [self.endpoint(pid) for pid in self.named] + [self.endpoint(pid, "_NODE_NAME_UNKNOWN_")
-                                                             for pid in self.unnamed]
-
-    def get_subscriptions_info_by_topic(self, topic, no_mangle=False):
-        return [self.endpoint(pid) for pid in self.readers] if no_mangle and topic == "ros_discovery_info" else []
-
-
-def test_a_process_counts_as_shown_once_its_readers_are_announced_too():
-    """DDS announces a process's writers and its readers apart: a process whose node is named
-    (by its /rosout writer) while none of its readers has come yet is not counted, or a listing
-    prints the topics it subscribes to with "Subscription count: 0"."""
-    assert discovery._processes_shown(_Graph(named=[101, 102], unnamed=[103], readers=[101])) == {101}
-    # process 103's node has no name yet
-    assert discovery._processes_shown(_Graph(named=[101, 102], unnamed=[103], readers=[101, 102, 103])) == {101, 102}
-
-
-def test_a_listing_waits_for_the_processes_it_found_not_for_as_many():
-    """A listing started beside other `ros2` commands found this process, the talker's and its own;
-    a quick `ros2` process that came after it looked and showed at once must not stand in for this
-    slow process, whose subscriptions had not come ("Subscription count: 0" in a suite run)."""
-    me, talker, newcomer = os.getpid(), os.getppid(), 1
-    here = [me, talker]
-    graph_now = _Graph(named=[talker, newcomer], readers=[talker, newcomer])
-    assert not discovery._every_process_shown(graph_now, here)
-    graph_now.named, graph_now.readers = [me, talker, newcomer], [me, talker, newcomer]
-    assert discovery._every_process_shown(graph_now, here)
-    # a process of another user (None: its sockets cannot be traced) needs one more shown
-    assert not discovery._every_process_shown(_Graph(named=[me, talker], readers=[me, talker]), here + [None])
-    assert discovery._every_process_shown(graph_now, here + [None])
-
-
-def test_a_listing_stops_waiting_for_a_process_that_has_ended():
-    """A `ros2` command beside it that ended before showing itself does not keep a listing waiting."""
-    ended = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True,
-                           text=True, check=True)
-    assert discovery._every_process_shown(_Graph(named=[os.getpid()], readers=[os.getpid()]),
-                                          [os.getpid(), int(ended.stdout)])
-
-
-def test_a_listing_does_not_wait_for_a_zombie():
-    """Two `ros2` commands started together by one program that reaps them in turn: the one that
-    ended first stays a zombie until its parent waits for it. The other one waited for it until
-    its backstop (12 s under load) in a suite run."""
-    ended = subprocess.Popen([sys.executable, "-S", "-c", "pass"])
-    try:
-        os.waitid(os.P_PID, ended.pid, os.WEXITED | os.WNOWAIT)  # it has ended; not reaped yet
-        assert os.path.exists(f"/proc/{ended.pid}")
-        assert discovery._every_process_shown(_Graph(named=[os.getpid()], readers=[os.getpid()]),
-                                              [os.getpid(), ended.pid])
-    finally:
-        ended.wait(timeout=10)
 
 
 def test_a_lone_socket_on_a_participants_port_is_no_participant(domain_id):

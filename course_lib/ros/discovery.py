@@ -7,11 +7,12 @@ first query of :mod:`course_lib.ros.graph` on the session's tool node waits here
 
 from __future__ import annotations
 
+import contextlib
 import os
 import time
 
 from course_lib import waiting
-from course_lib.ros import rosenv, session
+from course_lib.ros import announcements, rosenv, session
 from course_lib.supervision import process_tree
 
 #: Seconds a newly started tool node waits for discovery at least before its first answer
@@ -49,9 +50,9 @@ class Settling:
 
     - at least ``minimum`` seconds have passed since the tool node's creation,
     - the graph has not changed for ``quiet`` seconds (things found late bring more with them),
-    - and every other ROS process on this machine has shown its nodes, or ``complete_within``
-      seconds have passed since the tool node's creation (a process that has called
-      rclpy.init() but made no node yet would keep the wait going).
+    - and every other ROS process on this machine has shown all it announced (its nodes, with
+      their endpoints), or ``complete_within`` seconds have passed since the tool node's creation
+      (a process whose announcement has not come yet keeps the wait going).
 
     No fixed sleep: a wait ends as soon as the graph has stopped changing.
     """
@@ -92,7 +93,7 @@ def wait_for_discovery(minimum: float | None = None, quiet: float = _SETTLE_QUIE
         quiet: then wait until the graph has not changed for this long.
         complete_within: also wait, up to this many seconds after the tool node's creation,
             until every other DDS participant on this machine in this domain (each ROS process
-            has one, holding its nodes) has announced its nodes (default COMPLETE_SECONDS; 0:
+            has one, holding its nodes) has shown all it announced (default COMPLETE_SECONDS; 0:
             not at all). On a busy machine some of them take seconds to be discovered.
         until: a function of no arguments that ends the wait early when it returns true.
 
@@ -111,73 +112,90 @@ def wait_for_discovery(minimum: float | None = None, quiet: float = _SETTLE_QUIE
     here = _participants_here(node.context.get_domain_id()) if complete_within else []
     rule = Settling(node.created_at, time.monotonic(), _snapshot(node), minimum, quiet * busy,
                     complete_within if here else 0.0)
-
-    def done():
-        return (until is not None and until()) or rule.settled(
-            time.monotonic(), _snapshot(node), lambda: _every_process_shown(node, here))
-
     backstop = max(_SETTLE_MAX * busy, minimum) - (time.monotonic() - node.created_at)
-    return waiting.spin_until(done, max(0.0, backstop), poll=_SETTLE_POLL)
+    with _announcements(node, here) as heard:
+        def done():
+            return (until is not None and until()) or rule.settled(
+                time.monotonic(), _snapshot(node), lambda: _every_process_shown(node, heard, here))
+
+        return waiting.spin_until(done, max(0.0, backstop), poll=_SETTLE_POLL)
 
 
 def wait_for_every_process(timeout: float) -> bool:
-    """Wait, up to `timeout` s from now, until the tool node knows the nodes of every ROS process
-    on this machine in its domain. True if it does; a process that has called rclpy.init() but
-    made no node yet keeps it waiting until the timeout."""
+    """Wait, up to `timeout` s from now, until the tool node has discovered all that every ROS
+    process on this machine in its domain announced. True if it has; a process whose announcement
+    has not come (its participant not discovered yet) keeps it waiting until the timeout."""
     node = session.tool_node()
     here = _participants_here(node.context.get_domain_id())
-    return waiting.spin_until(lambda: _every_process_shown(node, here), timeout, poll=_SETTLE_POLL)
+    with _announcements(node, here) as heard:
+        return waiting.spin_until(lambda: _every_process_shown(node, heard, here), timeout, poll=_SETTLE_POLL)
 
 
-def _every_process_shown(node, here: list[int | None]) -> bool:
+def _announcements(node, here: list[int | None]):
+    """A reader of what the processes of `here` announce, for the length of a wait; none when no
+    other process is here."""
+    if not [pid for pid in here if pid != os.getpid()]:
+        return contextlib.nullcontext(None)
+    return announcements.Announcements(node)
+
+
+def _every_process_shown(node, heard, here: list[int | None]) -> bool:
     """True once every participant of `here` (a process id each, None: not known) whose process
-    still runs is among those the graph shows.
+    still runs is among those the graph shows all of (:func:`_processes_shown`).
 
     Participants are matched by their process, not counted: a listing started beside other
     `ros2` commands counted the quick ones that appeared after it looked, and answered before the
     slow process it was waiting for had shown its subscriptions ("Subscription count: 0").
     A process that has ended is not waited for, even while it is a zombie that its parent has not
     reaped yet (two `ros2` commands started together by one program that reaps them in turn).
+
+    Args:
+        heard: an Announcements reader (None: no other process is here).
     """
-    shown = _processes_shown(node)
+    shown = _processes_shown(node, heard.latest() if heard is not None else {})
+    shown.add(os.getpid() & 0xFFFF)  # this process's own nodes are in its graph from their start
     known = {pid & 0xFFFF for pid in here if pid is not None and process_tree.running(pid)}
     unknown = sum(1 for pid in here if pid is None)  # another user's process: its sockets cannot be traced
     return known <= shown and len(shown - known) >= unknown
 
 
-#: Topics every node publishes on (unless told not to): their publishers show its participant.
-_EVERY_NODE_PUBLISHES = ("/rosout", "/parameter_events")
-#: The DDS topic of rmw's graph messages: every ROS process reads it from its start, before it
-#: makes any node, so its reader there is the first reader the process announces.
-_GRAPH_TOPIC = "ros_discovery_info"
-
-
 def _process_of(gid) -> int:
-    """The process an endpoint belongs to, as Fast DDS writes it into the GUID prefix of its
-    participant: bytes 4 and 5 hold the low 16 bits of the process id."""
+    """The process an endpoint or participant belongs to, as Fast DDS writes it into the GUID
+    prefix of its participant: bytes 4 and 5 hold the low 16 bits of the process id."""
     return int.from_bytes(bytes(gid)[4:6], "little")
 
 
-def _processes_shown(node) -> set[int]:
-    """The processes (their ids' low 16 bits; this one's included) whose participant the graph
-    shows enough of to list: a node of it named, and its readers announced.
+def _processes_shown(node, announced: dict) -> set[int]:
+    """The processes (their ids' low 16 bits) whose participant the graph shows all of, as the
+    participant announced it (`announced`: its last ParticipantEntitiesInfo, by its GID): every node
+    listed by name, every reader and writer discovered.
 
-    rmw learns endpoints and node names from two different messages, and a listing needs the
-    names. DDS discovery announces a participant's writers and its readers apart, each in the
-    order they were made: seen by the writers alone, a listener's process showed its node while
-    its subscriptions had not come, and `ros2 topic info` printed "Subscription count: 0". A
-    participant's first reader is rmw's own on the graph topic; once it shows, the readers the
-    process had when this one found it have been sent. Counting nodes instead would not do: one
-    process can hold several nodes.
+    rmw learns endpoints and node names from two different messages, and DDS discovery announces
+    a participant's writers and its readers apart, each in the order they were made. Judged by
+    parts of it (its first reader and a named writer), a listener's process counted as shown
+    while its subscriptions had not come, and `ros2 topic info` printed "Subscription count: 0".
     """
-    readers = {_process_of(info.endpoint_gid)
-               for info in node.get_subscriptions_info_by_topic(_GRAPH_TOPIC, no_mangle=True)}
-    named = set()
-    for topic in _EVERY_NODE_PUBLISHES:
-        for info in node.get_publishers_info_by_topic(topic):
-            if info.node_name != "_NODE_NAME_UNKNOWN_":
-                named.add(_process_of(info.endpoint_gid))
-    return named & readers
+    if not announced:
+        return set()
+    listed = set(node.get_fully_qualified_node_names())
+    discovered = _discovered_gids(node)
+    shown = set()
+    for participant, message in announced.items():
+        nodes, gids = announcements.endpoints_of(message)
+        if nodes <= listed and gids <= discovered:
+            shown.add(_process_of(participant))
+    return shown
+
+
+def _discovered_gids(node) -> set[bytes]:
+    """The GIDs (16 bytes) of every reader and writer the graph shows, on every DDS topic (those of
+    services and of rmw's own included)."""
+    gids = set()
+    for name, _ in node.get_topic_names_and_types(no_demangle=True):
+        for info in (*node.get_publishers_info_by_topic(name, no_mangle=True),
+                     *node.get_subscriptions_info_by_topic(name, no_mangle=True)):
+            gids.add(bytes(info.endpoint_gid)[:16])
+    return gids
 
 
 def _participants_here(domain_id: int) -> list[int | None]:
