@@ -50,9 +50,19 @@ def session_domain():
 
 @pytest.fixture
 def domain_id():
-    """A ROS domain id reserved for one test, for tests that need traffic nobody else sees."""
+    """A ROS domain id reserved for one test, for tests that need traffic nobody else sees.
+
+    A notebook session the test started on it is stopped with the reservation: left running, its
+    tool node showed up in the next test's domain of the same id (a self-check in a suite run
+    took `_course_tools` for the student's node)."""
+    from course_lib.ros import session
+
     with rosenv.reserve_domain_id() as reservation:
-        yield reservation.domain_id
+        try:
+            yield reservation.domain_id
+        finally:
+            if session.domain_id() == reservation.domain_id:
+                session.stop()
 
 
 #: The test files that take longest (whole grading runs, JupyterLab in Chromium), longest first:

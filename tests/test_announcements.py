@@ -13,10 +13,9 @@ def _graph_readers(tool) -> int:
     return len(tool.get_subscriptions_info_by_topic(announcements.TOPIC, no_mangle=True))
 
 
-def test_a_process_announces_each_node_with_its_endpoints(domain_id):
+def test_a_process_announces_each_node_with_its_endpoints(session_domain):
     """This process's participant announces the node it holds, named, with the GID of its
     publisher (the one the graph shows); the reader is gone once closed."""
-    session.start(domain_id=domain_id)
     tool = session.tool_node()
     node = Node("announcer")
     node.create_publisher(String, "announced", 10)

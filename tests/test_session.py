@@ -150,9 +150,10 @@ def test_adding_the_same_node_twice_keeps_it(domain_id):
 def test_stop_then_start_again_works(domain_id):
     """After stop(), start() brings up a fresh session, and stale nodes are refused by name."""
     session.start(domain_id=domain_id)
+    assert session.domain_id() == domain_id
     old = session.add_node(Counter())
     session.stop()
-    assert not session.is_running()
+    assert not session.is_running() and session.domain_id() is None
     assert session.nodes() == []
     assert not rclpy.ok()
     session.start(domain_id=domain_id)

@@ -184,7 +184,7 @@ def _session_nodes(domain_id: int) -> dict[str, str]:
     Node names are not unique; the publisher id tells one node from another of the same name."""
     from course_lib.ros import discovery, graph, session
 
-    if not session.is_running() or session.tool_node().context.get_domain_id() != domain_id:
+    if session.domain_id() != domain_id:
         return {}
     graph.node_list()  # the first query waits for discovery
     discovery.wait_for_every_process(EARLIER_NODES_WAIT)

@@ -129,6 +129,12 @@ def is_running() -> bool:
             and state.context.ok())
 
 
+def domain_id() -> int | None:
+    """The ROS domain the running session is on; None when no session runs."""
+    state = _state
+    return state.context.get_domain_id() if is_running() else None
+
+
 def answer_limit(seconds: float | None) -> float | None:
     """How long to wait for the answer of a server that was found, given the wait's ``seconds``
     otherwise (None: as long as it takes).
