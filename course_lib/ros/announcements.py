@@ -120,6 +120,7 @@ class Announcements:
         self._subscription = rmw.rmw_create_subscription(self._rmw_node, _type_support(ParticipantEntitiesInfo),
                                                          TOPIC.encode(), ctypes.byref(qos), ctypes.byref(options))
         if not self._subscription:
+            rcutils.rcutils_reset_error()  # rmw's error state, which rcl would report and clear
             raise RuntimeError(f"rmw could not subscribe to {TOPIC}")
         self._sample = _Bytes()
         allocator = rcutils.rcutils_get_default_allocator()
@@ -133,12 +134,15 @@ class Announcements:
         message that has come since the last call."""
         from rclpy.serialization import deserialize_message
 
-        _, rmw, _ = _c_functions()
+        _, rmw, rcutils = _c_functions()
         taken = ctypes.c_bool(True)
         while self._subscription:
             taken.value = False
             if rmw.rmw_take_serialized_message(self._subscription, ctypes.byref(self._sample), ctypes.byref(taken),
-                                               None) or not taken.value:
+                                               None):
+                rcutils.rcutils_reset_error()
+                break
+            if not taken.value:
                 break
             message = deserialize_message(ctypes.string_at(self._sample.buffer, self._sample.buffer_length),
                                           self._message_class)
