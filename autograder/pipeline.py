@@ -54,6 +54,7 @@ from course_lib import contract
 from course_lib.checks import context
 from course_lib.checks.result import round_points
 from course_lib.ros import rosenv
+from course_lib.supervision import process_tree
 
 #: Seconds one submission's grading may take on an idle machine, every step included (issue #14:
 #: a hostile submission must not stall the class). Each step gets at most what is left of it.
@@ -335,10 +336,24 @@ def grade_submission(sub: Submission, course: Path, domain_id: int) -> GradeResu
     finally:
         if grading.early is not None:  # a step raised: stop it before its folder goes
             grading.early.cancel()
+        _end_student_processes(grading)
         _remove_tree(grading.work)
     result.score = round_points(sum(c["auto_score"] or 0 for c in result.cells)) if result.status != "failed" else 0.0
     result.seconds = round(time.monotonic() - started, 1)
     return result
+
+
+def _end_student_processes(g: Grading) -> None:
+    """Kill whatever still runs as the submission's uids (root only), before its domain, and so its
+    uids, go to another submission. Every process of the student's is stopped with the process
+    that started it (course_lib.supervision.supervisor); this is the grader's guarantee all the
+    same, and the instructor's report names what it found."""
+    if g.result.kernel_uid is None:
+        return
+    left = sum(process_tree.kill_uid(uid) for uid in (g.result.kernel_uid, g.early_uid))
+    if left:
+        g.result.detail += (f"\n{left} process(es) of the student's uid still ran when the grading of this submission "
+                            "ended; the grader killed them.")
 
 
 def grading_budget() -> float:

@@ -1,11 +1,17 @@
-"""autograder.pipeline's budget: one submission's grading is bounded, and a notebook stopped at its
-share says how long it was given (issue #14)."""
+"""autograder.pipeline's budget: one submission's grading is bounded, a notebook stopped at its
+share says how long it was given (issue #14), and nothing of the student's outlives it."""
 
 from __future__ import annotations
 
+import os
+import signal
+import subprocess
 import sys
 import threading
 import time
+import types
+
+import pytest
 
 from autograder import pipeline, report
 from autograder.result import GradeResult
@@ -101,3 +107,21 @@ def test_an_early_run_still_going_at_the_deadline_is_waited_for_not_dropped(tmp_
     early._thread.start()
     threading.Timer(0.5, building.set).start()
     assert early.outcome_for(tmp_path, ["values"]) == ({"BUILT": "1"}, {"values": "verdict"})
+
+
+@pytest.mark.skipif(os.geteuid() != 0, reason="the student's uids are the grader's as root only")
+def test_what_still_runs_as_the_students_uids_at_the_end_is_killed_and_reported():
+    """A process of the kernel's uid that outlived the submission's grading is killed before the
+    uid goes to the next submission, and the instructor's report says so."""
+    uid = 64998  # no grader uses it: theirs start at pipeline.KERNEL_UID_BASE
+    g = types.SimpleNamespace(result=GradeResult("s", "a", "", kernel_uid=uid), early_uid=uid + 1)
+    pipeline._end_student_processes(g)
+    assert g.result.detail == ""
+    left = subprocess.Popen(["/bin/sleep", "60"], user=uid)
+    try:
+        pipeline._end_student_processes(g)
+        assert left.wait(timeout=10) == -signal.SIGKILL
+        assert "1 process(es) of the student's uid still ran" in g.result.detail
+    finally:
+        left.kill()
+        left.wait(timeout=10)

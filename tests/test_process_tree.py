@@ -5,6 +5,7 @@ import signal
 import subprocess
 import sys
 
+import pytest
 from process_support import processes_with, wait_until
 
 from course_lib.supervision import process_tree
@@ -95,6 +96,27 @@ def test_a_zombie_does_not_run():
     assert os.path.exists(f"/proc/{proc.pid}") and not process_tree.running(proc.pid)
     proc.wait(timeout=10)
     assert not process_tree.running(proc.pid)
+
+
+#: A uid no process of this machine runs as (the grader's start at 61000).
+SPARE_UID = 64999
+
+
+@pytest.mark.skipif(os.geteuid() != 0, reason="starting processes as another uid needs root")
+def test_kill_uid_ends_every_process_of_the_uid_also_what_they_fork():
+    """Processes of the uid, with children of theirs that left their session, are found and
+    killed; processes of other uids are left alone."""
+    started = [subprocess.Popen(["/bin/sh", "-c", "setsid sleep 60 & sleep 60"], user=SPARE_UID) for _ in range(2)]
+    try:
+        assert wait_until(lambda: len(process_tree.processes_of_uid(SPARE_UID)) == 6, timeout=10)  # sh, 2 sleeps
+        assert process_tree.running(os.getpid())
+        assert process_tree.kill_uid(SPARE_UID) == 6
+        assert process_tree.processes_of_uid(SPARE_UID) == []  # zombies not reaped yet are not counted
+        assert process_tree.kill_uid(SPARE_UID) == 0
+    finally:
+        for proc in started:
+            proc.kill()
+            proc.wait(timeout=10)
 
 
 def test_cpu_seconds_of_a_process_that_has_gone_is_zero():
