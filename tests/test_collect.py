@@ -9,13 +9,16 @@ import zipfile
 
 import course_support
 import pytest
+from import_support import module_fixture
 from traitlets.config import Config
 
-from autograder import collect, config, nbgrader_cli, roster
+from autograder import config, nbgrader_cli, roster
+
+collect = module_fixture("autograder.collect")  # it imports nbgrader
 
 
 @pytest.mark.parametrize("zone, hour", [("UTC", 9), ("Europe/Berlin", 8)])
-def test_times_in_file_names_are_read_in_the_lms_time_zone(zone, hour):
+def test_times_in_file_names_are_read_in_the_lms_time_zone(collect, zone, hour):
     """'2025-03-16-09-30-00' is 09:30 (nbgrader's parser reads 09:00), kept as naive UTC."""
     settings = Config()
     settings.LmsFileNames.timezone = zone
@@ -25,7 +28,7 @@ def test_times_in_file_names_are_read_in_the_lms_time_zone(zone, hour):
     assert info["timestamp"] == datetime.datetime(2025, 3, 16, hour, 30)
 
 
-def test_other_files_and_names_are_skipped():
+def test_other_files_and_names_are_skipped(collect):
     """Blackboard's receipts (.txt) and names without an attempt are not collected."""
     plugin = collect.LmsFileNames()
     assert plugin.collect("/d/pubsub_bob_attempt_2025-03-16-09-30-00.txt") is None
@@ -50,7 +53,7 @@ def _download(course, folder, names: list[str]):
 
 
 @pytest.mark.slow
-def test_collect_puts_each_attempt_in_submitted_with_its_time(course, tmp_path):
+def test_collect_puts_each_attempt_in_submitted_with_its_time(collect, course, tmp_path):
     """alice's two attempts: the later one is kept with its time; carol's renamed notebook and
     dave (not in the roster) are reported with what to do."""
     zip_path = _download(course, tmp_path, [
@@ -69,7 +72,7 @@ def test_collect_puts_each_attempt_in_submitted_with_its_time(course, tmp_path):
 
 
 @pytest.mark.slow
-def test_collect_without_a_release_or_matching_names_says_what_to_do(course, tmp_path):
+def test_collect_without_a_release_or_matching_names_says_what_to_do(collect, course, tmp_path):
     """An assignment not released, and a download whose names match nothing, give the fix."""
     with pytest.raises(ValueError, match="has not been released.*python -m autograder release"):
         collect.collect(course, "brightness", [tmp_path / "x.zip"])

@@ -4,11 +4,14 @@ penalty, in nbgrader's columns but quoted as CSV; a filtered export never replac
 from __future__ import annotations
 
 import csv
+import datetime
 
 import pytest
-from nbgrader.utils import parse_utc
+from import_support import module_fixture
 
-from autograder import config, export, gradebook
+from autograder import config, gradebook
+
+export = module_fixture("autograder.export")  # it imports nbgrader
 
 
 @pytest.fixture(scope="module")
@@ -27,7 +30,7 @@ def course(tmp_path_factory):
         gb.update_or_create_student("ann", first_name="Ann", last_name="Ang")
         gb.update_or_create_student("bob", first_name="Bob", last_name="Baker, Jr.")
         gb.update_or_create_student("cy")
-    gradebook.record(root, "ann", "a", {("a", "check"): 5.0}, parse_utc("2025-01-11 08:00:00"),
+    gradebook.record(root, "ann", "a", {("a", "check"): 5.0}, datetime.datetime(2025, 1, 11, 8, 0),
                      config.load(root))
     return root
 
@@ -37,7 +40,7 @@ def _rows(path):
         return list(csv.DictReader(handle))
 
 
-def test_every_student_and_assignment_with_the_final_score(course):
+def test_every_student_and_assignment_with_the_final_score(export, course):
     """Six rows (3 students x 2 assignments); ann's late a: raw 5, penalty 1, score 4."""
     rows = _rows(export.export(course))
     assert [(r["assignment"], r["student_id"]) for r in rows] == \
@@ -49,14 +52,14 @@ def test_every_student_and_assignment_with_the_final_score(course):
     assert all(r["score"] == "0.0" and r["timestamp"] == "" for r in rows[1:])
 
 
-def test_names_with_commas_stay_one_field(course):
+def test_names_with_commas_stay_one_field(export, course):
     """nbgrader's own export joins fields with commas unquoted; this one is read back intact."""
     rows = _rows(export.export(course))
     assert {r["last_name"] for r in rows if r["student_id"] == "bob"} == {"Baker, Jr."}
     assert list(rows[0]) == export.COLUMNS
 
 
-def test_filtered_export_does_not_replace_grades_csv(course):
+def test_filtered_export_does_not_replace_grades_csv(export, course):
     """An export of one assignment to grades.csv is refused with the --to to use; grades.csv stays."""
     path = export.export(course)
     before = path.read_text()
@@ -70,7 +73,7 @@ def test_filtered_export_does_not_replace_grades_csv(course):
     assert {r["assignment"] for r in _rows(course / "a-only.csv")} == {"a"}
 
 
-def test_nbgrader_export_of_one_assignment_is_refused_with_its_error_line(course):
+def test_nbgrader_export_of_one_assignment_is_refused_with_its_error_line(export, course):
     """`nbgrader export --assignment a` in the course directory: an error line, exit status 1."""
     import subprocess
     import sys

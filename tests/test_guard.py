@@ -9,9 +9,12 @@ import sys
 
 import course_support
 import pytest
+from import_support import module_fixture
 
-from autograder import config, guard
+from autograder import config
 from course_lib import contract
+
+guard = module_fixture("autograder.guard")  # it imports nbconvert
 
 
 @pytest.fixture(scope="module")
@@ -57,7 +60,7 @@ def test_formgrader_autograde_button_refuses(course):
     assert _state(course) == before
 
 
-def test_exporter_works_under_the_graders_flag(monkeypatch):
+def test_exporter_works_under_the_graders_flag(guard, monkeypatch):
     """With the flag the grader sets for its sandboxed run, nbgrader gets a working exporter."""
     monkeypatch.setenv(contract.CHECKS_OUTSIDE_ENV, "1")
     assert guard.GraderOnlyExporter().file_extension == ".ipynb"

@@ -6,18 +6,19 @@ from __future__ import annotations
 import json
 
 import pytest
-from nbgrader.auth import Authenticator
-from nbgrader.coursedir import CourseDirectory
-from nbgrader.exchange import ExchangeError
 from traitlets.config import Config
 
-from coursehub.limited_submit import LimitedSubmit
-
+# nbgrader is imported by the tests, not at collection: each xdist worker collects every module.
 COURSE = "course101"
 
 
 def _submit(tmp_path, rules: dict, earlier: list[str]):
     """nbgrader's submit of `ann`'s brightness with the published `rules` and her `earlier` submission times."""
+    from nbgrader.auth import Authenticator
+    from nbgrader.coursedir import CourseDirectory
+
+    from coursehub.limited_submit import LimitedSubmit
+
     inbound = tmp_path / "exchange" / COURSE / "inbound"
     inbound.mkdir(parents=True, exist_ok=True)
     inbound.chmod(0o777)
@@ -38,6 +39,8 @@ def _submit(tmp_path, rules: dict, earlier: list[str]):
 
 
 def test_a_submission_past_the_attempts_is_refused_with_the_reason(tmp_path):
+    from nbgrader.exchange import ExchangeError
+
     rules = {"brightness": {"attempts": 2, "duedate": "2999-01-01 00:00:00 UTC"}}
     with pytest.raises(ExchangeError, match="brightness allows 2 graded submissions before the due date "
                                             r"\(2999-01-01 00:00 UTC\), and you have made 2.*\n"

@@ -2,7 +2,6 @@
 
 import nbformat
 from builtin_interfaces.msg import Time
-from nbclient import NotebookClient
 from rcl_interfaces.msg import Log
 
 from course_lib.ros import node_logs
@@ -43,6 +42,8 @@ hello = session.add_node(Hello())""",
 def test_log_lines_stay_with_the_cell_that_added_the_node(domain_id, monkeypatch):
     """The lines go to an output widget of the first cell, not as stderr into the cells after it,
     and are said once what they are; node_logs.text() gives them back."""
+    from nbclient import NotebookClient  # nbclient is imported when this test runs, not at collection
+
     monkeypatch.setenv("ROS_DOMAIN_ID", str(domain_id))
     notebook = nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell(source) for source in CELLS])
     NotebookClient(notebook, timeout=120, kernel_name="python3").execute()
