@@ -6,7 +6,7 @@ import os
 import subprocess
 import sys
 
-from course_lib.ros import discovery, processes, session
+from course_lib.ros import announcements, discovery, processes, session
 
 
 def settling(minimum=0.5, quiet=0.2, complete_within=4.0):
@@ -85,14 +85,17 @@ def _gid(pid: int, entity: int) -> bytes:
 
 
 def _announced(pid: int, node: str, readers=(), writers=()):
-    """{participant GID: the ParticipantEntitiesInfo} a process holding one node announces."""
+    """{participant GID: what it announced} for a process holding one node, as
+    Announcements.latest() gives it: read (announcements.parse) from the message rmw would send."""
+    from rclpy.serialization import serialize_message
     from rmw_dds_common.msg import Gid, NodeEntitiesInfo, ParticipantEntitiesInfo
 
     info = NodeEntitiesInfo(node_namespace="/", node_name=node,
                             reader_gid_seq=[Gid(data=list(_gid(pid, r))) for r in readers],
                             writer_gid_seq=[Gid(data=list(_gid(pid, w))) for w in writers])
     participant = _gid(pid, 0x1C1)
-    return {participant: ParticipantEntitiesInfo(gid=Gid(data=list(participant)), node_entities_info_seq=[info])}
+    message = ParticipantEntitiesInfo(gid=Gid(data=list(participant)), node_entities_info_seq=[info])
+    return dict([announcements.parse(serialize_message(message))])
 
 
 class _Graph:

@@ -11,7 +11,8 @@ not show them. :mod:`course_lib.ros.discovery` reads them to know when it has di
 rclpy cannot subscribe to that topic: rcl makes every topic name absolute ("/ros_discovery_info"),
 and rmw's topic has no slash. So :class:`Announcements` makes the subscription one level down, with
 rmw's own C functions (``rmw_create_subscription``, ``rmw_take_serialized_message``) on the tool
-node's rmw node, and turns each sample into a message with ``rclpy.serialization``. This is how
+node's rmw node, and reads each sample's CDR bytes itself (:func:`parse`): the message's Python
+class would import numpy (its GIDs are arrays), which a ``ros2`` command otherwise does without. This is how
 rmw itself subscribes (rmw_fastrtps_cpp, ``init_context_impl``): same topic, type and QoS, but
 for the depth.
 
@@ -21,6 +22,8 @@ Only Fast DDS (rmw_fastrtps_cpp, the only rmw the ROS wheels hold) is supported.
 from __future__ import annotations
 
 import ctypes
+import struct
+import typing
 
 #: rmw's DDS topic of graph messages (no ROS name: no leading slash, no "rt/" prefix).
 TOPIC = "ros_discovery_info"
@@ -80,35 +83,79 @@ def _c_functions():
         rcutils.rcutils_uint8_array_init.argtypes = [ctypes.POINTER(_Bytes), ctypes.c_size_t,
                                                      ctypes.POINTER(_Allocator)]
         rcutils.rcutils_uint8_array_fini.argtypes = [ctypes.POINTER(_Bytes)]
-        ctypes.pythonapi.PyCapsule_GetPointer.restype = ctypes.c_void_p
-        ctypes.pythonapi.PyCapsule_GetPointer.argtypes = [ctypes.py_object, ctypes.c_char_p]
-        ctypes.pythonapi.PyCapsule_GetName.restype = ctypes.c_char_p
-        ctypes.pythonapi.PyCapsule_GetName.argtypes = [ctypes.py_object]
         _functions = rcl, rmw, rcutils
     return _functions
 
 
-def _type_support(message_class) -> int:
-    """The address of a message type's C type support (what rclpy hands rcl for it)."""
-    from rclpy.type_support import check_for_type_support
+def _type_support() -> int:
+    """The address of ParticipantEntitiesInfo's C type support, from rmw_dds_common's library
+    (which rmw has loaded)."""
+    library = ctypes.CDLL("librmw_dds_common__rosidl_typesupport_c.so")
+    handle = library.rosidl_typesupport_c__get_message_type_support_handle__rmw_dds_common__msg__ParticipantEntitiesInfo
+    handle.restype = ctypes.c_void_p
+    return handle()
 
-    check_for_type_support(message_class)
-    capsule = message_class._TYPE_SUPPORT
-    return ctypes.pythonapi.PyCapsule_GetPointer(capsule, ctypes.pythonapi.PyCapsule_GetName(capsule))
+
+class Announced(typing.NamedTuple):
+    """What one participant announced: its nodes (fully qualified names) and the GIDs (16 bytes
+    each) of their readers and writers."""
+
+    nodes: frozenset[str]
+    gids: frozenset[bytes]
+
+
+def parse(data: bytes) -> tuple[bytes, Announced]:
+    """The participant's GID and what it announced, from one serialized ParticipantEntitiesInfo
+    (CDR: a 4-byte encapsulation header, then each field aligned to its size from there: gid
+    uint8[16]; node_entities_info_seq, a sequence of node_namespace and node_name strings and
+    reader_gid_seq and writer_gid_seq, sequences of uint8[16]).
+
+    Raises:
+        ValueError: not a ParticipantEntitiesInfo in CDR (truncated, or another encoding).
+    """
+    if len(data) < 4 or data[0] != 0 or data[1] not in (0, 1):
+        raise ValueError(f"not CDR: encapsulation header {bytes(data[:4])!r}")
+    order, body, position = ("<" if data[1] == 1 else ">"), memoryview(data)[4:], 0
+
+    def count() -> int:
+        nonlocal position
+        position = (position + 3) & ~3
+        try:
+            (value,) = struct.unpack_from(order + "I", body, position)
+        except struct.error as error:
+            raise ValueError(f"truncated at byte {position}") from error
+        position += 4
+        return value
+
+    def octets(size: int) -> bytes:
+        nonlocal position
+        chunk = bytes(body[position:position + size])
+        if len(chunk) != size:
+            raise ValueError(f"truncated at byte {position}")
+        position += size
+        return chunk
+
+    def text() -> str:
+        return octets(count())[:-1].decode()  # the length counts the terminating NUL
+
+    participant, nodes, gids = octets(16), set(), set()
+    for _ in range(count()):
+        namespace, name = text(), text()
+        nodes.add(f"{namespace.rstrip('/')}/{name}")
+        for _ in range(2):  # readers, then writers
+            gids.update(octets(16) for _ in range(count()))
+    return participant, Announced(frozenset(nodes), frozenset(gids))
 
 
 class Announcements:
     """A reader of every participant's graph messages, on a node's participant; close it before the
     node is destroyed (``with Announcements(node) as heard:``).
 
-    ``latest()`` gives the last message of each participant heard so far.
+    ``latest()`` gives what each participant announced last, of what has been heard so far.
     """
 
     def __init__(self, node):
-        from rmw_dds_common.msg import ParticipantEntitiesInfo
-
         rcl, rmw, rcutils = _c_functions()
-        self._message_class = ParticipantEntitiesInfo
         self._rmw_node = rcl.rcl_node_get_rmw_handle(node.handle.pointer)
         if not self._rmw_node:
             raise RuntimeError(f"Node {node.get_name()} has no rmw node (destroyed?)")
@@ -117,7 +164,7 @@ class Announcements:
         qos = _QoS(history=_KEEP_LAST, depth=DEPTH, reliability=_RELIABLE, durability=_TRANSIENT_LOCAL,
                    liveliness=_LIVELINESS_SYSTEM_DEFAULT, avoid_ros_namespace_conventions=True)
         options = rmw.rmw_get_default_subscription_options()
-        self._subscription = rmw.rmw_create_subscription(self._rmw_node, _type_support(ParticipantEntitiesInfo),
+        self._subscription = rmw.rmw_create_subscription(self._rmw_node, _type_support(),
                                                          TOPIC.encode(), ctypes.byref(qos), ctypes.byref(options))
         if not self._subscription:
             rcutils.rcutils_reset_error()  # rmw's error state, which rcl would report and clear
@@ -127,13 +174,11 @@ class Announcements:
         if rcutils.rcutils_uint8_array_init(ctypes.byref(self._sample), 1024, ctypes.byref(allocator)):
             self.close()
             raise MemoryError("no memory for a graph message")
-        self._latest: dict[bytes, object] = {}
+        self._latest: dict[bytes, Announced] = {}
 
-    def latest(self) -> dict[bytes, object]:
-        """{participant GID (16 bytes): its last ParticipantEntitiesInfo}, after taking every
-        message that has come since the last call."""
-        from rclpy.serialization import deserialize_message
-
+    def latest(self) -> dict[bytes, Announced]:
+        """{participant GID (16 bytes): what it announced last}, after taking every message that
+        has come since the last call (one that cannot be read is left out)."""
         _, rmw, rcutils = _c_functions()
         taken = ctypes.c_bool(True)
         while self._subscription:
@@ -144,9 +189,11 @@ class Announcements:
                 break
             if not taken.value:
                 break
-            message = deserialize_message(ctypes.string_at(self._sample.buffer, self._sample.buffer_length),
-                                          self._message_class)
-            self._latest[bytes(message.gid.data)] = message
+            try:
+                participant, announced = parse(ctypes.string_at(self._sample.buffer, self._sample.buffer_length))
+            except ValueError:
+                continue
+            self._latest[participant] = announced
         return self._latest
 
     def close(self) -> None:
@@ -162,14 +209,3 @@ class Announcements:
 
     def __exit__(self, *exc) -> None:
         self.close()
-
-
-def endpoints_of(message) -> tuple[set[str], set[bytes]]:
-    """The nodes (their fully qualified names) and endpoint GIDs (16 bytes each) one
-    ParticipantEntitiesInfo announces."""
-    nodes, gids = set(), set()
-    for info in message.node_entities_info_seq:
-        namespace = info.node_namespace.rstrip("/")
-        nodes.add(f"{namespace}/{info.node_name}")
-        gids.update(bytes(gid.data) for gid in (*info.reader_gid_seq, *info.writer_gid_seq))
-    return nodes, gids

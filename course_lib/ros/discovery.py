@@ -167,7 +167,7 @@ def _process_of(gid) -> int:
 
 def _processes_shown(node, announced: dict) -> set[int]:
     """The processes (their ids' low 16 bits) whose participant the graph shows all of, as the
-    participant announced it (`announced`: its last ParticipantEntitiesInfo, by its GID): every node
+    participant announced it (`announced`: Announcements.latest()): every node
     listed by name, every reader and writer discovered.
 
     rmw learns endpoints and node names from two different messages, and DDS discovery announces
@@ -180,8 +180,7 @@ def _processes_shown(node, announced: dict) -> set[int]:
     listed = set(node.get_fully_qualified_node_names())
     discovered = _discovered_gids(node)
     shown = set()
-    for participant, message in announced.items():
-        nodes, gids = announcements.endpoints_of(message)
+    for participant, (nodes, gids) in announced.items():
         if nodes <= listed and gids <= discovered:
             shown.add(_process_of(participant))
     return shown
