@@ -113,7 +113,9 @@ def test_an_early_run_still_going_at_the_deadline_is_waited_for_not_dropped(tmp_
 def test_what_still_runs_as_the_students_uids_at_the_end_is_killed_and_reported():
     """A process of the kernel's uid that outlived the submission's grading is killed before the
     uid goes to the next submission, and the instructor's report says so."""
-    uid = 64998  # no grader uses it: theirs start at pipeline.KERNEL_UID_BASE
+    # No grader uses these (theirs are pipeline.KERNEL_UID_BASE + a domain id, and 1000 more), nor
+    # does test_process_tree.py (64999), which runs beside this test in another worker.
+    uid = 64990
     g = types.SimpleNamespace(result=GradeResult("s", "a", "", kernel_uid=uid), early_uid=uid + 1)
     pipeline._end_student_processes(g)
     assert g.result.detail == ""
