@@ -134,7 +134,7 @@ def wait_for_every_process(timeout: float) -> bool:
 def _announcements(node, here: list[int | None]):
     """A reader of what the processes of `here` announce, for the length of a wait; none when no
     other process is here."""
-    if not [pid for pid in here if pid != os.getpid()]:
+    if all(pid == os.getpid() for pid in here):
         return contextlib.nullcontext(None)
     return announcements.Announcements(node)
 

@@ -77,10 +77,10 @@ def processes_of_uid(uid: int) -> list[int]:
             continue
         try:
             with open(f"/proc/{entry}/status") as handle:
-                real = next(line.split()[1] for line in handle if line.startswith("Uid:"))
-        except (OSError, StopIteration):
+                fields = dict(line.split(":", 1) for line in handle if line.startswith(("State:", "Uid:")))
+        except OSError:
             continue  # gone meanwhile
-        if int(real) == uid and running(int(entry)):
+        if int(fields.get("Uid", "-1 ").split()[0]) == uid and fields.get("State", "Z").split()[0] not in ("Z", "X"):
             found.append(int(entry))
     return found
 
