@@ -231,6 +231,79 @@ def test_remove_node_by_plain_name(domain_id):
     assert session.nodes() == []
 
 
+TWO_REMOVALS = """
+import threading
+from course_lib.ros import session
+from rclpy.node import Node
+session.start()
+begun, cell_waits = threading.Event(), threading.Event()
+leaving = session.add_node(Node("leaving"))
+removed_by_callback = []
+
+def remove_when_asked():
+    if cell_waits.is_set() and not removed_by_callback:
+        begun.set()
+        session.remove_node(leaving)
+        removed_by_callback.append(leaving)
+
+session.add_node(Node("view")).create_timer(0.01, remove_when_asked)
+deliver = session.node_logs.deliver
+
+def deliver_once_the_callback_began():
+    # _remove calls node_logs.deliver first: in the cell's call, hold there until the callback runs
+    if threading.current_thread() is threading.main_thread() and not begun.is_set():
+        cell_waits.set()
+        assert begun.wait(10), "the timer callback did not run"
+    deliver()
+
+session.node_logs.deliver = deliver_once_the_callback_began
+session.add_node(Node("in_the_cell"))
+session.remove_node("in_the_cell")
+print("left:", [node.get_name() for node in session.nodes()], "removed by the callback:",
+      [node is leaving for node in removed_by_callback], flush=True)
+session.stop()
+"""
+
+
+def test_a_callback_that_removes_a_node_while_a_cell_removes_another_deadlocks_neither(domain_id):
+    """A live view's redraw timer removes its own node when its time is up (course_lib.live), from
+    the session's thread, which holds the executor during the callback; a cell may remove a node at
+    that very moment. Lesson 02 hung for 306 s in a suite run: the cell held the session's lock
+    while it waited for the executor, and the callback held the executor while it waited for the
+    lock. Here the cell's removal goes on exactly when the callback has begun (in a process of its
+    own: a deadlock would hold the session's lock for good)."""
+    try:
+        result = subprocess.run([sys.executable, "-c", TWO_REMOVALS], capture_output=True, text=True,
+                                env=rosenv.ros_environment(domain_id=domain_id), timeout=60)
+    except subprocess.TimeoutExpired:
+        pytest.fail("the two removals deadlocked: the process still ran after 60 s")
+    assert result.returncode == 0, result.stderr
+    assert "left: ['view'] removed by the callback: [True]" in result.stdout, result.stdout
+
+
+def test_stop_while_a_callback_removes_its_node_waits_for_the_callback_only(domain_id, capsys):
+    """stop() waits for the running callback without holding the session's lock: a live view's
+    timer that removes its own node as stop() begins ends at once, and stop() does not report a
+    callback still running (it held the lock, the callback waited for it until stop's timeout)."""
+    session.start(domain_id=domain_id)
+    in_callback, armed, removed = threading.Event(), threading.Event(), []
+    view = session.add_node(Node("view"))
+
+    def remove_own_node_when_stopping():
+        if armed.is_set() and not in_callback.is_set():
+            in_callback.set()
+            assert session._state.stopping.wait(10)
+            session.remove_node(view)
+            removed.append(view)
+
+    view.create_timer(0.01, remove_own_node_when_stopping)
+    armed.set()
+    assert in_callback.wait(10), "the timer callback did not run"
+    session.stop(timeout=30)
+    assert removed == [view] and not session.is_running()
+    assert "still running" not in capsys.readouterr().err
+
+
 def test_remove_node_of_an_unknown_name_lists_the_known_ones(domain_id):
     """A wrong name in remove_node() gets an error that lists the names to use."""
     session.start(domain_id=domain_id)

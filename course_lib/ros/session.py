@@ -174,7 +174,8 @@ def start(domain_id: int | None = None) -> None:
             _check_domain(_state.context, domain_id)
             return
         if _state is not None:  # a session whose thread or context died: clear it up first
-            _teardown(timeout=1.0)
+            _end_thread(_state, timeout=1.0)
+            _teardown()
         context = get_default_context()
         if context.ok():
             _check_domain(context, domain_id)
@@ -219,28 +220,26 @@ def stop(timeout: float = 2.0) -> None:
         timeout: seconds to wait for a running callback to finish.
     """
     global _state, _stopped
+    state = _state
+    if state is not None:  # outside _lock: a callback that removes a node may be waiting for it
+        _end_thread(state, timeout)
     with _lock:
         if _state is None:
             return
+        if _state is not state:  # another thread started a session meanwhile
+            _end_thread(_state, timeout)
         try:
-            _teardown(timeout)
+            _teardown()
         finally:
             _state = None
             _stopped = True
 
 
-def _teardown(timeout: float) -> None:
+def _teardown() -> None:
+    """Destroy the nodes of the session, whose thread has ended (_end_thread), and shut ROS down."""
     import rclpy
 
     state = _state
-    state.stopping.set()
-    # The thread sees the flag within one spin period, or when its current callback returns.
-    if state.thread is not None and state.thread is not threading.current_thread():
-        state.thread.join(timeout)
-        if state.thread.is_alive():
-            print(f"course_lib.ros.session: a callback was still running {timeout} s after stop(); "
-                  "ROS is shut down anyway. Keep callbacks short (no sleep or long loops).",
-                  file=sys.stderr)
     state.executor.shutdown(timeout_sec=0)
     for node in list(state.nodes.values()) + ([state.tool] if state.tool is not None else []):
         teardown.destroy_node(node)
@@ -250,6 +249,18 @@ def _teardown(timeout: float) -> None:
         rclpy.try_shutdown()
     else:  # someone replaced the default context meanwhile; shut down only our own
         state.context.try_shutdown()
+
+
+def _end_thread(state: _State, timeout: float) -> None:
+    """Ask the background thread to end and wait for it (at once when it has ended already)."""
+    state.stopping.set()
+    # The thread sees the flag within one spin period, or when its current callback returns.
+    if state.thread is not None and state.thread is not threading.current_thread() and state.thread.is_alive():
+        state.thread.join(timeout)
+        if state.thread.is_alive():
+            print(f"course_lib.ros.session: a callback was still running {timeout} s after stop(); "
+                  "ROS is shut down anyway. Keep callbacks short (no sleep or long loops).",
+                  file=sys.stderr)
 
 
 def _spin(state: _State) -> None:
@@ -336,10 +347,11 @@ def add_node(node):
         if old is node:
             return node
         if old is not None:
-            _remove(state, name)
+            old = _remove(state, name)
         state.nodes[name] = node
         state.executor.add_node(node)
         since = state.created_at.pop(name, None)
+    _destroy(state, old)
     node_logs.attach(node, tool_node, since)
     return node
 
@@ -381,15 +393,27 @@ def _before_node_created(node_name, namespace, context, cli_args) -> None:
         name = node_names.expected_name(node_name, namespace, cli_args)
         state.created_at[name] = time.time()
         node_logs.expect(name, state.created_at[name])  # lines stamped from now on are the new node's
-        if name in state.nodes:
-            _remove(state, name)
+        old = _remove(state, name) if name in state.nodes else None
+    _destroy(state, old)
 
 
-def _remove(state: _State, name: str) -> None:
+def _remove(state: _State, name: str):
+    """Take a node out of the session and the executor; returns it for _destroy.
+
+    Called under _lock; _destroy must come after _lock is let go: it waits for the executor's
+    thread, and a callback there (a live view's timer that removes its own node) may be waiting
+    for _lock."""
     node_logs.deliver()  # the node's last log lines reach its cell before it goes
     node = state.nodes.pop(name)
     state.executor.remove_node(node)  # wakes the executor, which then lets go of spin_lock
-    if threading.current_thread() is state.thread:  # a callback removes a node: lock is ours
+    return node
+
+
+def _destroy(state: _State, node) -> None:
+    """Destroy a node _remove took out, between two rounds of the executor."""
+    if node is None:
+        return
+    if threading.current_thread() is state.thread:  # a callback removes a node: spin_lock is ours
         teardown.destroy_node(node)
         return
     with state.spin_lock:
@@ -418,7 +442,8 @@ def remove_node(node_or_name) -> None:
             problem = "no node" if not names else f"{len(names)} nodes"
             raise ValueError(f"The session holds {problem} matching {node_or_name!r}; it holds "
                              f"{sorted(held) or 'none'}: pass one of these full names")
-        _remove(state, names[0])
+        node = _remove(state, names[0])
+    _destroy(state, node)
 
 
 def nodes() -> list:
