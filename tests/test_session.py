@@ -11,7 +11,7 @@ from rclpy.exceptions import InvalidHandle
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 
-from course_lib.ros import discovery, graph, rosenv, session
+from course_lib.ros import discovery, graph, rosenv, run_limits, session
 
 
 class Counter(Node):
@@ -342,35 +342,6 @@ def test_tool_node_is_hidden_lazy_and_single(domain_id):
     assert session.nodes() == []
 
 
-def test_time_limit_caps_only_under_test_or_grading(monkeypatch):
-    """Live notebooks keep their durations; test and grading runs get separate, finite caps."""
-    monkeypatch.delenv("COURSE_LIB_UNDER_TEST", raising=False)
-    monkeypatch.delenv("COURSE_LIB_GRADING", raising=False)
-    assert session.time_limit(None) is None
-    assert session.time_limit(60.0) == 60.0
-    monkeypatch.setenv("COURSE_LIB_UNDER_TEST", "1")
-    assert session.time_limit(None) == session.TEST_TIME_LIMIT
-    assert session.time_limit(0.5) == 0.5
-    monkeypatch.setenv("COURSE_LIB_UNDER_TEST", "0")
-    monkeypatch.setenv("COURSE_LIB_GRADING", "1")
-    assert session.time_limit(None) == session.GRADING_TIME_LIMIT
-    assert session.time_limit(60.0) == session.GRADING_TIME_LIMIT
-
-
-def test_an_answer_is_awaited_at_least_the_backstop_under_test_only(monkeypatch):
-    """The answer of a server that was found ends its wait; under test a short limit would let a
-    busy machine decide, so it is at least ANSWER_BACKSTOP there; live and under grading the wait
-    keeps its own limit (a parameter client's 5 s and its hint, a grading's short waits)."""
-    monkeypatch.delenv("COURSE_LIB_UNDER_TEST", raising=False)
-    monkeypatch.delenv("COURSE_LIB_GRADING", raising=False)
-    assert (session.answer_limit(None), session.answer_limit(5.0)) == (None, 5.0)
-    monkeypatch.setenv("COURSE_LIB_UNDER_TEST", "1")
-    assert session.answer_limit(None) == session.answer_limit(5.0) == session.ANSWER_BACKSTOP
-    assert session.answer_limit(600.0) == 600.0
-    monkeypatch.setenv("COURSE_LIB_GRADING", "1")
-    assert session.answer_limit(5.0) == 5.0
-
-
 def test_unbounded_spin_for_ends_under_test(domain_id, monkeypatch):
     """spin_for() with no duration, which runs until interrupted live, returns under test: its
     wait asks for TEST_TIME_LIMIT (how much longer it took is the machine's doing)."""
@@ -379,8 +350,8 @@ def test_unbounded_spin_for_ends_under_test(domain_id, monkeypatch):
     asked, wait_for = [], session.wait_for
     monkeypatch.setattr(session, "wait_for", lambda predicate, timeout=10.0, poll=0.02: (
         asked.append(timeout), wait_for(predicate, timeout, poll))[1])
-    assert session.spin_for() >= session.TEST_TIME_LIMIT
-    assert asked == [session.TEST_TIME_LIMIT]
+    assert session.spin_for() >= run_limits.TEST_TIME_LIMIT
+    assert asked == [run_limits.TEST_TIME_LIMIT]
 
 
 KERNEL_EXIT = """

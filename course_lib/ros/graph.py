@@ -235,7 +235,7 @@ def topic_hz(topic: str, window: int = 10000, duration: float = 2.0, timeout: fl
     """Measure how often a topic is published, like ``ros2 topic hz``.
 
     The measurement starts at the first message and lasts ``duration`` seconds (shorter under
-    test or grading, see session.time_limit). Messages are not deserialized, so this works
+    test or grading, see run_limits.time_limit). Messages are not deserialized, so this works
     for large images too.
 
     Args:

@@ -20,6 +20,7 @@ import yaml
 from rcl_interfaces.msg import ParameterType
 
 from course_lib.ros import session
+from course_lib.ros.run_limits import answer_limit
 
 #: Seconds to wait for a node's parameter services (ros2 param waits as long).
 SERVICE_TIMEOUT = 5.0
@@ -60,7 +61,7 @@ def _client(node_name: str, timeout: float):
 
 
 def _result(future, node_name: str, timeout: float):
-    timeout = session.answer_limit(timeout)  # the node's answer, once its services were found
+    timeout = answer_limit(timeout)  # the node's answer, once its services were found
     if not session.wait_for(future.done, timeout=timeout, poll=0.005):
         raise TimeoutError(f"Node {_full_name(node_name)} did not answer its parameter service "
                            f"within {timeout} s: is its executor busy (a callback that never returns)?")

@@ -48,18 +48,10 @@ from collections.abc import Callable
 
 from course_lib import waiting
 from course_lib.ros import node_logs, node_names, rclpy_backports, rosenv, teardown
+from course_lib.ros.run_limits import time_limit
 
 #: Name of the session's hidden helper node (a leading "_" hides it from node listings).
 TOOL_NODE_NAME = "_course_tools"
-
-#: Longest run, in seconds, of a wait that would last forever (or long) in a live notebook,
-#: when the test suite or CI runs the notebook (rosenv.under_test()).
-TEST_TIME_LIMIT = 2.0
-#: The same limit while the autograder runs a submission (rosenv.under_grading()).
-GRADING_TIME_LIMIT = 5.0
-#: Seconds that a wait for the answer of a server that was found (a service's response, an
-#: action goal's acceptance and result) may last at least under the test suite (answer_limit).
-ANSWER_BACKSTOP = 60.0
 
 # How long the background thread waits for work before it looks at its own state again.
 _SPIN_PERIOD = 0.1
@@ -100,28 +92,6 @@ class SessionStopped(RuntimeError):
                          "that start the processes this cell needs, then run this cell again.")
 
 
-def time_limit(seconds: float | None) -> float | None:
-    """How long a lesson loop may run in this run mode.
-
-    Args:
-        seconds: the live duration; None means "until interrupted".
-
-    Returns:
-        ``seconds`` in a live notebook; at most TEST_TIME_LIMIT under test and at most
-        GRADING_TIME_LIMIT under grading (the smaller one when both flags are set).
-    """
-    limits = []
-    if rosenv.under_test():
-        limits.append(TEST_TIME_LIMIT)
-    if rosenv.under_grading():
-        limits.append(GRADING_TIME_LIMIT)
-    if not limits:
-        return seconds
-    if seconds is None:
-        return min(limits)
-    return min([seconds] + limits)
-
-
 def is_running() -> bool:
     """True while the background executor spins."""
     state = _state
@@ -133,20 +103,6 @@ def domain_id() -> int | None:
     """The ROS domain the running session is on; None when no session runs."""
     state = _state
     return state.context.get_domain_id() if is_running() else None
-
-
-def answer_limit(seconds: float | None) -> float | None:
-    """How long to wait for the answer of a server that was found, given the wait's ``seconds``
-    otherwise (None: as long as it takes).
-
-    The answer ends the wait, and comes unless the server is broken: the limit is only a
-    backstop, so under the test suite it is at least ANSWER_BACKSTOP, far from any answer's time
-    on a busy machine (a busy machine must not decide a test). Live and under grading (where a
-    notebook's waits stay short) it is ``seconds``.
-    """
-    if rosenv.under_test() and not rosenv.under_grading():
-        return ANSWER_BACKSTOP if seconds is None else max(seconds, ANSWER_BACKSTOP)
-    return seconds
 
 
 def start(domain_id: int | None = None) -> None:
@@ -507,7 +463,7 @@ def spin_for(seconds: float | None = None) -> float:
 
     Args:
         seconds: how long; None runs until the kernel is interrupted. Under test or grading
-            the time is capped (see time_limit), so a lesson cell never hangs a run.
+            the time is capped (see run_limits.time_limit), so a lesson cell never hangs a run.
 
     Returns:
         The seconds actually waited.

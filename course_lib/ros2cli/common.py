@@ -230,12 +230,12 @@ def loop_limit(seconds: float | None) -> float | None:
     """How long a wait that the user bounds to ``seconds`` (None: until Ctrl-C) may last.
 
     Live, just ``seconds``. Under the test suite or the grader, also at most
-    course_lib.ros.session.time_limit after the DISCOVERY_BACKSTOP that discovery may take in a new
+    course_lib.ros.run_limits.time_limit after the DISCOVERY_BACKSTOP that discovery may take in a new
     process, so that a ``!ros2 topic hz`` cell cannot hang a notebook run.
     """
-    from course_lib.ros import session
+    from course_lib.ros.run_limits import time_limit
 
-    limit = session.time_limit(seconds)
+    limit = time_limit(seconds)
     return limit + DISCOVERY_BACKSTOP if limit is not None and limit != seconds else limit
 
 
@@ -249,11 +249,12 @@ def wait_until(done: typing.Callable[[], bool], seconds: float | None = None) ->
 def wait_for_answer(done: typing.Callable[[], bool]) -> bool:
     """Wait until ``done()``: the answer of a server this verb has found. Live, as long as it
     takes (Ctrl-C ends it); under grading within the loop limit, as every wait; under test within
-    course_lib.ros.session.answer_limit (the loop limit, about 7 s, could decide a test on a busy
+    course_lib.ros.run_limits.answer_limit (the loop limit, about 7 s, could decide a test on a busy
     machine)."""
     from course_lib.ros import session
+    from course_lib.ros.run_limits import answer_limit
 
-    return session.wait_for(done, timeout=session.answer_limit(loop_limit(None)), poll=0.02)
+    return session.wait_for(done, timeout=answer_limit(loop_limit(None)), poll=0.02)
 
 
 @contextlib.contextmanager
