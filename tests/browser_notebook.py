@@ -358,6 +358,8 @@ def run_in_lab(context, lab: JupyterLab, path: str, screenshot: Path | None = No
     try:
         run = run_notebook(page, path, code_cell_count(lab.root_dir / path), LESSON_RUN_TIMEOUT, screenshot,
                            screenshot_always)
+    except TimeoutError as stuck:
+        raise TimeoutError(f"{stuck}\nPython stacks of the kernels, {lab.kernel_stacks()}") from None
     finally:
         close_notebook(page, lab, path)
     print(f"\n{path}: Run All Cells took {run.seconds:.1f} s")

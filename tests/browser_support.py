@@ -154,15 +154,57 @@ class JupyterLab:
         still_served = set(self.descendants())
         _end_processes([p for p in before if p not in still_served], grace=10)
 
+    def kernel_stacks(self, settle: float = 0.5, timeout: float = 10) -> str:
+        """Every thread's Python stack in each kernel of the server, as the kernels print them to
+        the log on SIGUSR1 (STACKS_ON_SIGUSR1): where a notebook that never ends waits."""
+        start = self.log_path.stat().st_size
+        kernels = self.kernels_that_print_stacks()
+        for pid in kernels:
+            with contextlib.suppress(ProcessLookupError):
+                os.kill(pid, signal.SIGUSR1)
+        size, deadline = start, time.monotonic() + timeout
+        while kernels and time.monotonic() < deadline:  # until the log stops growing
+            time.sleep(settle)
+            size, grown = self.log_path.stat().st_size, size
+            if size == grown > start:
+                break
+        with open(self.log_path, "rb") as log:
+            log.seek(start)
+            return f"kernels {kernels}:\n" + log.read().decode(errors="replace")
+
+    def kernels_that_print_stacks(self) -> list[int]:
+        """The pids of the server's kernels that handle SIGUSR1 (the startup file has run: to a
+        kernel without the handler the signal would be the end)."""
+        pids = []
+        for process in self.descendants():
+            with contextlib.suppress(psutil.Error, OSError):
+                if "ipykernel_launcher" in " ".join(process.cmdline()) and _catches(process.pid, signal.SIGUSR1):
+                    pids.append(process.pid)
+        return pids
+
     def log_tail(self, lines: int = 30) -> str:
         text = self.log_path.read_text(errors="replace") if self.log_path.exists() else ""
         return "\n".join(text.splitlines()[-lines:])
+
+
+def _catches(pid: int, number: int) -> bool:
+    """Whether the process has a handler for the signal (the SigCgt mask of /proc/PID/status)."""
+    with open(f"/proc/{pid}/status") as status:
+        mask = next(line.split()[1] for line in status if line.startswith("SigCgt:"))
+    return bool(int(mask, 16) >> (number - 1) & 1)
 
 
 def free_port() -> int:
     with socket.socket() as sock:
         sock.bind(("127.0.0.1", 0))
         return sock.getsockname()[1]
+
+
+#: An IPython startup file for the tests' kernels: SIGUSR1 prints every thread's Python stack to
+#: the kernel's own stderr, which is the server's log (JupyterLab.kernel_stacks).
+STACKS_ON_SIGUSR1 = """import faulthandler, signal, sys
+faulthandler.register(signal.SIGUSR1, file=sys.__stderr__, all_threads=True)
+"""
 
 
 @contextlib.contextmanager
@@ -180,9 +222,12 @@ def running_jupyterlab(root_dir: Path, state_dir: Path, timeout: float = 120):
         target = settings_dir / name
         target.parent.mkdir(parents=True, exist_ok=True)
         target.write_text(json.dumps(values))
+    startup = state_dir / "ipython" / "profile_default" / "startup" / "00_stacks_on_sigusr1.py"
+    startup.parent.mkdir(parents=True, exist_ok=True)
+    startup.write_text(STACKS_ON_SIGUSR1)
     from course_lib.notebook import student_lab
 
-    env = dict(os.environ,
+    env = dict(os.environ, IPYTHONDIR=str(state_dir / "ipython"),
                # As `make lab` does: nbgrader's student side only (course_lib/notebook/student_lab).
                JUPYTER_CONFIG_PATH=os.pathsep.join(filter(None, [str(student_lab.CONFIG_DIR),
                                                                   os.environ.get("JUPYTER_CONFIG_PATH")])),

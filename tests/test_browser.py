@@ -9,6 +9,7 @@ packages run in tests/test_browser_lessons.py, beside this file (browser_noteboo
 """
 
 import json
+import time
 from pathlib import Path
 
 import pytest
@@ -191,6 +192,21 @@ def test_the_students_lab_has_no_instructor_side(lab):
         urllib.request.urlopen(f"{lab.url}/formgrader?token={lab.token}", timeout=30)
     version = urllib.request.urlopen(f"{lab.url}/nbgrader_version?version=x&token={lab.token}", timeout=30)
     assert "server version is" in version.read().decode()  # the validate/assignment-list extensions answer
+
+
+def test_a_lesson_that_never_ends_would_show_where_its_kernel_waits(lab):
+    """A lesson still running at its timeout reports every thread's stack of the kernels
+    (JupyterLab.kernel_stacks): clean-clone run #45 showed only the prompts of a hung lesson."""
+    kernel = lab.api("POST", "kernels")
+    try:
+        waited = time.monotonic()
+        while not lab.kernels_that_print_stacks():
+            assert time.monotonic() - waited < 60, "no kernel handles SIGUSR1: did its startup file run?"
+            time.sleep(0.25)
+        stacks = lab.kernel_stacks()
+    finally:
+        lab.api("DELETE", f"kernels/{kernel['id']}")
+    assert "Current thread" in stacks and "ipykernel" in stacks, stacks
 
 
 @pytest.mark.timeout(RUN_TIMEOUT)
