@@ -7,7 +7,6 @@ with tests/test_ros2cli_interface_builds.py): the interface package tutorial_int
 
 import os
 import re
-import signal
 import subprocess
 import sys
 import threading
@@ -16,6 +15,7 @@ from pathlib import Path
 
 import pytest
 import tutorial_workspace
+from process_support import interrupt
 from ros2cli_support import ros2
 
 from course_lib.ros import rosenv, workspace
@@ -89,7 +89,10 @@ def test_generated_node_logs_and_takes_remaps(built_ws, domain_id):
     command = workspace.executable_command(built_ws, "tutorial_nodes", "hello_node",
                                            remap={"__node": "renamed_hello"}, params={"use_sim_time": False})
     env = workspace.workspace_environment(built_ws, domain_id=domain_id)
-    process = subprocess.Popen(command, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    # Clean-clone run #53: the node still ran 10 s after Ctrl-C (SIGKILL, -9) and its output said
+    # nothing more; with the fault handler, the abort that ends a stuck node prints its stacks.
+    process = subprocess.Popen(command, env=dict(env, PYTHONFAULTHANDLER="1"), stdout=subprocess.PIPE,
+                               stderr=subprocess.STDOUT, text=True)
     lines, greeted = [], threading.Event()
 
     def read():
@@ -107,12 +110,7 @@ def test_generated_node_logs_and_takes_remaps(built_ws, domain_id):
         answer = ros2("param", "get", "/renamed_hello", "use_sim_time", env=env).stdout
         assert answer.strip() == "Boolean value is: False", answer
     finally:
-        process.send_signal(signal.SIGINT)
-        try:
-            process.wait(timeout=10)
-        except subprocess.TimeoutExpired:
-            process.kill()
-            process.wait(timeout=10)
+        interrupt(process)
         reader.join(timeout=10)
     output = "".join(lines)
     assert process.returncode == 0, output  # SIGINT ends the node cleanly (try/finally + try_shutdown)
