@@ -2,7 +2,6 @@
 line (psutil), so that a test only sees the processes it started itself."""
 
 import shlex
-import signal
 import subprocess
 import sys
 import time
@@ -38,21 +37,6 @@ def wait_until(condition, timeout: float = 60.0) -> bool:
     while not (result := condition()) and time.monotonic() < deadline:
         time.sleep(0.05)
     return result
-
-
-def interrupt(process: subprocess.Popen, timeout: float = 60.0) -> None:
-    """Ctrl-C a process and wait for it to end. Should it still run after `timeout` (a backstop),
-    SIGABRT ends it: started with PYTHONFAULTHANDLER=1, a Python process first prints every
-    thread's stack to its stderr, so the test's output shows where it was stuck; then SIGKILL."""
-    process.send_signal(signal.SIGINT)
-    for then in (signal.SIGABRT, signal.SIGKILL):
-        try:
-            process.wait(timeout=timeout)
-            return
-        except subprocess.TimeoutExpired:
-            process.send_signal(then)
-            timeout = 10
-    process.wait(timeout=timeout)
 
 
 def in_background_of_a_script(command: list[str], output, env: dict) -> tuple[subprocess.Popen, int]:

@@ -7,6 +7,7 @@ with tests/test_ros2cli_interface_builds.py): the interface package tutorial_int
 
 import os
 import re
+import signal
 import subprocess
 import sys
 import threading
@@ -15,10 +16,10 @@ from pathlib import Path
 
 import pytest
 import tutorial_workspace
-from process_support import interrupt
 from ros2cli_support import ros2
 
 from course_lib.ros import rosenv, workspace
+from course_lib.supervision import process_tree
 
 
 @pytest.fixture(scope="session")
@@ -92,7 +93,7 @@ def test_generated_node_logs_and_takes_remaps(built_ws, domain_id):
     # Clean-clone run #53: the node still ran 10 s after Ctrl-C (SIGKILL, -9) and its output said
     # nothing more; with the fault handler, the abort that ends a stuck node prints its stacks.
     process = subprocess.Popen(command, env=dict(env, PYTHONFAULTHANDLER="1"), stdout=subprocess.PIPE,
-                               stderr=subprocess.STDOUT, text=True)
+                               stderr=subprocess.STDOUT, text=True, start_new_session=True)
     lines, greeted = [], threading.Event()
 
     def read():
@@ -110,7 +111,8 @@ def test_generated_node_logs_and_takes_remaps(built_ws, domain_id):
         answer = ros2("param", "get", "/renamed_hello", "use_sim_time", env=env).stdout
         assert answer.strip() == "Boolean value is: False", answer
     finally:
-        interrupt(process)
+        # Ctrl-C; after the suite's 60 s backstop SIGABRT, which the fault handler turns into stacks
+        process_tree.stop_group(process, steps=((signal.SIGINT, 60.0), (signal.SIGABRT, 10.0), (signal.SIGKILL, 10.0)))
         reader.join(timeout=10)
     output = "".join(lines)
     assert process.returncode == 0, output  # SIGINT ends the node cleanly (try/finally + try_shutdown)
