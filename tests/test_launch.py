@@ -150,8 +150,9 @@ def ros2_launch(*argv: str, domain_id: int, env: dict | None = None) -> subproce
                             stderr=subprocess.STDOUT, text=True, env=environment)
 
 
-def interrupt(process: subprocess.Popen, timeout: float = 20.0) -> str:
-    """Ctrl-C to a ros2 launch process; its whole output once it has ended."""
+def interrupt(process: subprocess.Popen, timeout: float = 60.0) -> str:
+    """Ctrl-C to a ros2 launch process; its whole output once it has ended. ``timeout`` is a
+    backstop: the launch ends its nodes (each within its 5 s sigterm_timeout) long before."""
     process.send_signal(signal.SIGINT)
     try:
         output, _ = process.communicate(timeout=timeout)
@@ -378,7 +379,7 @@ def test_a_kernel_that_ends_takes_its_launches_with_it(prefix, ending):
         kernel.stdin.flush()
         if ending == "SIGKILL":
             kernel.kill()
-        kernel.wait(timeout=20)
+        kernel.wait(timeout=60)  # a backstop
     finally:
         kernel.kill()
         kernel.communicate()
@@ -433,9 +434,9 @@ def test_a_colcon_built_package_launches_by_package_and_file_name(tutorial_ws, r
     process = ros2_launch("launch_tutorial", launch_file, "rate:=5.0", domain_id=ros_domain, env=environment)
     try:
         assert "/tutorial/talker" in graph.node_list(wait_for=["/tutorial/talker"], timeout=40)
-        assert "/tutorial/talk" in graph.topic_list(wait_for=["/tutorial/talk"], timeout=10)
+        assert "/tutorial/talk" in graph.topic_list(wait_for=["/tutorial/talk"], timeout=60)
         assert parameters_of("/tutorial/talker", ["rate"]) == {"rate": 5.0}
-        assert len(graph.topic_echo("/tutorial/talk", count=2, timeout=10)) == 2
+        assert len(graph.topic_echo("/tutorial/talk", count=2, timeout=60)) == 2
     finally:
         output = interrupt(process)
     assert "process has finished cleanly" in output, output

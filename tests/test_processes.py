@@ -62,7 +62,7 @@ def test_talker_is_found_logged_and_stopped_cleanly(talker_dir, domain_id):
         talker.wait_for_node("talker", timeout=30)
         talker.wait_for_node("/talker", timeout=5)
         assert wait_until(lambda: "Publishing hello" in talker.log), talker.log
-        code = talker.stop()
+        code = talker.stop(timeout=60)  # a backstop before SIGKILL: the talker ends on the signal
     assert code in (0, -signal.SIGINT), talker.describe_exit()
     assert talker.exit_reason == "stopped"
     assert "[INFO]" in talker.log and "[talker]" in talker.log  # rclpy's logger writes to stderr

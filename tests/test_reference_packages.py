@@ -408,8 +408,9 @@ def test_built_marker_reader_logs_a_malformed_image_and_keeps_running(pipeline):
 
 @pytest.mark.slow
 def test_built_nodes_stop_cleanly_on_ctrl_c(pipeline):
-    assert pipeline.camera.stop() == 0, pipeline.camera.log_tail()
-    assert pipeline.reader.stop() == 0, pipeline.reader.log_tail()
+    # 60 s: a backstop before SIGKILL (stop's own 5 s would make a slow exit on a busy machine fail)
+    assert pipeline.camera.stop(timeout=60) == 0, pipeline.camera.log_tail()
+    assert pipeline.reader.stop(timeout=60) == 0, pipeline.reader.log_tail()
     assert "Traceback" not in pipeline.reader.log + pipeline.camera.log
 
 
