@@ -38,13 +38,17 @@ def scaled(seconds: float) -> int:
     return round(backstop(seconds))
 
 
-def cell_timeout(cell) -> int:
-    """nbclient's timeout_func: graded cells and a workspace's build cell (a message package takes
-    tens of seconds to build) get TEST_CELL_TIMEOUT, all others CELL_TIMEOUT (both scaled)."""
+def long_cell(cell) -> bool:
+    """Whether a cell may run long: a graded test cell (its checks), or a workspace's build cell (a
+    message package takes tens of seconds to build). Every other cell is an ordinary one."""
     meta = cell.get("metadata", {}).get("nbgrader", {})
-    if "course_lib build" in cell.get("source", ""):
-        return scaled(TEST_CELL_TIMEOUT)
-    return scaled(TEST_CELL_TIMEOUT if meta.get("grade") and not meta.get("solution") else CELL_TIMEOUT)
+    return "course_lib build" in cell.get("source", "") or bool(meta.get("grade") and not meta.get("solution"))
+
+
+def cell_timeout(cell) -> int:
+    """nbclient's timeout_func: long cells (long_cell) get TEST_CELL_TIMEOUT, all others
+    CELL_TIMEOUT (both scaled)."""
+    return scaled(TEST_CELL_TIMEOUT if long_cell(cell) else CELL_TIMEOUT)
 
 
 #: What nbgrader leaves out when it submits, collects or autogrades a folder: its defaults, and
