@@ -38,6 +38,9 @@ def apply(c, root: str | Path | None = None) -> None:
     # nbgrader's own autograde (CLI, formgrader button) would run the hidden checks in the
     # student's kernel, outside the sandbox: it refuses and names the course's grader.
     c.Autograde.exporter_class = "autograder.guard.GraderOnlyExporter"
+    # The notebook's run stops an ordinary cell by its processor time, or once it idles, instead of
+    # at its wall-clock timeout, which grows with the load (autograder.cell_watch).
+    c.Autograde.autograde_preprocessors = watched_preprocessors()
     # `nbgrader export` and `python -m autograder export` write one file, in one format.
     c.ExportApp.plugin_class = "autograder.export.CourseCsvExport"
     if root is not None:
@@ -47,6 +50,17 @@ def apply(c, root: str | Path | None = None) -> None:
     # `nbgrader zip_collect`: the file names and times of an LMS download.
     c.ZipCollectApp.collector_plugin = "autograder.collect.LmsFileNames"
     quiet_add_submission()
+
+
+def watched_preprocessors() -> list:
+    """nbgrader's autograde preprocessors, its Execute replaced by autograder.cell_watch's."""
+    from nbgrader.converters import Autograde
+    from nbgrader.preprocessors import Execute
+
+    from autograder.cell_watch import WatchedExecute
+
+    steps = Autograde.class_traits()["autograde_preprocessors"].default()
+    return [WatchedExecute if step is Execute else step for step in steps]
 
 
 def quiet_add_submission() -> None:
