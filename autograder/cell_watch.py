@@ -98,12 +98,12 @@ class WatchedExecute(Execute):
     _watch: CellWatch | None = None
 
     async def async_execute_cell(self, cell, cell_index, execution_count=None, store_history=True):
-        watch = self._start_watch(cell)
+        self._watch = self._start_watch(cell)
         try:
             return await super().async_execute_cell(cell, cell_index, execution_count, store_history)
         finally:
-            if watch is not None:
-                watch.stop()
+            if self._watch is not None:  # on_cell_executed has stopped it, unless the cell raised
+                self._watch.stop()
             self._watch = None
 
     # nbclient binds its synchronous execute_cell (which nbconvert's preprocessor calls) to its
@@ -119,9 +119,9 @@ class WatchedExecute(Execute):
         def interrupt():
             asyncio.run_coroutine_threadsafe(self.km.interrupt_kernel(), loop)
 
-        self._watch = CellWatch(pid, interrupt, self.cpu_budget, self.idle_limit, self.idle_window)
-        self._watch.start()
-        return self._watch
+        watch = CellWatch(pid, interrupt, self.cpu_budget, self.idle_limit, self.idle_window)
+        watch.start()
+        return watch
 
     def on_cell_executed(self, **kwargs):
         watch = self._watch
