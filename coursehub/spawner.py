@@ -28,20 +28,7 @@ from jupyterhub.spawner import LocalProcessSpawner
 from traitlets import Unicode
 
 from coursehub import course as course_settings
-from coursehub import forward, sandbox
-
-
-def processes_in_network_namespace(namespace: str) -> list[int]:
-    """The process ids whose network namespace is `namespace` (as /proc/PID/ns/net reads)."""
-    found = []
-    for entry in os.listdir("/proc"):
-        if entry.isdigit():
-            try:
-                if os.readlink(f"/proc/{entry}/ns/net") == namespace:
-                    found.append(int(entry))
-            except OSError:
-                pass
-    return found
+from coursehub import forward, netns, sandbox
 
 
 class IsolatedSpawner(LocalProcessSpawner):
@@ -50,7 +37,8 @@ class IsolatedSpawner(LocalProcessSpawner):
 
     _hub_door = None  # one per hub process: hub.sock -> the hub's API
     _door = None
-    _namespace = ""
+    #: The server's network namespace (coursehub.netns), pinned once the server runs in it.
+    _namespace: netns.PinnedNamespace | None = None
 
     def make_preexec_fn(self, name):
         return None  # stays root until the namespaces exist; setpriv drops to the user inside them
@@ -85,8 +73,8 @@ class IsolatedSpawner(LocalProcessSpawner):
         self.notebook_dir = str(workdir)
         self.popen_kwargs = {"cwd": str(workdir)}
         self.cmd = sandbox.as_user(course, self.user.name, [sys.executable, "-m", "coursehub.singleuser"])
+        self._end_namespace()  # (a server that ended on its own, not yet polled)
         ip, port = await super().start()
-        self._namespace = ""
         if self._door is not None:
             self._door.close()
         self._door = await forward.tcp_to_unix("127.0.0.1", port, str(course.server_socket(self.user.name)),
@@ -95,24 +83,29 @@ class IsolatedSpawner(LocalProcessSpawner):
 
     async def poll(self):
         status = await super().poll()
-        if status is None and not self._namespace:
-            try:
-                self._namespace = os.readlink(f"/proc/{self.pid}/ns/net")
-            except OSError:
-                pass
+        if status is None and self._namespace is None:
+            self._namespace = netns.PinnedNamespace.of(self.pid)  # None until the server is in its own
+        elif status is not None:  # it ended on its own (the hub calls stop() only for a running server)
+            self._end_namespace()
         return status
 
     async def stop(self, now=False):
-        await self.poll()  # learns the namespace while the server still runs
+        await self.poll()  # pins the namespace while the server still runs
         await super().stop(now=now)
         if self._door is not None:
             self._door.close()
             self._door = None
-        # Whatever the user left running in the namespace (a node started with nohup, say) ends too.
-        if self._namespace and self._namespace != os.readlink("/proc/self/ns/net"):
-            for pid in processes_in_network_namespace(self._namespace):
-                try:
-                    os.kill(pid, signal.SIGKILL)
-                except ProcessLookupError:
-                    pass
-        self._namespace = ""
+        self._end_namespace()
+
+    def _end_namespace(self) -> None:
+        """Kill whatever the user left running in the server's namespace (a node started with
+        nohup, say), then let the namespace go."""
+        if self._namespace is None:
+            return
+        for pid in self._namespace.processes():
+            try:
+                os.kill(pid, signal.SIGKILL)
+            except ProcessLookupError:
+                pass
+        self._namespace.close()
+        self._namespace = None

@@ -23,7 +23,10 @@ import os
 import re
 import secrets
 import shutil
+import signal
+import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -453,19 +456,53 @@ def test_submissions_at_once_are_each_graded_once_across_a_kill_of_the_service(h
         plain.cells, service_cells)
 
 
+@contextlib.contextmanager
+def _bystanders(every: float = 0.02):
+    """Short-lived processes in network namespaces of their own, one more every `every` s while the
+    block runs, as a grader makes them (a sandbox for each build, notebook run and check); yields
+    the list."""
+    made, done = [], threading.Event()
+
+    def make() -> None:
+        while not done.is_set():
+            made.append(subprocess.Popen(["unshare", "--net", "sleep", "2"]))
+            time.sleep(every)
+
+    thread = threading.Thread(target=make, daemon=True)
+    thread.start()
+    try:
+        yield made
+    finally:
+        done.set()
+        thread.join()
+        for process in made:
+            process.wait(60)
+
+
 def test_stopping_the_hub_stops_every_process_of_the_course(hub):
+    """Every process of the course's users and of their servers' namespaces ends with the hub, and
+    nothing else: a namespace made meanwhile (a grading's, say) may get the number a server's had."""
+    from coursehub.netns import PinnedNamespace
+
     service = grading_service(hub)
-    namespaces = set()
-    for process in course_processes(hub):
-        try:
-            namespaces.add(os.readlink(f"/proc/{process.pid}/ns/net"))
-        except OSError:
-            pass
-    namespaces.discard(os.readlink("/proc/self/ns/net"))
-    assert namespaces, "no server of the course was running before the hub stopped"
-    hub.stop()
-    deadline = time.monotonic() + 60  # a backstop: stopping the servers of a loaded machine takes seconds
-    while (left := course_processes(hub, namespaces)) and time.monotonic() < deadline:
-        time.sleep(0.2)
-    assert not left, [(p.pid, p.info) for p in left]
+    namespaces = {}  # pinned: once the servers end, their numbers go to new namespaces
+    try:
+        for process in course_processes(hub):
+            pinned = PinnedNamespace.of(process.pid)
+            if pinned is not None:
+                namespaces.setdefault(pinned.identity, pinned)
+                if namespaces[pinned.identity] is not pinned:
+                    pinned.close()
+        assert namespaces, "no server of the course was running before the hub stopped"
+        with _bystanders() as bystanders:
+            hub.stop()
+            deadline = time.monotonic() + 60  # a backstop: stopping the servers of a loaded machine takes seconds
+            while (left := course_processes(hub, namespaces.values())) and time.monotonic() < deadline:
+                time.sleep(0.2)
+        assert not left, [(p.pid, p.info) for p in left]
+    finally:
+        for pinned in namespaces.values():
+            pinned.close()
+    killed = [p.pid for p in bystanders if p.returncode == -signal.SIGKILL]
+    assert killed == [], f"stopping the hub killed {len(killed)} of {len(bystanders)} processes of other namespaces"
     _wait_until_gone(service)  # the grading service (root) stops with the hub
