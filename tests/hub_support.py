@@ -7,6 +7,8 @@ and find every process of the course's users.
 - ``log_in``: a requests session logged in through the hub's login form, with the user's server up;
 - ``run_in_kernel``: start a kernel in a user's server, run code, return what it printed;
 - ``course_processes``: the processes of the course's uids and of their network namespaces;
+- ``namespace_bystanders``: processes in network namespaces of their own that come and go (as a
+  grader's sandboxes do) while the hub is stopped;
 - ``grading_service``, ``sandboxed``, ``submission_states``: the hub's grading service process,
   its processes in the grader's sandbox (a grading runs), and the rows of its queue as its page
   shows them to a student.
@@ -25,6 +27,7 @@ import pwd
 import signal
 import subprocess
 import sys
+import threading
 import time
 import uuid
 from pathlib import Path
@@ -257,6 +260,29 @@ def course_processes(hub: Hub, namespaces=()) -> list[psutil.Process]:
         except (psutil.Error, OSError, TypeError):
             pass
     return found
+
+
+@contextlib.contextmanager
+def namespace_bystanders(every: float = 0.02):
+    """Short-lived processes in network namespaces of their own, one more every `every` s while the
+    block runs, as a grader makes them (a sandbox for each build, notebook run and check); yields
+    the list."""
+    made, done = [], threading.Event()
+
+    def make() -> None:
+        while not done.is_set():
+            made.append(subprocess.Popen(["unshare", "--net", "sleep", "2"]))
+            time.sleep(every)
+
+    thread = threading.Thread(target=make, daemon=True)
+    thread.start()
+    try:
+        yield made
+    finally:
+        done.set()
+        thread.join()
+        for process in made:
+            process.wait(60)
 
 
 def grading_service(hub: Hub, timeout: float = 120) -> psutil.Process:

@@ -24,9 +24,7 @@ import re
 import secrets
 import shutil
 import signal
-import subprocess
 import sys
-import threading
 import time
 from pathlib import Path
 
@@ -43,6 +41,7 @@ from hub_support import (  # noqa: E402  # noqa: E402
     course_processes,
     grading_service,
     log_in,
+    namespace_bystanders,
     run_in_kernel,
     running_hub,
     sandboxed,
@@ -456,29 +455,6 @@ def test_submissions_at_once_are_each_graded_once_across_a_kill_of_the_service(h
         plain.cells, service_cells)
 
 
-@contextlib.contextmanager
-def _bystanders(every: float = 0.02):
-    """Short-lived processes in network namespaces of their own, one more every `every` s while the
-    block runs, as a grader makes them (a sandbox for each build, notebook run and check); yields
-    the list."""
-    made, done = [], threading.Event()
-
-    def make() -> None:
-        while not done.is_set():
-            made.append(subprocess.Popen(["unshare", "--net", "sleep", "2"]))
-            time.sleep(every)
-
-    thread = threading.Thread(target=make, daemon=True)
-    thread.start()
-    try:
-        yield made
-    finally:
-        done.set()
-        thread.join()
-        for process in made:
-            process.wait(60)
-
-
 def test_stopping_the_hub_stops_every_process_of_the_course(hub):
     """Every process of the course's users and of their servers' namespaces ends with the hub, and
     nothing else: a namespace made meanwhile (a grading's, say) may get the number a server's had."""
@@ -494,7 +470,7 @@ def test_stopping_the_hub_stops_every_process_of_the_course(hub):
                 if namespaces[pinned.identity] is not pinned:
                     pinned.close()
         assert namespaces, "no server of the course was running before the hub stopped"
-        with _bystanders() as bystanders:
+        with namespace_bystanders() as bystanders:
             hub.stop()
             deadline = time.monotonic() + 60  # a backstop: stopping the servers of a loaded machine takes seconds
             while (left := course_processes(hub, namespaces.values())) and time.monotonic() < deadline:
