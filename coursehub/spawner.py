@@ -20,13 +20,13 @@ from __future__ import annotations
 
 import os
 import pwd
-import signal
 import sys
 from pathlib import Path
 
 from jupyterhub.spawner import LocalProcessSpawner
 from traitlets import Unicode
 
+from course_lib.supervision import process_tree
 from coursehub import course as course_settings
 from coursehub import forward, netns, sandbox
 
@@ -102,10 +102,6 @@ class IsolatedSpawner(LocalProcessSpawner):
         nohup, say), then let the namespace go."""
         if self._namespace is None:
             return
-        for pid in self._namespace.processes():
-            try:
-                os.kill(pid, signal.SIGKILL)
-            except ProcessLookupError:
-                pass
+        process_tree.kill_all(self._namespace.processes)
         self._namespace.close()
         self._namespace = None

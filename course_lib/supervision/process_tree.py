@@ -8,6 +8,8 @@ The one place that ends process trees in the course:
   gone, :func:`signal_group` kills what its node's group left;
 - a plain subprocess.Popen started with ``start_new_session=True`` (a build) is stopped with
   :func:`stop_group`: SIGINT, then SIGTERM, then SIGKILL, each given its time.
+- what is left of a submission (:func:`kill_uid`) or of a student's server (its namespace,
+  coursehub.spawner) is killed with :func:`kill_all`, until none is left.
 
 The plain-terminal equivalent is ``kill -INT -- -PGID`` (a negative pid names a process group).
 Standard library only: the supervisor runs without site-packages.
@@ -85,12 +87,12 @@ def processes_of_uid(uid: int) -> list[int]:
     return found
 
 
-def kill_uid(uid: int, timeout: float = 5.0) -> int:
-    """SIGKILL every running process of real uid `uid`, again and again until none is left (a
-    process may fork while it is being killed) or `timeout` seconds pass. For a uid that only one
-    caller's processes use (the grader's per-worker uids). Returns how many processes it killed."""
+def kill_all(find, timeout: float = 5.0) -> int:
+    """SIGKILL every process that ``find()`` lists (running ones, zombies left out), again and
+    again until it lists none (a process may fork while it is being killed) or `timeout` seconds
+    pass. Returns how many processes it killed."""
     killed, deadline = set(), time.monotonic() + timeout
-    while (alive := processes_of_uid(uid)) and time.monotonic() < deadline:
+    while (alive := find()) and time.monotonic() < deadline:
         for pid in alive:
             try:
                 os.kill(pid, signal.SIGKILL)
@@ -99,6 +101,12 @@ def kill_uid(uid: int, timeout: float = 5.0) -> int:
                 pass
         time.sleep(0.01)  # SIGKILL is delivered at once, but the process needs a moment to end
     return len(killed)
+
+
+def kill_uid(uid: int, timeout: float = 5.0) -> int:
+    """kill_all of the running processes of real uid `uid`. For a uid that only one caller's
+    processes use (the grader's per-worker uids). Returns how many processes it killed."""
+    return kill_all(lambda: processes_of_uid(uid), timeout)
 
 
 def children_of(pid: int) -> list[int]:
