@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import asyncio
 import os
+import pwd
 
 import pytest
 
@@ -89,3 +90,20 @@ def test_course_settings_survive_a_save_and_a_load(tmp_path):
     saved.save()
     assert course.load(tmp_path) == saved
     assert os.stat(tmp_path / "course.json").st_mode & 0o777 == 0o600
+
+
+def test_a_file_removed_while_a_tree_is_given_away_is_left_out(tmp_path, monkeypatch):
+    """chown_tree lists a folder, then changes each owner: a file removed in between (SQLite's
+    journal of another grading worker's write to the gradebook) is no error. It once failed a
+    grading of the hub's service, whose submission then never got its feedback."""
+    (tmp_path / "gradebook.db").write_text("")
+    walk = os.walk
+
+    def listed_before_the_journal_went(path):
+        for directory, dirs, files in walk(path):
+            yield directory, dirs, [*files, "gradebook.db-journal"]
+
+    monkeypatch.setattr(os, "walk", listed_before_the_journal_went)
+    me = pwd.getpwuid(os.getuid())
+    accounts.chown_tree(tmp_path, me.pw_name)
+    assert (tmp_path / "gradebook.db").stat().st_uid == me.pw_uid
