@@ -4,14 +4,16 @@ before the due date for assignments whose ``reasons_before_due`` is False, autog
 
 from __future__ import annotations
 
-from nbconvert.preprocessors import Preprocessor
+from nbgrader.preprocessors import NbGraderPreprocessor
 
 NOTE = ("The score of this check is above. Why it scored so is shown after the due date, when your "
         "instructor releases the final feedback.\n")
 
 
-class ScoresOnly(Preprocessor):
-    """Replace the outputs of the graded test cells (the checks' verdicts) by NOTE."""
+class ScoresOnly(NbGraderPreprocessor):
+    """Replace the outputs of the graded test cells (the checks' verdicts) by NOTE. An nbgrader
+    preprocessor, so enabled: nbconvert's own are disabled unless configured, and a converter's
+    exporter skips them without a word."""
 
     def preprocess_cell(self, cell, resources, index):
         settings = cell.metadata.get("nbgrader", {})
