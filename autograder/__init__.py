@@ -13,8 +13,9 @@
 - Grading: ``autograder.release`` (course root, release), ``autograder.nbgrader_cli``,
   ``autograder.submissions`` (what was handed in, its digest), ``autograder.sandbox`` and
   ``autograder/sandbox_entry.py`` (isolation), ``autograder.staging`` (private copies),
-  ``autograder.pipeline`` (one submission, step by step), ``autograder.hidden_checks`` (the
-  hidden checks and their verdicts), ``autograder.outputs`` (autograded notebooks, logs),
+  ``autograder.pipeline`` (one submission, step by step), ``autograder.work_folders`` (its work
+  folder, and those of gradings cut short), ``autograder.hidden_checks`` (the hidden checks and
+  their verdicts), ``autograder.outputs`` (autograded notebooks, logs),
   ``autograder.result``, ``autograder.store`` (recorded results, cache), ``autograder.grading``
   (the whole class, in parallel).
 - Grading on submission (the hub's service, coursehub.grading_service): ``autograder.submit_queue``

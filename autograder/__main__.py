@@ -82,6 +82,11 @@ def _run(parser, args) -> int:
     elif args.command == "grade":
         if args.workers < 1:
             parser.error("--workers must be at least 1")
+        from autograder import work_folders
+
+        swept = work_folders.sweep()  # what the gradings of a killed grade run (or service) left
+        if swept:
+            print(f"Removed {len(swept)} work folder(s) of gradings cut short", file=sys.stderr)
         results = grading.grade(args.course_dir, args.assignment, workers=args.workers, force=args.force,
                                 student=args.student)
         failed = [r for r in results if r.status == "failed"]

@@ -38,11 +38,10 @@ import json
 import os
 import shutil
 import sys
-import tempfile
 import time
 from pathlib import Path
 
-from autograder import config, early_checks, gradebook, intake, kernel, packages
+from autograder import config, early_checks, gradebook, intake, kernel, packages, work_folders
 from autograder.hidden_checks import apply_verdicts, grade_outside, graded_checks
 from autograder.nbgrader_cli import env_for_tools
 from autograder.outputs import keep_autograded, keep_log, scrub_paths
@@ -99,7 +98,7 @@ class Grading:
     course: Path
     domain_id: int
     result: GradeResult
-    work: Path                 # the private work folder, removed at the end
+    work: Path                 # the private work folder (autograder.work_folders), removed at the end
     env: dict = dataclasses.field(default_factory=dict)  # for every sandboxed process
     notebook_run: object = None  # the nbgrader autograde process (course_lib.ros.processes.NodeProcess)
     deadline: float = 0.0      # time.monotonic() by which the grading must end (grading_budget)
@@ -326,7 +325,7 @@ def grade_submission(sub: Submission, course: Path, domain_id: int) -> GradeResu
         result.seconds = round(time.monotonic() - started, 1)
         return result
     budget = grading_budget()
-    grading = Grading(sub, course, domain_id, result, Path(tempfile.mkdtemp(prefix="autograder-work-")),
+    grading = Grading(sub, course, domain_id, result, work_folders.make(),
                       deadline=started + budget, budget=budget)
     try:
         for step in STEPS:
@@ -337,7 +336,7 @@ def grade_submission(sub: Submission, course: Path, domain_id: int) -> GradeResu
         if grading.early is not None:  # a step raised: stop it before its folder goes
             grading.early.cancel()
         _end_student_processes(grading)
-        _remove_tree(grading.work)
+        work_folders.remove(grading.work)
     result.score = round_points(sum(c["auto_score"] or 0 for c in result.cells)) if result.status != "failed" else 0.0
     result.seconds = round(time.monotonic() - started, 1)
     return result
@@ -387,14 +386,3 @@ def _cells_timed_out(log: str) -> str:
     if not limits:
         return ""
     return f"; {len(limits)} cell(s) ran past their limit of {', '.join(sorted(set(limits)))} s and were interrupted"
-
-
-def _remove_tree(path: Path) -> None:
-    def retry(function, name, _exc):
-        try:
-            os.chmod(os.path.dirname(name), 0o700)
-            function(name)
-        except OSError:
-            pass
-    shutil.rmtree(path, onerror=retry)
-

@@ -66,6 +66,11 @@ class Service:
         self._contents, self._contents_lock = {}, threading.Lock()
 
     def start(self) -> None:
+        from autograder import work_folders
+
+        swept = work_folders.sweep()  # what the gradings of a killed service (or grade run) left
+        if swept:
+            _log(f"removed {len(swept)} work folder(s) of gradings cut short: {', '.join(map(str, swept))}")
         recovered = self.queue.recover()
         if recovered:
             _log(f"{recovered} submission(s) whose grading was cut short are queued again")
@@ -184,8 +189,11 @@ def main(argv=None) -> int:
     parser.add_argument("--workers", type=int, help="submissions graded at the same time (default: "
                         f"c.GradeOnSubmit.workers in the course's nbgrader_config.py, else {config.SUBMIT_WORKERS})")
     args = parser.parse_args(argv)
+    import signal
+
     from tornado import ioloop
 
+    from autograder import work_folders
     from coursehub import grading_status
 
     course = course_settings.load(args.hub_dir)
@@ -198,16 +206,21 @@ def main(argv=None) -> int:
                  "restarted.")
             workers = config.SUBMIT_WORKERS
     service = Service(course, workers=max(1, workers), rules_file=course.submit_rules)
-    service.start()
-    prefix = os.environ.get("JUPYTERHUB_SERVICE_PREFIX", f"/{course_settings.GRADING_PAGE}")
-    grading_status.application(service.queue, prefix).listen(course.grading_port, "127.0.0.1")
-    _log(f"grading {', '.join(service.rules()) or 'nothing yet (c.GradeOnSubmit.assignments)'} on submission "
-         f"with {service.workers} worker(s); status at {prefix} (127.0.0.1:{course.grading_port})")
+    # The hub stops its services with SIGINT, then SIGTERM: either ends the loop below.
+    signal.signal(signal.SIGTERM, signal.default_int_handler)
     try:
+        service.start()
+        prefix = os.environ.get("JUPYTERHUB_SERVICE_PREFIX", f"/{course_settings.GRADING_PAGE}")
+        grading_status.application(service.queue, prefix).listen(course.grading_port, "127.0.0.1")
+        _log(f"grading {', '.join(service.rules()) or 'nothing yet (c.GradeOnSubmit.assignments)'} on submission "
+             f"with {service.workers} worker(s); status at {prefix} (127.0.0.1:{course.grading_port})")
         ioloop.IOLoop.current().start()
-    except KeyboardInterrupt:  # the hub stops its services with SIGINT
+    except KeyboardInterrupt:
         pass
     service.stopping.set()
+    # The gradings cut short (queued again at the next start) leave no work folder: the process
+    # becomes their remover when its worker threads hold any (autograder.work_folders).
+    work_folders.end_gradings()
     return 0
 
 
