@@ -31,8 +31,10 @@ def content_key(folder: Path, underlay_keys=()) -> str:
     digest = hashlib.sha256(f"{CACHE_VERSION}\0{sys.version}\0{sys.prefix}\0".encode())
     for key in underlay_keys:
         digest.update(key.encode() + b"\0")
-    for path in sorted(p for p in folder.rglob("*") if p.is_file()):
-        digest.update(str(path.relative_to(folder)).encode() + b"\0" + path.read_bytes() + b"\0")
+    for path in sorted(p for p in folder.rglob("*") if p.is_file() or p.is_symlink()):
+        # A student's link is named, never followed (root reads these files).
+        content = b"link " + os.readlink(path).encode() if path.is_symlink() else path.read_bytes()
+        digest.update(str(path.relative_to(folder)).encode() + b"\0" + content + b"\0")
     return digest.hexdigest()[:32]
 
 

@@ -4,6 +4,9 @@ what is wrong and how to fix it (not "nbgrader could not grade the notebook (exi
 - Notebook names: nbgrader grades a notebook only under the name it was released with. LMS
   downloads rename files that were uploaded twice (``pubsub (1).ipynb``, ``pubsub-1.ipynb``).
 - The submission time: ``timestamp.txt`` (written by ``nbgrader zip_collect``) must hold a date.
+- The files: plain files and folders only, within the size and count limits (autograder.untrusted),
+  and each released notebook a Jupyter notebook (JSON), so that a broken one is told in seconds,
+  before any build or kernel.
 """
 
 from __future__ import annotations
@@ -61,6 +64,47 @@ def timestamp(folder: Path) -> Problem | None:
     return None
 
 
+def files(folder: Path) -> Problem | None:
+    """A Problem when the folder holds anything but plain files and folders, or too much
+    (autograder.untrusted: nothing is followed out of it)."""
+    from autograder import untrusted
+    from course_lib.checks.validate import IGNORE
+
+    try:
+        untrusted.copy_tree(folder, None, ignore=IGNORE)
+    except untrusted.Refused as refusal:
+        return Problem(reason=str(refusal), fix=f"Look at {folder}: {refusal}")
+    return None
+
+
+def notebooks(course: Path, assignment: str, folder: Path) -> Problem | None:
+    """A Problem when a released notebook in `folder` is not a Jupyter notebook (JSON nbformat 4)."""
+    import json
+
+    import nbformat
+
+    for name in released_notebooks(course, assignment):
+        path = Path(folder) / name
+        try:
+            text = path.read_text(encoding="utf-8")
+            json.loads(text)  # nbformat's own error hides where the JSON breaks
+            nbformat.reads(text, as_version=4)
+        except UnicodeDecodeError as error:
+            problem = f"it is not text (byte {error.start} is not UTF-8)"
+        except json.JSONDecodeError as error:
+            problem = f"it is not valid JSON ({error.msg} at line {error.lineno}, column {error.colno})"
+        except Exception as error:  # noqa: BLE001 - nbformat's own complaints, whatever their class
+            said = str(error).strip().splitlines()
+            problem = f"nbformat cannot read it ({said[0][:200] if said else type(error).__name__})"
+        else:
+            continue
+        return Problem(reason=(f"'{name}' is not a Jupyter notebook: {problem}, so it could not be graded. Open "
+                               "the released notebook in JupyterLab, save it there (File > Save Notebook) and "
+                               "submit again."), fix=f"Look at {path}")
+    return None
+
+
 def check(course: Path, student: str, assignment: str, folder: Path) -> Problem | None:
     """The first problem that keeps a submission from being graded, or None."""
-    return notebook_names(course, student, assignment, folder) or timestamp(folder)
+    return (files(folder) or notebook_names(course, student, assignment, folder)
+            or notebooks(course, assignment, folder) or timestamp(folder))

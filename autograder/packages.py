@@ -283,7 +283,7 @@ def _build_interface(name: str, folder: Path, key: str, cache: InterfaceCache, s
     build_ws = scratch / "interfaces" / key
     if build_ws.exists():
         shutil.rmtree(build_ws)
-    shutil.copytree(folder, build_ws / "src" / name, symlinks=False)
+    shutil.copytree(folder, build_ws / "src" / name, symlinks=True)  # root follows no student link
     if give is not None:
         give(build_ws)
     ok, output = _colcon(build_ws, [], env, run)

@@ -20,8 +20,12 @@ def stage_grader(work: Path) -> Path:
 
 
 def private_copy(source: Path, target: Path) -> None:
-    """Copy a directory tree readable by root only (other workers' uids cannot read it)."""
-    shutil.copytree(source, target, ignore=shutil.ignore_patterns(".ipynb_checkpoints"))
+    """Copy a submission's folder readable by root only (other workers' uids cannot read it),
+    following no link out of it (autograder.untrusted; intake.check refused such a folder before)."""
+    from autograder import untrusted
+    from course_lib.checks.validate import IGNORE
+
+    untrusted.copy_tree(source, target, ignore=IGNORE)
     for directory, _dirs, files in os.walk(target):
         os.chmod(directory, 0o711)
         for name in files:

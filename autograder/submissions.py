@@ -43,7 +43,8 @@ PER_SUBMISSION_FILES = ("timestamp.txt", "submission_secret.txt")
 
 def _tree_digest(paths: list[Path], digest, skip: tuple = ()) -> None:
     for base in paths:
-        files = [base] if base.is_file() else sorted(p for p in base.rglob("*") if p.is_file())
+        # A link is not read (root must not follow a student's link; intake.check refuses it).
+        files = [base] if base.is_file() else sorted(p for p in base.rglob("*") if p.is_file() and not p.is_symlink())
         for path in files:
             if path.parent == base and path.name in skip:
                 continue

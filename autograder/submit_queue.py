@@ -118,10 +118,11 @@ class SubmitQueue:
             return {r[0] for r in self._db.execute("SELECT entry FROM submissions")}
 
     def add(self, entry: str, student: str, assignment: str, submitted: datetime, attempts: int | None,
-            duedate: datetime | None) -> Row:
+            duedate: datetime | None, refused: str | None = None) -> Row:
         """Queue a new submission: it supersedes the student's older one of the assignment still
         queued; it is refused when it is past `attempts` submissions before the due date (None:
-        no limit; a submission after the due date is never refused). Times are naive UTC."""
+        no limit; a submission after the due date is never refused), or with the reason `refused`
+        (an entry that is no submission of the student's: coursehub.inbound). Times are naive UTC."""
 
         def work(db):
             attempt = 1 + db.execute("SELECT COUNT(*) FROM submissions WHERE student=? AND assignment=?",
@@ -131,7 +132,9 @@ class SubmitQueue:
                                  "AND state != 'refused' AND (? IS NULL OR submitted <= ?)",
                                  (student, assignment, _iso(duedate), _iso(duedate))).fetchone()[0]
             state, message = "queued", ""
-            if attempts is not None and before_due and counted >= attempts:
+            if refused:
+                state, message = "refused", refused
+            elif attempts is not None and before_due and counted >= attempts:
                 state = "refused"
                 due = f"the due date ({duedate:%Y-%m-%d %H:%M} UTC)" if duedate else "the due date"
                 message = (f"{assignment} allows {attempts} graded submission"
@@ -176,9 +179,19 @@ class SubmitQueue:
             "gradings=gradings+1, changed=? WHERE id=? AND state='grading'",
             (content, score, max_score, message, reused_from, _now(), row_id)))
 
-    def failed(self, row_id: int, message: str) -> None:
+    def failed(self, row_id: int, message: str, content: str | None = None, score: float | None = None,
+               max_score: float | None = None) -> None:
+        """A row that ends without feedback to release; with `content`, its (failed) result was recorded."""
+        recorded = 1 if content is not None else 0
         self._transaction(lambda db: db.execute(
-            "UPDATE submissions SET state='failed', message=?, changed=? WHERE id=?", (message, _now(), row_id)))
+            "UPDATE submissions SET state='failed', message=?, content=COALESCE(?, content), score=COALESCE(?, score), "
+            "max_score=COALESCE(?, max_score), gradings=gradings+?, changed=? WHERE id=?",
+            (message, content, score, max_score, recorded, _now(), row_id)))
+
+    def refuse(self, row_id: int, message: str) -> None:
+        """A row whose files were not taken (autograder.untrusted): not graded, for the reason `message`."""
+        self._transaction(lambda db: db.execute(
+            "UPDATE submissions SET state='refused', message=?, changed=? WHERE id=?", (message, _now(), row_id)))
 
     def released(self, row_ids: list[int]) -> None:
         """The feedback of these rows is in the exchange."""

@@ -98,8 +98,37 @@ def chown_tree(path, user: str) -> None:
     and SQLite's journal beside it comes and goes."""
     entry = pwd.getpwnam(user)
     for directory, dirs, files in os.walk(path):
-        with contextlib.suppress(FileNotFoundError):
-            os.chown(directory, entry.pw_uid, entry.pw_gid)
+        with contextlib.suppress(FileNotFoundError):  # a folder swapped for a link meanwhile: the link's
+            os.chown(directory, entry.pw_uid, entry.pw_gid, follow_symlinks=False)
         for name in files + dirs:
             with contextlib.suppress(FileNotFoundError):
                 os.chown(os.path.join(directory, name), entry.pw_uid, entry.pw_gid, follow_symlinks=False)
+
+
+def as_user(user: str, work) -> None:
+    """Call `work()` in a child process that runs as `user` (their uid and group, no other groups):
+    root writing into a folder the user controls, such as their home, would follow their links.
+
+    Raises:
+        RuntimeError: `work` raised in the child (its traceback was printed there).
+    """
+    entry = pwd.getpwnam(user)
+    pid = os.fork()
+    if pid == 0:  # the child: never returns
+        code = 1
+        try:
+            os.setgroups([])
+            os.setgid(entry.pw_gid)
+            os.setuid(entry.pw_uid)
+            os.environ["HOME"] = entry.pw_dir
+            work()
+            code = 0
+        except BaseException:  # noqa: BLE001 - reported through the exit code
+            import traceback
+
+            traceback.print_exc()
+        finally:
+            os._exit(code)
+    code = os.waitstatus_to_exitcode(os.waitpid(pid, 0)[1])
+    if code != 0:
+        raise RuntimeError(f"writing in {user}'s home as {user} failed (exit status {code})")

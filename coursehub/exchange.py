@@ -12,7 +12,7 @@ import json
 import os
 from pathlib import Path
 
-from coursehub.accounts import chown_tree
+from coursehub.accounts import as_user
 
 
 def create_exchange(root: Path) -> None:
@@ -36,6 +36,8 @@ def write_settings(course) -> Path:
         f"c.Exchange.root = {str(course.exchange)!r}\n"
         "# Submit refused past the attempts the hub's grading service grades (coursehub.limited_submit).\n"
         "c.ExchangeFactory.submit = 'coursehub.limited_submit.LimitedSubmit'\n"
+        "# Collect takes a submission only from its owner, and follows no link (coursehub.checked_collect).\n"
+        "c.ExchangeFactory.collect = 'coursehub.checked_collect.CheckedCollect'\n"
         f"c.LimitedSubmit.rules_file = {str(course.submit_rules)!r}\n"
         "apply_student(c)\n")
     os.chmod(path, 0o644)
@@ -45,10 +47,13 @@ def write_settings(course) -> Path:
 def write_student_settings(home: Path, user: str) -> None:
     """A student's ~/.jupyter: no prompt about Jupyter's news (the server's namespace has no network
     to fetch them). The instructor's nbgrader extensions are off through course_lib/notebook/student_lab on
-    the student's JUPYTER_CONFIG_PATH (coursehub.sandbox.user_environment), as in `make lab`."""
-    jupyter = home / ".jupyter"
-    notification = jupyter / "lab" / "user-settings" / "@jupyterlab" / "apputils-extension"
-    notification.mkdir(parents=True, exist_ok=True)
-    (notification / "notification.jupyterlab-settings").write_text(
-        json.dumps({"fetchNews": "false", "checkForUpdates": False}, indent=2))
-    chown_tree(jupyter, user)
+    the student's JUPYTER_CONFIG_PATH (coursehub.sandbox.user_environment), as in `make lab`.
+    Written as the student (coursehub.accounts.as_user): the home is theirs, links and all."""
+
+    def write() -> None:
+        notification = home / ".jupyter" / "lab" / "user-settings" / "@jupyterlab" / "apputils-extension"
+        notification.mkdir(parents=True, exist_ok=True)
+        (notification / "notification.jupyterlab-settings").write_text(
+            json.dumps({"fetchNews": "false", "checkForUpdates": False}, indent=2))
+
+    as_user(user, write)

@@ -22,20 +22,31 @@ import shutil
 from datetime import datetime, timezone
 from pathlib import Path
 
-from autograder import config, export, report, store
+from autograder import config, export, report, store, untrusted
 from autograder.submissions import PER_SUBMISSION_FILES, Submission, submission_digest
 from autograder.submit_queue import Row, SubmitQueue
 from coursehub import inbound
 from coursehub.accounts import chown_tree
 
 
-def grade(course, queue: SubmitQueue, row: Row, one_at_a_time=None) -> None:
-    """Collect, grade (or reuse a grading of the same content) and record one claimed row.
+def grade(course, queue: SubmitQueue, row: Row, uid: int | None, one_at_a_time=None) -> None:
+    """Collect, grade (or reuse a grading of the same content) and record one claimed row of the
+    student whose uid is `uid` (None: no longer on the roster); a submission that is not taken
+    (autograder.untrusted) is refused with its reason.
     `one_at_a_time(content)`: a lock held from looking for a grading of the same content to
     recording this one (workers given the same files grade them once); None: no other worker."""
     course_dir = course.course_dir
-    entry = inbound.parse(inbound.inbound(course.exchange, course.course_id) / row.entry)
-    sub = Submission(row.student, row.assignment, inbound.collect(entry, course_dir))
+    folder = inbound.inbound(course.exchange, course.course_id) / row.entry
+    try:
+        if uid is None:
+            raise untrusted.Refused(f"{row.student} is no longer a student of this course, so the submission was not "
+                                    "graded.")
+        collected = inbound.collect(folder, row.student, row.assignment, uid, course_dir)
+    except untrusted.Refused as refusal:
+        queue.refuse(row.id, str(refusal))
+        inbound.set_aside(folder, row.id, course_dir)
+        return
+    sub = Submission(row.student, row.assignment, collected)
     content = submission_digest(sub, course_dir, content_only=True)
     with one_at_a_time(content) if one_at_a_time else contextlib.nullcontext():
         _grade_collected(course, queue, row, sub, content)
@@ -57,8 +68,11 @@ def _grade_collected(course, queue: SubmitQueue, row: Row, sub: Submission, cont
                 result = grade_submission(sub, course_dir, reservation.domain_id)
         store.save_result(course_dir, result, course_config)
     chown_tree(course_dir, course.instructor)  # the instructor's formgrader and commands write here too
-    message = result.reason.strip().splitlines()[0] if result.status == "failed" and result.reason.strip() else ""
-    queue.graded(row.id, content, result.score, result.max_score, message, reused_from)
+    if result.status == "failed":  # no graded notebook, so no feedback page: its reason is on the student's page
+        queue.failed(row.id, result.reason.strip() or "it could not be graded; your instructor will grade it.",
+                     content=content, score=result.score, max_score=result.max_score)
+        return
+    queue.graded(row.id, content, result.score, result.max_score, "", reused_from)
 
 
 def _same_content(course_dir: Path, queue: SubmitQueue, sub: Submission, content: str):
@@ -95,18 +109,37 @@ def scores_only(rules: config.SubmitRules, duedate: datetime | None) -> bool:
     return not rules.reasons_before_due and (duedate is None or now <= duedate)
 
 
-def release(course, assignment: str, rows: list[Row], hide_reasons: bool) -> None:
-    """Write the feedback of these graded rows of one assignment and release it to their students."""
+def release(course, assignment: str, rows: list[Row], hide_reasons: bool) -> dict[int, str]:
+    """Write the feedback of these graded rows of one assignment and release it to their students;
+    return the rows whose feedback could not be written or released, with the error (the others
+    are released: one row's failure holds up no other)."""
+    import traceback
+
     from autograder import feedback
 
     course_dir = course.course_dir
+    failures = {}  # student -> error
     students = sorted({row.student for row in rows})
-    feedback.write_in_process(course_dir, assignment, students, scores_only=hide_reasons)
-    for student in students:
-        _release_one(course, assignment, student)
+    try:
+        feedback.write_in_process(course_dir, assignment, students, scores_only=hide_reasons)
+        written = students
+    except Exception:  # noqa: BLE001 - one page broke the batch: each student's alone, to find whose
+        written = []
+        for student in students:
+            try:
+                feedback.write_in_process(course_dir, assignment, [student], scores_only=hide_reasons)
+                written.append(student)
+            except Exception:  # noqa: BLE001 - that student's failure, reported to the service
+                failures[student] = traceback.format_exc()
+    for student in written:
+        try:
+            _release_one(course, assignment, student)
+        except Exception:  # noqa: BLE001 - that student's failure, reported to the service
+            failures[student] = traceback.format_exc()
     report.write_report(course_dir)  # the instructor's files, once for the batch
     export.export(course_dir)
     chown_tree(course_dir, course.instructor)
+    return {row.id: failures[row.student] for row in rows if row.student in failures}
 
 
 def _release_one(course, assignment: str, student: str) -> None:

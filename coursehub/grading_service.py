@@ -37,8 +37,10 @@ from autograder.submit_queue import SubmitQueue
 from coursehub import course as course_settings
 from coursehub import grading_job, inbound, limited_submit
 
-#: Seconds before the feedback that could not be released is tried again.
+#: Seconds before the feedback that could not be released is tried again, and how many tries a
+#: submission's feedback gets before its row fails.
 RETRY_SECONDS = 30.0
+RELEASE_TRIES = 3
 #: Seconds the feedback of a grading waits for the next one while the workers are busy.
 BATCH_SECONDS = 2.0
 #: Seconds between two publications of the rules for the students' servers (the due dates change
@@ -64,6 +66,7 @@ class Service:
         self.graded = threading.Event()
         self._rules, self._rules_read, self._rules_lock = {}, None, threading.Lock()
         self._contents, self._contents_lock = {}, threading.Lock()
+        self._retry: dict[int, tuple[float, int]] = {}  # row id -> (when to release again, tries so far)
 
     def start(self) -> None:
         from autograder import work_folders
@@ -108,18 +111,29 @@ class Service:
                 name: {"attempts": rule.attempts, "duedate": f"{due[name]} UTC" if due[name] else None}
                 for name, rule in self._rules.items()})
 
+    def students(self) -> dict[str, int]:
+        """The roster's accounts and their uids: a submission counts for the student who owns it."""
+        import pwd
+
+        roster = set(self.course.students)
+        return {entry.pw_name: entry.pw_uid for entry in pwd.getpwall() if entry.pw_name in roster}
+
     def look_once(self) -> int:
-        """Queue the new complete submissions of assignments graded on submission; return how many."""
+        """Queue the new complete submissions of assignments graded on submission, and refuse the
+        entries of inbound/ that are no submission of their owner's (coursehub.inbound.look), each
+        with its reason for the student who made it; return how many were looked at."""
         rules = self.rules()
         folder = inbound.inbound(self.course.exchange, self.course.course_id)
-        entries = [e for e in inbound.new_entries(folder, self.queue.known()) if e.assignment in rules]
+        entries = [e for e in inbound.new_entries(folder, self.queue.known(), self.students())
+                   if e.refused or e.assignment in rules]
         for entry in entries:
-            row = self.queue.add(entry.name, entry.student, entry.assignment, entry.submitted,
-                                 rules[entry.assignment].attempts,
-                                 grading_job.duedate(self.course.course_dir, entry.assignment))
+            rule = rules.get(entry.assignment, config.SubmitRules())
+            row = self.queue.add(entry.name, entry.student, entry.assignment, entry.submitted, rule.attempts,
+                                 grading_job.duedate(self.course.course_dir, entry.assignment) if not entry.refused
+                                 else None, refused=entry.refused)
             if row.state == "refused":
-                inbound.set_aside(entry, self.course.course_dir)
-                _log(f"refused {entry.name}: {row.message}")
+                inbound.set_aside(entry.path, row.id, self.course.course_dir)
+                _log(f"refused {entry.name!r} (owner {entry.student}): {row.message}")
             else:
                 self.queued.release()
         return len(entries)
@@ -150,15 +164,15 @@ class Service:
             if row is None:  # superseded meanwhile
                 continue
             try:
-                grading_job.grade(self.course, self.queue, row, self.one_at_a_time)
+                grading_job.grade(self.course, self.queue, row, self.students().get(row.student), self.one_at_a_time)
             except Exception:  # noqa: BLE001 - not the student's fault: the instructor's grade run takes it
-                _log(f"could not grade {row.entry}:\n{traceback.format_exc()}")
-                self.queue.failed(row.id, "the grading service ran into an error.")
+                _log(f"could not grade {row.entry!r}:\n{traceback.format_exc()}")
+                self.queue.failed(row.id, "the grading service ran into an error; your instructor will grade it.")
             self.graded.set()
 
     def _release(self) -> None:
         while not self.stopping.is_set():
-            if not self.graded.wait(self.poll_seconds):
+            if not self.graded.wait(self.poll_seconds) and not self._retries_due():
                 continue
             self.graded.clear()
             # Quick gradings in a row (the same content handed in by many) make one batch: a batch
@@ -166,20 +180,43 @@ class Service:
             deadline = time.monotonic() + BATCH_SECONDS
             while self.queue.busy() and time.monotonic() < deadline and not self.stopping.is_set():
                 self.stopping.wait(0.2)
-            rows = self.queue.waiting_for_feedback()
-            for assignment, group in itertools.groupby(sorted(rows, key=lambda r: r.assignment),
-                                                       key=lambda r: r.assignment):
-                group = list(group)
-                try:
-                    rules = self.rules().get(assignment, config.SubmitRules())
-                    due = grading_job.duedate(self.course.course_dir, assignment)
-                    grading_job.release(self.course, assignment, group, grading_job.scores_only(rules, due))
-                    self.queue.released([r.id for r in group])
-                except Exception:  # noqa: BLE001 - logged; the scores are recorded, the next round tries again
-                    _log(f"could not release the feedback of {assignment} (trying again in "
-                         f"{RETRY_SECONDS:g} s):\n{traceback.format_exc()}")
-                    self.stopping.wait(RETRY_SECONDS)
-                    self.graded.set()
+            self.release_once()
+
+    def _retries_due(self) -> bool:
+        now = time.monotonic()
+        return any(when <= now for when, _tries in self._retry.values())
+
+    def release_once(self) -> None:
+        """Release the feedback of the graded rows, one assignment at a time. A row whose feedback
+        cannot be written or released fails alone: it is tried again RETRY_SECONDS later, and after
+        RELEASE_TRIES tries it is 'failed' with its reason on its student's page; the others go on."""
+        now = time.monotonic()
+        rows = [r for r in self.queue.waiting_for_feedback() if self._retry.get(r.id, (0.0, 0))[0] <= now]
+        for assignment, group in itertools.groupby(sorted(rows, key=lambda r: r.assignment),
+                                                   key=lambda r: r.assignment):
+            group = list(group)
+            try:
+                rules = self.rules().get(assignment, config.SubmitRules())
+                due = grading_job.duedate(self.course.course_dir, assignment)
+                failures = grading_job.release(self.course, assignment, group, grading_job.scores_only(rules, due))
+            except Exception:  # noqa: BLE001 - the whole assignment's: each of its rows is tried again
+                failures = {row.id: traceback.format_exc() for row in group}
+            self.queue.released([r.id for r in group if r.id not in failures])
+            for row in group:
+                if row.id in failures:
+                    self._release_failed(row, failures[row.id])
+                else:
+                    self._retry.pop(row.id, None)
+
+    def _release_failed(self, row, error: str) -> None:
+        tries = self._retry.get(row.id, (0.0, 0))[1] + 1
+        _log(f"could not release the feedback of {row.entry!r} (try {tries} of {RELEASE_TRIES}):\n{error}")
+        if tries < RELEASE_TRIES:
+            self._retry[row.id] = (time.monotonic() + RETRY_SECONDS, tries)
+            return
+        self._retry.pop(row.id, None)
+        self.queue.failed(row.id, "it was graded, but its feedback page could not be written; your instructor has the "
+                                  "details.")
 
 
 def main(argv=None) -> int:

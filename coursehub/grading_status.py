@@ -32,7 +32,8 @@ def describe(queue: SubmitQueue, row: Row) -> str:
         return (f"{score}{reason}; press Fetch Feedback in the Assignments panel (Nbgrader > Assignment List) to "
                 "read why")
     if row.state == "failed":
-        return f"could not be graded: {row.message} Your instructor will grade it."
+        score = f" ({points_text(row.score)} / {points_text(row.max_score)})" if row.max_score else ""
+        return f"failed{score}: {row.message}"
     return f"{row.state} (not graded): {row.message}"
 
 

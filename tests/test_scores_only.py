@@ -4,14 +4,12 @@ seen on the page the grading service releases into the exchange, which the stude
 
 from __future__ import annotations
 
-import dataclasses
 import html
-import os
 from datetime import datetime, timedelta, timezone
-from pathlib import Path
 
 import nbformat
 import pytest
+from feedback_support import VERDICT, graded_course
 from import_support import module_fixture
 
 from autograder.config import SubmitRules
@@ -44,53 +42,7 @@ def test_reasons_are_left_out_only_before_the_due_date_and_when_the_rules_say_so
     assert not scores_only(SubmitRules(), now + timedelta(days=1))
 
 
-VERDICT = "✘ returned 255, expected 127\n"
 DAY = timedelta(days=1)
-
-
-@dataclasses.dataclass
-class HubCourse:
-    """What coursehub.grading_job.release reads of the hub's course (coursehub.course.Course)."""
-    course_dir: Path
-    exchange: Path
-    course_id: str
-    instructor: str
-
-
-def _graded_course(root, duedate):
-    """A course whose assignment hw (notebook hw: check 4 points, due at `duedate` or never) has
-    alice's submission graded 3 of 4, as a grading leaves it: the gradebook, the grader's record
-    and the autograded notebook, whose check printed VERDICT."""
-    import pwd
-
-    from autograder import config, gradebook, store
-    from autograder.result import GradeResult
-
-    course = root / "course"
-    course.mkdir()
-    config.write_config(course)
-    with gradebook.open_gradebook(course) as gb:
-        gb.update_or_create_assignment("hw", duedate=duedate and f"{duedate:%Y-%m-%d %H:%M:%S} UTC")
-        gb.add_notebook("hw", "hw")
-        gb.add_solution_cell("answer", "hw", "hw")
-        gb.add_grade_cell("check", "hw", "hw", max_score=4, cell_type="code")
-    (course / "submitted" / "alice" / "hw").mkdir(parents=True)
-    graded = course / "autograded" / "alice" / "hw"
-    graded.mkdir(parents=True)
-    (graded / "submission_secret.txt").write_text("secret")
-    nb = nbformat.v4.new_notebook()
-    answer = nbformat.v4.new_code_cell("print(7)", outputs=[nbformat.v4.new_output("stream", text="7\n")])
-    answer.metadata["nbgrader"] = {"solution": True, "grade": False, "locked": False, "grade_id": "answer",
-                                   "schema_version": 3}
-    check = nbformat.v4.new_code_cell("grade()", outputs=[nbformat.v4.new_output("stream", text=VERDICT)])
-    check.metadata["nbgrader"] = {"solution": False, "grade": True, "locked": True, "grade_id": "check",
-                                  "points": 4, "schema_version": 3}
-    nb.cells = [answer, check]
-    nbformat.write(nb, graded / "hw.ipynb")
-    store.save_result(course, GradeResult("alice", "hw", "digest", score=3, max_score=4, cells=[
-        {"notebook": "hw", "cell": "check", "auto_score": 3.0, "max_score": 4}]), config.load(course))
-    (root / "exchange" / "c101").mkdir(parents=True)  # the hub made it when it released hw
-    return HubCourse(course, root / "exchange", "c101", pwd.getpwuid(os.getuid()).pw_name)
 
 
 def _released_page(grading_job, course) -> str:
@@ -109,7 +61,7 @@ def test_feedback_released_before_the_due_date_shows_the_score_and_the_note_not_
         grading_job, scores_only_module, tmp_path, due):
     note = scores_only_module.NOTE
     now = datetime.now(timezone.utc).replace(tzinfo=None)
-    page = _released_page(grading_job, _graded_course(tmp_path, due and now + due))
+    page = _released_page(grading_job, graded_course(tmp_path, due and now + due))
     assert "Score: 3.0 / 4.0" in page
     assert note.strip() in page and VERDICT.strip() not in page
     assert ">7\n" in page  # the student's own output stays
@@ -118,6 +70,6 @@ def test_feedback_released_before_the_due_date_shows_the_score_and_the_note_not_
 def test_feedback_released_after_the_due_date_shows_the_verdict(grading_job, scores_only_module, tmp_path):
     note = scores_only_module.NOTE
     now = datetime.now(timezone.utc).replace(tzinfo=None)
-    page = _released_page(grading_job, _graded_course(tmp_path, now - DAY))
+    page = _released_page(grading_job, graded_course(tmp_path, now - DAY))
     assert "Score: 3.0 / 4.0" in page
     assert VERDICT.strip() in page and note.strip() not in page
