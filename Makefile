@@ -38,7 +38,20 @@ HUB_DIR ?= /srv/ros2cv-hub
 
 .PHONY: setup lab test check browser-deps hub-deps hub clean
 
-setup: $(VENV)/.setup-done
+RVIZ_JS := course_lib/notebook/rviz/js
+RVIZ_BUNDLE := course_lib/notebook/rviz/static/rviz.js
+setup: $(VENV)/.setup-done $(RVIZ_BUNDLE)
+
+# The notebook's RViz (course_lib/notebook/rviz): its module and three.js, installed from npm into the
+# venv and bundled into one file that the widget sends to the browser over the kernel's comm (no CDN:
+# the hub's machines are offline). Without npm the view says how to get it.
+$(RVIZ_BUNDLE): $(RVIZ_JS)/rviz.js $(RVIZ_JS)/package.json
+	@if command -v npm >/dev/null 2>&1; then \
+	  mkdir -p $(VENV)/rviz-js && cp $(RVIZ_JS)/package.json $(VENV)/rviz-js/ && \
+	  npm install --silent --no-audit --no-fund --prefix $(VENV)/rviz-js && \
+	  NODE_PATH=$(VENV)/rviz-js/node_modules $(VENV)/rviz-js/node_modules/.bin/esbuild $(RVIZ_JS)/rviz.js \
+	    --bundle --format=esm --minify --log-level=warning --outfile=$@; \
+	else echo "npm is not installed: the notebook's RViz needs Node.js and npm to bundle three.js (apt-get install nodejs npm)"; fi
 
 # jsonschema's optional format checkers (pulled in by jupyter-events' jsonschema[format-nongpl]) are
 # imported with jsonschema, so in every process that imports nbformat (nbgrader, nbclient, Jupyter,
@@ -48,7 +61,8 @@ setup: $(VENV)/.setup-done
 OPTIONAL_FORMAT_CHECKERS := rfc3987-syntax isoduration arrow fqdn uri-template webcolors jsonpointer \
                             rfc3986-validator rfc3339-validator
 $(VENV)/.setup-done: Makefile environment.txt pyproject.toml course_lib/ros/wheelfix.py course_lib/ros2cli/install.py \
-                     course_lib/ros/underlay.py
+                     course_lib/ros/underlay.py course_lib/robot/install.py course_lib/robot/interface_install.py \
+                     $(wildcard course_lib/robot/interfaces/*/* course_lib/robot/interfaces/*/*/* course_lib/robot/robot_sim/* course_lib/robot/robot_sim/*/*)
 	@$(PYTHON) -c 'import sys; v = sys.version_info[:2]; ok = (3, 10) <= v <= (3, 13); \
 	print("Using Python %d.%d from %s" % (v + (sys.executable,))) if ok else \
 	sys.exit("Python %d.%d found, but the ROS 2 Jazzy wheels exist for CPython 3.10-3.13 only. " \
@@ -64,6 +78,7 @@ $(VENV)/.setup-done: Makefile environment.txt pyproject.toml course_lib/ros/whee
 	$(PY) -m course_lib repair-wheels
 	$(PY) -m course_lib install-ros2
 	$(PY) -m course_lib underlay
+	$(PY) -m course_lib install-robot
 	@touch $@
 
 # JupyterLab refuses to run as root unless told; containers and CI often are root.
@@ -79,9 +94,12 @@ ALLOW_ROOT := $(if $(filter 0,$(shell id -u)),--allow-root)
 # JUPYTER_CONFIG_PATH: a student's lab shows nbgrader's student side only (course_lib/notebook/student_lab).
 # A student alone fetches the assignments in Nbgrader > Assignment List from the lab's own exchange
 # (.lab/, git-ignored), where the course's grader releases them, again when their source changed
-# (course_lib/notebook/student_lab/exchange.py).
+# (course_lib/notebook/student_lab/exchange.py); `python -m autograder grade-lab` grades what they
+# submitted there and releases its feedback for Fetch Feedback (autograder/lab_grading.py).
 lab: setup
 	$(PY) -m autograder release-lab
+	@echo "Graded feedback on an assignment: Submit it in Nbgrader > Assignment List, run" \
+	  "'python -m autograder grade-lab' in a terminal, then press Fetch Feedback."
 	eval "$$($(PY) -m course_lib env)" && . "$(CURDIR)/$(VENV)/local_setup.sh" && \
 	JUPYTER_CONFIG_PATH="$(CURDIR)/course_lib/notebook/student_lab$${JUPYTER_CONFIG_PATH:+:$$JUPYTER_CONFIG_PATH}" \
 	exec $(VENV)/bin/jupyter lab --no-browser --ip=127.0.0.1 --port=$(LAB_PORT) $(ALLOW_ROOT) \

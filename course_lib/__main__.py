@@ -6,6 +6,8 @@ Commands:
     repair-wheels     make the pip-installed ROS 2 CMake files usable in this environment
     install-ros2      put the course's `ros2` command into this environment (pip install only)
     underlay          write local_setup.{sh,bash,zsh} into this environment (a ROS underlay)
+    install-robot     build tf2_msgs (not on PyPI) and install the simulated robot's ROS package
+                      robot_sim into this environment (pip install only)
     env               print the notebook session's ROS variables as shell exports
                       (eval "$(python -m course_lib env)"; make lab does it for JupyterLab)
 """
@@ -38,6 +40,9 @@ def main(argv: list[str] | None = None) -> int:
     if command == "underlay":
         from course_lib.ros import underlay
         return underlay.main(rest)
+    if command == "install-robot":
+        from course_lib.robot import install
+        return install.main(rest)
     if command == "install-ros2":
         from course_lib.ros2cli import install
         return install.main(rest)

@@ -99,13 +99,7 @@ class _View:
                 return
             self.stopped = True
             self.stop_reason = reason
-        with _views_lock:
-            if _views.get(self.node_name) is self:
-                del _views[self.node_name]
-        try:
-            session.remove_node(self.node)
-        except ValueError:  # the session stopped (or replaced the node) already
-            pass
+        forget_view(self, _views, _views_lock)
         self._show_status()
 
     def _show_status(self) -> None:
@@ -113,6 +107,18 @@ class _View:
 
     def _repr_mimebundle_(self, **kwargs):
         return self.widget._repr_mimebundle_(**kwargs)
+
+
+def forget_view(view, views: dict, lock: threading.Lock) -> None:
+    """A stopped view out of its registry `views` (name of its hidden node -> view; unless a view
+    made since holds that name) and its node out of the session."""
+    with lock:
+        if views.get(view.node_name) is view:
+            del views[view.node_name]
+    try:
+        session.remove_node(view.node)
+    except ValueError:  # the session stopped (or replaced the node) already
+        pass
 
 
 def _hidden_name(kind: str, topics) -> str:

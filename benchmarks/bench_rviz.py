@@ -1,0 +1,237 @@
+"""The notebook's RViz with a 720-beam scan at 20 Hz: the kernel's processor time per scan and the
+frames the browser draws per second, beside the raw message rate.
+
+(a) In this process, no browser: the processor time of one scan update, from the message to the
+bytes for the comm, for this view (course_lib.notebook.rviz: receive, draw in the fixed frame,
+encode) and, when importable (``--with DIR``: a folder they were installed into with
+``uv pip install --target DIR pythreejs k3d``), for pythreejs (a Points geometry's position and
+colour attributes set) and k3d (a points object's positions and colours set). Widgets made outside
+a kernel serialise their state as in one, and hand it to a comm that sends nothing.
+
+(b) In JupyterLab in headless Chromium (the browser tests' set-up): a publisher process sends the
+scans at 20 Hz; the notebook's kernel shows them in RViz (Grid, TF, LaserScan). Over a window: the
+scans a plain subscriber in this process got (the raw rate), the drawings the browser has shown, the
+frames it drew, the kernel's processor time per second and per scan, and the browser's time to
+render one frame.
+
+    .venv/bin/python benchmarks/bench_rviz.py [--seconds 10] [--updates 500] [--with /tmp/eval/k3d]
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import signal
+import subprocess
+import sys
+import tempfile
+import textwrap
+import time
+from importlib import metadata
+from pathlib import Path
+from types import SimpleNamespace
+
+import numpy as np
+
+REPO = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(REPO))
+sys.path.insert(0, str(REPO / "tests"))
+
+BEAMS, RATE = 720, 20.0
+
+PUBLISHER = textwrap.dedent(f"""
+    import math, sys
+    import numpy as np
+    import rclpy
+    import rclpy.executors
+    from geometry_msgs.msg import TransformStamped
+    from rclpy.qos import qos_profile_sensor_data
+    from sensor_msgs.msg import LaserScan
+    rclpy.init()
+    node = rclpy.create_node("bench_scanner")
+    scans = node.create_publisher(LaserScan, "scan", qos_profile_sensor_data)
+    tf = node.create_publisher(TransformStamped, "bench_tf", 10)
+    count = [0]
+    def tick():
+        count[0] += 1
+        t = TransformStamped(child_frame_id="laser")
+        t.header.frame_id = "odom"
+        t.transform.translation.x, t.transform.rotation.w = 0.1 * math.sin(count[0] / 20), 1.0
+        tf.publish(t)
+        msg = LaserScan(angle_min=-math.pi, angle_increment=2 * math.pi / {BEAMS}, range_min=0.1, range_max=10.0)
+        msg.header.frame_id = "laser"
+        msg.ranges = (3.0 + np.sin(np.arange({BEAMS}) / 30 + count[0] / 10)).tolist()
+        scans.publish(msg)
+    node.create_timer({1 / RATE}, tick)
+    try:
+        rclpy.spin(node)
+    except (KeyboardInterrupt, rclpy.executors.ExternalShutdownException):
+        pass
+""")
+
+
+def scan_message(seed: int) -> SimpleNamespace:
+    ranges = 3.0 + np.sin(np.arange(BEAMS) / 30 + seed / 10)
+    header = SimpleNamespace(frame_id="laser")
+    return SimpleNamespace(header=header, ranges=ranges.tolist(), angle_min=-math.pi,
+                           angle_increment=2 * math.pi / BEAMS, range_min=0.1, range_max=10.0)
+
+
+def per_update(update, count: int) -> float:
+    update(0)  # first use: imports and caches
+    started = time.process_time()
+    for i in range(1, count + 1):
+        update(i)
+    return (time.process_time() - started) / count
+
+
+def in_process(count: int) -> list[tuple[str, float]]:
+    from course_lib.notebook.rviz import displays, view
+    from course_lib.notebook.rviz.transforms import TransformTree, matrix
+
+    tree = TransformTree()
+    tree.set("odom", "laser", matrix((0.1, 0, 0)))
+    scan = displays.LaserScan("LaserScan")
+
+    def course(i):
+        scan.receive(scan_message(i), 0.0)
+        view.encode({"LaserScan": scan.draw(tree, "odom", 0.0)}, i)
+
+    rows = [("course_lib.notebook.rviz (anywidget + three.js)", per_update(course, count))]
+    try:
+        import pythreejs
+
+        geometry = pythreejs.BufferGeometry(attributes={
+            "position": pythreejs.BufferAttribute(np.zeros((BEAMS, 3), np.float32)),
+            "color": pythreejs.BufferAttribute(np.zeros((BEAMS, 3), np.float32))})
+        pythreejs.Points(geometry, pythreejs.PointsMaterial(vertexColors="VertexColors"))
+
+        def three(i):
+            points, ranges = _scan_in_odom(i)
+            geometry.attributes["position"].array = points
+            geometry.attributes["color"].array = (displays.geometry.rainbow(ranges)[:, :3] / 255).astype(np.float32)
+
+        rows.append((f"pythreejs {metadata.version('pythreejs')}", per_update(three, count)))
+    except ImportError:
+        rows.append(("pythreejs (not importable: --with DIR)", float("nan")))
+    try:
+        import k3d
+
+        cloud = k3d.points(np.zeros((BEAMS, 3), np.float32), point_size=0.05)
+        plot = k3d.plot()
+        plot += cloud
+
+        def k3d_update(i):
+            points, ranges = _scan_in_odom(i)
+            rgb = displays.geometry.rainbow(ranges)[:, :3].astype(np.uint32)
+            cloud.positions = points
+            cloud.colors = (rgb[:, 0] << 16) | (rgb[:, 1] << 8) | rgb[:, 2]
+
+        rows.append((f"k3d {metadata.version('k3d')}", per_update(k3d_update, count)))
+    except ImportError:
+        rows.append(("k3d (not importable: --with DIR)", float("nan")))
+    return rows
+
+
+def _scan_in_odom(i):
+    from course_lib.notebook.rviz import geometry
+    from course_lib.notebook.rviz.transforms import matrix, transform_points
+
+    msg = scan_message(i)
+    points, ranges = geometry.scan_points(msg.ranges, msg.angle_min, msg.angle_increment, msg.range_min, msg.range_max)
+    return transform_points(matrix((0.1, 0, 0)), points), ranges
+
+
+NOTEBOOK = ["""from course_lib.notebook.rviz import RViz
+view = RViz("odom", transform_topics=["/bench_tf"], seconds=3600, size=[800, 480])
+view.add("Grid")
+view.add("TF")
+view.add("LaserScan", topic="/scan")
+view"""]
+
+STATE_JS = """() => { const el = document.querySelector('.rviz-canvas').parentElement;
+  return {seq: Number(el.dataset.seq || 0), frames: Number(el.dataset.frames || 0),
+          renderMs: Number(el.dataset.renderMs || 0)}; }"""
+
+
+def in_browser(seconds: float) -> dict:
+    from browser_notebook import close_notebook, open_notebook, run_notebook, write_notebook
+    from browser_support import launched_chromium, running_jupyterlab
+    from sensor_msgs.msg import LaserScan
+
+    from course_lib.ros import rosenv, session
+
+    with tempfile.TemporaryDirectory() as scratch, rosenv.reserve_domain_id() as reservation:
+        root, state = Path(scratch, "root"), Path(scratch, "state")
+        root.mkdir()
+        write_notebook(root / "rviz.ipynb", NOTEBOOK)
+        env = dict(rosenv.ros_environment(), ROS_DOMAIN_ID=str(reservation.domain_id))
+        publisher = subprocess.Popen([sys.executable, "-c", PUBLISHER], env=env)
+        session.start(domain_id=reservation.domain_id)
+        arrivals = []
+        from rclpy.qos import qos_profile_sensor_data
+
+        counter = session.tool_node().create_subscription(
+            LaserScan, "/scan", lambda msg: arrivals.append(time.monotonic()), qos_profile_sensor_data)
+        try:
+            import os
+
+            saved = os.environ.get("ROS_DOMAIN_ID")
+            os.environ["ROS_DOMAIN_ID"] = str(reservation.domain_id)
+            with running_jupyterlab(root, state) as lab, launched_chromium(Path(scratch, "chromium")) as browser:
+                page = open_notebook(browser, lab, "rviz.ipynb")
+                run_notebook(page, "rviz.ipynb", 1, 240)
+                page.wait_for_function("() => { const c = document.querySelector('.rviz-canvas');"
+                                       " return c && Number(c.parentElement.dataset.seq || 0) > 20; }", timeout=120_000)
+                kernel = next(p for p in lab.descendants() if "ipykernel_launcher" in " ".join(p.cmdline()))
+                before, cpu0, t0, n0 = page.evaluate(STATE_JS), _cpu(kernel), time.monotonic(), len(arrivals)
+                page.wait_for_timeout(seconds * 1000)
+                after, cpu1, t1, n1 = page.evaluate(STATE_JS), _cpu(kernel), time.monotonic(), len(arrivals)
+                close_notebook(page, lab, "rviz.ipynb")
+            if saved is None:
+                os.environ.pop("ROS_DOMAIN_ID", None)
+            else:
+                os.environ["ROS_DOMAIN_ID"] = saved
+        finally:
+            session.tool_node().destroy_subscription(counter)
+            publisher.send_signal(signal.SIGINT)
+            publisher.wait(timeout=60)
+            session.stop()
+    window = t1 - t0
+    return {"window": window, "raw": (n1 - n0) / window, "shown": (after["seq"] - before["seq"]) / window,
+            "frames": (after["frames"] - before["frames"]) / window, "kernel_cpu": (cpu1 - cpu0) / window,
+            "per_scan": (cpu1 - cpu0) / max(1, after["seq"] - before["seq"]), "render_ms": after["renderMs"]}
+
+
+def _cpu(process) -> float:
+    times = process.cpu_times()
+    return times.user + times.system
+
+
+def main(argv=None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--seconds", type=float, default=10.0, help="the browser part's window")
+    parser.add_argument("--updates", type=int, default=500, help="scan updates per way in part (a)")
+    parser.add_argument("--with", dest="extra", action="append", default=[],
+                        help="a folder to import pythreejs or k3d from (uv pip install --target DIR ...)")
+    parser.add_argument("--parts", default="ab")
+    args = parser.parse_args(argv)
+    sys.path[2:2] = args.extra
+    if "a" in args.parts:
+        print(f"(a) kernel processor time per {BEAMS}-beam scan update, {args.updates} updates each\n")
+        print("| way | per scan | at 20 Hz, share of a core |\n|---|---:|---:|")
+        for way, seconds in in_process(args.updates):
+            print(f"| {way} | {seconds * 1e3:.2f} ms | {seconds * RATE:.1%} |")
+    if "b" in args.parts:
+        result = in_browser(args.seconds)
+        print(f"\n(b) JupyterLab in headless Chromium, {BEAMS}-beam scans at {RATE:g} Hz, "
+              f"window {result['window']:.1f} s\n")
+        print("| raw scans/s (a plain subscriber) | drawings sent/s | frames drawn/s | kernel CPU | "
+              "kernel CPU per scan sent | one frame's render |\n|---:|---:|---:|---:|---:|---:|")
+        print(f"| {result['raw']:.1f} | {result['shown']:.1f} | {result['frames']:.1f} | "
+              f"{result['kernel_cpu']:.1%} of a core | {result['per_scan'] * 1e3:.1f} ms | "
+              f"{result['render_ms']:.1f} ms |")
+
+
+if __name__ == "__main__":
+    main()

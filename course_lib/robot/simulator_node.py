@@ -1,0 +1,215 @@
+"""The robot simulator as a ROS 2 node: ``/cmd_vel`` in; ``/scan``, ``/odom``, ``/tf``,
+``/tf_static`` and ``/clock`` out; a ``~/reset`` service.
+
+    ros2 run robot_sim simulator --ros-args -p world:=pillar -p seed:=3
+    python -m course_lib.robot.simulator_node --ros-args -p lock_step:=true
+
+Each tick (``1/scan_rate`` simulated seconds) the node publishes the simulated time on /clock,
+odom -> base_link on /tf, the odometry on /odom and then the scan on /scan, all stamped with the
+simulated time (it never goes back: a reset restarts the robot, not the clock). A /cmd_vel holds
+until the next one: clamped to the robot's limits, or, when a value is NaN or infinite, refused
+with an error in the log and the robot stopped.
+
+Two ways to run (parameter ``lock_step``):
+
+- real time (default): a tick every ``1/scan_rate`` s of wall time, ``real_time_factor`` times
+  faster if it is not 1; how a robot behaves, and what a student watches.
+- lock-step: the simulation waits, after each scan, for the /cmd_vel that answers it, and then
+  advances one tick; it starts once /scan has a subscriber and /cmd_vel a publisher, and pauses
+  while either is missing. A controller that answers each scan with one /cmd_vel (and runs on
+  simulated time, ``use_sim_time``) then sees the same scans, and drives the same way, however
+  busy the machine: as fast as the slowest of the two keeps up. A scan nobody answers within
+  ``reply_timeout`` wall seconds is passed over with a warning (a backstop, not a pace).
+"""
+
+from __future__ import annotations
+
+import array
+import math
+import time
+
+import rclpy
+from builtin_interfaces.msg import Time
+from geometry_msgs.msg import TransformStamped, Twist
+from nav_msgs.msg import Odometry
+from rclpy.clock import Clock, ClockType
+from rclpy.executors import ExternalShutdownException
+from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, QoSProfile
+from rosgraph_msgs.msg import Clock as ClockMessage
+from sensor_msgs.msg import LaserScan
+from std_srvs.srv import Trigger
+from tf2_msgs.msg import TFMessage
+
+from course_lib.robot import husky
+from course_lib.robot.simulation import Laser, Simulation
+
+
+def stamp(seconds: float) -> Time:
+    nanoseconds = round(seconds * 1e9)
+    return Time(sec=nanoseconds // 10**9, nanosec=nanoseconds % 10**9)
+
+
+def yaw_quaternion(yaw: float) -> tuple[float, float, float, float]:
+    """(x, y, z, w) of a turn by `yaw` about z."""
+    return 0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2)
+
+
+class RobotSimulator(Node):
+    """The simulated robot's node (see the module's docstring)."""
+
+    def __init__(self, **node_options):
+        super().__init__("robot_simulator", **node_options)
+        world = self.declare_parameter("world", "pillar").value
+        seed = self.declare_parameter("seed", 0).value
+        self.scan_rate = self.declare_parameter("scan_rate", 20.0).value
+        self.lock_step = self.declare_parameter("lock_step", False).value
+        self.real_time_factor = self.declare_parameter("real_time_factor", 1.0).value
+        self.reply_timeout = self.declare_parameter("reply_timeout", 5.0).value
+        beams = self.declare_parameter("beams", Laser.beams).value
+        noise = self.declare_parameter("noise", Laser.noise).value
+        self.sim = Simulation(world, seed=seed, laser=Laser(beams=beams, noise=noise))
+        self.clock_offset = 0.0  # simulated seconds before the last reset
+
+        self.clock_pub = self.create_publisher(ClockMessage, "/clock", 10)
+        self.tf_pub = self.create_publisher(TFMessage, "/tf", 100)
+        latched = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL)
+        self.tf_static_pub = self.create_publisher(TFMessage, "/tf_static", latched)
+        self.odom_pub = self.create_publisher(Odometry, "odom", 10)
+        # Reliable: a subscriber of either reliability (the default, or sensor-data QoS) gets it.
+        self.scan_pub = self.create_publisher(LaserScan, "scan", 10)
+        self.cmd_sub = self.create_subscription(Twist, "cmd_vel", self.on_cmd_vel, 10)
+        self.reset_srv = self.create_service(Trigger, "~/reset", self.on_reset)
+
+        self.tf_static_pub.publish(TFMessage(transforms=[self.laser_transform()]))
+        # Wall-clock timers, also when a launch file sets use_sim_time for every node.
+        steady = Clock(clock_type=ClockType.STEADY_TIME)
+        self.awaiting_reply_since = None  # lock-step: when the scan that waits for its answer went out
+        if self.lock_step:
+            self.timer = self.create_timer(min(0.1, self.reply_timeout), self.on_lock_step_timer, clock=steady)
+        else:
+            self.wall_start = time.monotonic()
+            self.timer = self.create_timer(1.0 / (self.scan_rate * self.real_time_factor), self.on_tick, clock=steady)
+        self.get_logger().info(
+            f"Robot in world '{world}' (seed {seed}){self.pillar_words()}, "
+            + ("lock-step: waiting for a /scan subscriber and a /cmd_vel publisher" if self.lock_step
+               else f"real time x{self.real_time_factor:g}"))
+
+    @property
+    def now(self) -> float:
+        """Simulated seconds since the node started (over resets)."""
+        return self.clock_offset + self.sim.time
+
+    def pillar_words(self) -> str:
+        return "" if self.sim.pillar is None else ", pillar at ({:.2f}, {:.2f})".format(*self.sim.pillar)
+
+    # --- commands and services -------------------------------------------------------------------
+
+    def on_cmd_vel(self, msg: Twist) -> None:
+        try:
+            self.sim.command(msg.linear.x, msg.angular.z)
+        except ValueError as error:
+            self.get_logger().error(f"Refused /cmd_vel: {error}. The robot stops.")
+            self.sim.command(0.0, 0.0)
+        if self.lock_step and self.awaiting_reply_since is not None:
+            self.tick()
+
+    def on_reset(self, request, response):
+        self.clock_offset += self.sim.time
+        self.sim.reset()
+        response.success = True
+        response.message = f"Robot back at the start{self.pillar_words()}"
+        self.get_logger().info(response.message)
+        return response
+
+    # --- time ----------------------------------------------------------------------------------
+
+    def on_tick(self) -> None:
+        """Real time: simulate up to where the wall clock (times the factor) says, then publish."""
+        due = (time.monotonic() - self.wall_start) * self.real_time_factor
+        behind = due - self.now
+        # A process that was stopped (or starved) does not make the robot jump: at most a tick.
+        self.sim.step(min(max(behind, 0.0), 1.0 / self.scan_rate))
+        self.publish_state()
+
+    def on_lock_step_timer(self) -> None:
+        """Lock-step: start (or pause) with the graph; pass over a scan nobody answers."""
+        connected = self.scan_pub.get_subscription_count() > 0 and self.cmd_sub.get_publisher_count() > 0
+        if self.awaiting_reply_since is None:
+            if connected:
+                self.publish_state()
+                self.awaiting_reply_since = time.monotonic()
+        elif not connected:
+            self.awaiting_reply_since = None
+        elif time.monotonic() - self.awaiting_reply_since > self.reply_timeout:
+            self.get_logger().warning(f"No /cmd_vel within {self.reply_timeout:g} s of the scan at "
+                                      f"t={self.now:.2f} s: going on without it")
+            self.tick()
+
+    def tick(self) -> None:
+        """Lock-step: advance one tick and publish what the robot senses there."""
+        self.sim.step(1.0 / self.scan_rate)
+        self.publish_state()
+        self.awaiting_reply_since = time.monotonic()
+
+    # --- what the robot publishes ----------------------------------------------------------------
+
+    def publish_state(self) -> None:
+        now = stamp(self.now)
+        self.clock_pub.publish(ClockMessage(clock=now))
+        x, y, yaw = self.sim.pose()
+        linear, angular = self.sim.velocity()
+        moved = TransformStamped()
+        moved.header.stamp, moved.header.frame_id, moved.child_frame_id = now, husky.ODOM_FRAME, husky.BASE_FRAME
+        moved.transform.translation.x, moved.transform.translation.y = x, y
+        q = moved.transform.rotation
+        q.x, q.y, q.z, q.w = yaw_quaternion(yaw)
+        self.tf_pub.publish(TFMessage(transforms=[moved]))
+        self.odom_pub.publish(self.odometry(moved, linear, angular))
+        self.scan_pub.publish(self.laser_scan(now))
+
+    def odometry(self, moved: TransformStamped, linear: float, angular: float) -> Odometry:
+        odom = Odometry()
+        odom.header = moved.header
+        odom.child_frame_id = moved.child_frame_id
+        odom.pose.pose.position.x = moved.transform.translation.x
+        odom.pose.pose.position.y = moved.transform.translation.y
+        odom.pose.pose.orientation = moved.transform.rotation
+        odom.twist.twist.linear.x, odom.twist.twist.angular.z = linear, angular
+        return odom
+
+    def laser_scan(self, now: Time) -> LaserScan:
+        laser = self.sim.laser
+        scan = LaserScan()
+        scan.header.stamp, scan.header.frame_id = now, husky.LASER_FRAME
+        scan.angle_min, scan.angle_max, scan.angle_increment = laser.angle_min, laser.angle_max, laser.angle_increment
+        scan.scan_time = 1.0 / self.scan_rate
+        scan.range_min, scan.range_max = laser.range_min, laser.range_max
+        scan.ranges = array.array("f", self.sim.scan().tobytes())
+        return scan
+
+    def laser_transform(self) -> TransformStamped:
+        mount = TransformStamped()
+        mount.header.frame_id, mount.child_frame_id = husky.BASE_FRAME, husky.LASER_FRAME
+        t = mount.transform.translation
+        t.x, t.y, t.z = husky.LASER_OFFSET
+        mount.transform.rotation.w = 1.0
+        return mount
+
+
+def main(args=None):
+    rclpy.init(args=args)
+    node = None
+    try:
+        node = RobotSimulator()
+        rclpy.spin(node)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()
+
+
+if __name__ == "__main__":
+    main()
