@@ -18,6 +18,8 @@
   their verdicts), ``autograder.outputs`` (autograded notebooks, logs),
   ``autograder.result``, ``autograder.store`` (recorded results, cache), ``autograder.grading``
   (the whole class, in parallel).
+- ``python -m autograder grade-lab``: a student alone grades what they submitted in `make lab`'s exchange
+  and gets its feedback there (``autograder.lab_grading``).
 - Grading on submission (the hub's service, coursehub.grading_service): ``autograder.submit_queue``
   (its durable queue), ``autograder.scores_only`` (feedback without the verdicts before the due
   date); the rules per assignment are ``autograder.config.GradeOnSubmit``.

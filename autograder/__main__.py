@@ -1,5 +1,6 @@
 """python -m autograder roster|release|collect|grade|feedback|export COURSE_DIR, record-answers: the
-instructor's commands; release-lab: the assignments for a student's `make lab`."""
+instructor's commands; release-lab: the assignments for a student's `make lab`; grade-lab: grades
+what that student submitted there and releases the feedback for Fetch Feedback."""
 
 from __future__ import annotations
 
@@ -21,6 +22,10 @@ def _parser() -> argparse.ArgumentParser:
     lab = sub.add_parser("release-lab", help="release the assignments into the exchange of `make lab` "
                          "(.lab/ in LAB_ROOT, default this repository), where a student alone fetches them")
     lab.add_argument("lab_root", type=Path, nargs="?", default=None)
+    gla = sub.add_parser("grade-lab", help="grade the latest submission of each assignment in the exchange of "
+                         "`make lab` and release its feedback (Fetch Feedback in Nbgrader > Assignment List)")
+    gla.add_argument("lab_root", type=Path, nargs="?", default=None)
+    gla.add_argument("--assignment", action="append", help="only this assignment (repeatable)")
     col = sub.add_parser("collect", help="an LMS download (zip) of an assignment into COURSE_DIR/submitted/")
     col.add_argument("course_dir", type=Path)
     col.add_argument("assignment")
@@ -75,6 +80,12 @@ def _run(parser, args) -> int:
         released = release.release_for_lab(*([args.lab_root] if args.lab_root else []))
         print(f"Released for Nbgrader > Assignment List: {', '.join(released)}" if released
               else "The assignments in Nbgrader > Assignment List are up to date")
+    elif args.command == "grade-lab":
+        from autograder import lab_grading
+
+        results = lab_grading.grade_lab(*([args.lab_root] if args.lab_root else []), assignments=args.assignment)
+        print("\n".join(map(lab_grading.summary, results)) or "Nothing submitted yet: press Submit in "
+              "Nbgrader > Assignment List first")
     elif args.command == "collect":
         from autograder import collect
 

@@ -1,6 +1,7 @@
 """The graded quiz (course_lib/checks/quiz.py): the answer key gets full marks, a blank quiz 0, a
 wrong answer loses exactly its points with its explanation; the self-check only judges the form;
-the key stays with the grader. The check runs in this process, as the grader's check process runs
+the key stays with the grader; the right letters are spread and a wrong answer's feedback says why
+that choice is wrong without naming the right one. The check runs in this process, as the grader's check process runs
 it (no ROS, no nbgrader: the whole pipeline grades a quiz in tests/test_autograder_pipeline.py)."""
 
 from __future__ import annotations
@@ -9,6 +10,7 @@ import json
 import os
 
 import pytest
+from quiz_support import gives_away
 
 from autograder import record
 from autograder.answers import quiz as key
@@ -17,7 +19,7 @@ from course_lib.checks import answers, assignments, check_process, registry
 from course_lib.checks import quiz as checks
 from course_lib.checks.quiz_questions import QUIZ_QUESTIONS
 
-RIGHT = {name: letter for name, (letter, _why) in key.KEY.items()}
+RIGHT = {name: entry.answer for name, entry in key.KEY.items()}
 
 
 def graded(tmp_path, monkeypatch, given: dict | None):
@@ -32,8 +34,34 @@ def graded(tmp_path, monkeypatch, given: dict | None):
 
 def test_the_key_answers_every_question_and_only_those():
     assert set(key.KEY) == set(QUIZ_QUESTIONS)
-    for name, (letter, why) in key.KEY.items():
-        assert letter in QUIZ_QUESTIONS[name].choices and why, name
+    for name, entry in key.KEY.items():
+        choices = QUIZ_QUESTIONS[name].choices
+        assert entry.answer in choices and entry.why, name
+        assert set(entry.wrong) == set(choices) - {entry.answer} and all(entry.wrong.values()), name
+
+
+def test_the_right_letters_are_spread():
+    """No letter is right in more than 40 % of the questions, so that none is a good guess."""
+    counts = {letter: list(RIGHT.values()).count(letter) for letter in "abcd"}
+    assert max(counts.values()) <= 0.4 * len(RIGHT), counts
+
+
+@pytest.mark.parametrize("name", sorted(QUIZ_QUESTIONS, key=lambda name: int(name[1:])))
+def test_a_wrong_answers_feedback_never_names_the_right_one(name):
+    entry = key.KEY[name]
+    right = QUIZ_QUESTIONS[name].choices[entry.answer]
+    for letter, feedback in entry.wrong.items():
+        assert gives_away(feedback, entry.answer, right) is None, (name, letter, feedback)
+        assert key.explain(name, letter) == feedback
+    assert key.explain(name, entry.answer) is None
+
+
+def test_the_give_away_check_finds_a_named_answer():
+    assert gives_away("The answer is d.", "d", "x") and gives_away("Not this: pick (d).", "d", "x")
+    assert gives_away("It is `/robot1/dark`, as the namespace says.", "d", "`/robot1/dark`")
+    assert gives_away("That is about 30 Hz", "d", "about 30 Hz")
+    assert gives_away("A homography needs 4 pairs.", "c", "4")
+    assert gives_away("dark_fraction is the executable's name", "d", "`/robot1/dark`") is None
 
 
 def test_the_answer_key_gets_full_marks(tmp_path, monkeypatch):
@@ -55,7 +83,7 @@ def test_one_wrong_answer_loses_exactly_its_points_and_says_why(tmp_path, monkey
     assert result.points == result.max_points - QUIZ_QUESTIONS["q6"].points
     failed = [item["message"] for item in result.items if not item["ok"]]
     assert failed == [f"q6: not {wrong}; {key.explain('q6', wrong)}"]
-    assert "namespace=\"robot1\"" in failed[0]
+    assert key.explain("q6", wrong) == key.KEY["q6"].wrong[wrong] and "robot1/dark" not in failed[0]
 
 
 def test_an_answer_that_is_no_letter_loses_its_points_with_what_to_write(tmp_path, monkeypatch):
@@ -103,8 +131,9 @@ def test_no_explanation_of_the_key_is_in_what_students_install():
 
     folder = Path(course_lib.__file__).parent
     texts = [path.read_text() for path in folder.rglob("*") if path.suffix in (".py", ".json")]
-    for name, (_letter, why) in key.KEY.items():
-        assert not any(why[:40] in text for text in texts), name
+    for name, entry in key.KEY.items():
+        for why in (entry.why, *entry.wrong.values()):
+            assert not any(why[:40] in text for text in texts), name
 
 
 def test_the_check_is_worth_the_points_of_its_questions():

@@ -8,9 +8,14 @@ no answer: the graded quiz's answers stay with the grader (autograder/answers/qu
 from __future__ import annotations
 
 import dataclasses
+import re
 
 #: What a student leaves where an answer is not given yet (the self-checks say "not answered yet").
 PLACEHOLDERS = (None, ..., "...", "")
+
+#: How a markdown text that opens with a block (no sentence) begins: a code fence, a list, a
+#: quote, a heading, a table.
+_OPENS_WITH_BLOCK = re.compile(r"(```|~~~|[-*+] |\d+[.)] |>|#|\|)")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -28,8 +33,12 @@ class Question:
     points: float = 1.0
 
     def markdown(self, label: str) -> str:
-        """The question as a notebook shows it: its label in bold, the text, then one line per choice."""
-        lines = [f"**{label}.** {self.text.strip()}", ""]
+        """The question as a notebook shows it: its label in bold before the text's first sentence,
+        then one list item per choice. A text that opens with a block (a fenced code block, a list)
+        gets the label on a line of its own: on the block's first line markdown would read the
+        block as text of the label's paragraph."""
+        text = self.text.strip()
+        lines = [f"**{label}.**" + ("\n\n" if _OPENS_WITH_BLOCK.match(text) else " ") + text, ""]
         lines += [f"- **{letter}**: {choice}" for letter, choice in self.choices.items()]
         return "\n".join(lines)
 

@@ -89,7 +89,8 @@ def selfcheck(name: str) -> None:
     missing = [f"  ✘ {question}: {problem}" for question, problem in problems if problem]
     done = [question for question, problem in problems if not problem]
     lines = [f"[self-check] {len(done)} of {len(problems)} answers are well-formed (whether they are right "
-             "is graded after you hand the quiz in)", *missing]
+             "is graded after you hand the quiz in: Submit it; working alone in `make lab`, then run "
+             "`python -m autograder grade-lab` in a terminal and press Fetch Feedback)", *missing]
     if done:
         answered = (f"{question} = {normalized(answers[question])!r}" for question in done)
         lines.append("  ✔ answered: " + ", ".join(answered))

@@ -6,7 +6,8 @@ A lesson ends with two cells::
     quiz = {1: "", 2: "", 3: ""}                   # your letters
     selfcheck.check_quiz("05", quiz)
 
-The questions of every lesson, with their answers and why, are in :mod:`.lesson_quiz_questions`
+The questions of every lesson, with their answers, why each is right and why each wrong choice
+is wrong, are in :mod:`.lesson_quiz_questions`
 (ungraded: a student may read them; the graded quiz keeps its answers with the grader).
 """
 
@@ -48,7 +49,8 @@ def show_quiz(lesson: str) -> None:
 
 
 def check_quiz(lesson: str, answers: dict) -> Verdict:
-    """Each answer right or wrong, and for a wrong one why; true when all are right.
+    """Each answer right or wrong: a right one with why it is right, a wrong one with why that
+    choice is wrong (never which is right); true when all are right.
 
     `answers` maps the question's number (1, 2, ...) to a letter. A question without a
     well-formed answer says what to write, and the verdict is not done yet.
@@ -67,6 +69,6 @@ def check_quiz(lesson: str, answers: dict) -> Verdict:
             right += 1
             lines.append(f"  ✔ {number}: {item.answer}. {item.why}")
         else:
-            lines.append(f"  ✘ {number}: not {normalized(answer)}. {item.why}")
+            lines.append(f"  ✘ {number}: not {normalized(answer)}. {item.wrong[normalized(answer)]}")
     head = f"{right} of {len(questions)} right" + ("." if right == len(questions) else "; try the others again.")
     return Verdict(right == len(questions), "\n".join([head, *lines]))

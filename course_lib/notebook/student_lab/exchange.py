@@ -8,7 +8,9 @@ own, ``.lab/exchange`` under the lab's root (hidden from the file browser and fr
 course's grader (``python -m autograder release-lab``). The lab's ``nbgrader_config.py`` names that
 exchange and the course id with :func:`use_local_exchange`; the panel then lists the assignments,
 Fetch copies one to ``<root>/<assignment>/``, and Validate works on it. Submit keeps a copy in
-the exchange (nobody grades it there: a student alone checks with the self-checks and Validate).
+the exchange, where no instructor collects it: ``python -m autograder grade-lab``
+(autograder/lab_grading.py) grades the latest submission with the course's grader and releases its
+feedback into this exchange, where Fetch Feedback finds it.
 """
 
 from __future__ import annotations
