@@ -116,6 +116,8 @@ def test_package_submission_gets_its_scores_with_its_reasons_on_the_feedback_pag
     page = page.replace("&#39;", "'").replace("&quot;", '"')
     for reason in entry["reasons"]:
         assert reason in page, (reason, outputs[-3000:])
+    for phrase in entry.get("absent", []):
+        assert phrase not in page, (phrase, outputs[-3000:])
 
 
 def test_reference_solution_gets_full_marks_beside_its_own_hostile_cell(graded):

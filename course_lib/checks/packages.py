@@ -110,6 +110,19 @@ def wait_node(ctx, probe, proc, name: str) -> bool:
     return ctx.precondition(True, f"node {name} runs")
 
 
+def node_ended(ctx, proc, name: str, before: str) -> bool:
+    """When the student's process `proc` has ended before its node `name` did what the check waits
+    for (`before`, e.g. "offered service /x"): that is the check's cause, with the process's exit
+    and log, in place of wait_node's "node runs" (a node that appears and then raises in its
+    __init__ did not start). True when it has ended; nothing recorded while it runs."""
+    if proc.running():
+        return False
+    ctx.items[:] = [item for item in ctx.items if not (item["ok"] and item["message"] == f"node {name} runs")]
+    ctx.item(False, f"the process ended ({proc.describe_exit()}) before node {name} {before}:\n"
+                    f"{clip(proc.log_tail(6))}")
+    return True
+
+
 def endpoints(ctx, module: str, class_name: str) -> dict:
     """Context.endpoints for a class of a built package (its messages need the build)."""
     ws = require_build(ctx)

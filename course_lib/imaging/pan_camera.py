@@ -2,10 +2,15 @@
 
 The lessons' and the services_actions assignment's simulated camera for "find the cat": the board
 hangs straight ahead (pan 0 degrees); turning the head to ``pan`` degrees (positive: to the right)
-moves the board to the left of the frame, and past about 20 degrees its markers leave the frame.
-Angles wrap to [-180, 180). Nothing here draws unless asked (``frame_at``): which markers are in
-view is computed from the board's geometry (``scenes.detectable_from``), so answering a question
-about an angle costs well under a millisecond.
+moves the board to the left of the frame, and between about 15 and 32 degrees its markers leave
+the frame. Angles wrap to [-180, 180). Nothing here draws unless asked (``frame_at``): which
+markers are in view is computed from the board's geometry (``scenes.detectable_from``), so
+answering a question about an angle costs well under a millisecond.
+
+The answers are what OpenCV's ArUco detector finds in ``frame_at(pan)``: the markers it surely
+finds (``markers_in_view``), and the few it may find or miss (``uncertain_markers``: a marker
+touching the frame's border band, or a small one), which a check of a node's answers counts
+neither way.
 """
 
 from __future__ import annotations
@@ -29,6 +34,17 @@ BOARD_SCALE = 0.6
 _OUT_OF_VIEW = 60.0
 #: The frame size the answers are computed for.
 FRAME_SIZE = (640, 480)
+#: The shortest side (pixels) of a marker that is surely found. The pan camera's frames are clean
+#: (camera_views.Look(): no noise, blur or JPEG), where OpenCV's detector with its default
+#: parameters finds far smaller markers than in the scenes' hard frames (scenes.MIN_MARKER_SIDE):
+#: on clean frames of the board at many sizes and angles it found every marker of 17 pixels or
+#: more, some of 9 to 16, none below 8.9. A marker must also lie scenes.FRAME_MARGIN pixels inside
+#: the frame (the detector skips candidates within 3 pixels of the border).
+SURE_SIDE = 18.0
+#: A marker smaller than this, or not whole in the frame, is never found.
+SEEN_SIDE = 8.0
+#: A corner this far outside the pixel centres is still in the picture (the frame's edge).
+_EDGE = -0.5
 
 
 def wrap(pan: float) -> float:
@@ -57,17 +73,38 @@ def pose_at(pan: float) -> Pose:
 
 def markers_in_view(pan: float) -> tuple[int, ...]:
     """The board markers (1-8) in view with the head at `pan` degrees, ascending: whole, off the
-    frame's border and big enough that a detector surely finds them (scenes.detectable_from)."""
-    pan = wrap(pan)
-    if abs(pan) >= _OUT_OF_VIEW:
-        return ()
-    return scenes.detectable_from(pose_at(pan), size=FRAME_SIZE)
+    frame's border and big enough that a detector surely finds them (see SURE_SIDE)."""
+    return _found(pan, SURE_SIDE, scenes.FRAME_MARGIN)
+
+
+def uncertain_markers(pan: float) -> tuple[int, ...]:
+    """The board markers a detector may find or miss at `pan` degrees, ascending: whole in the
+    frame, but within scenes.FRAME_MARGIN pixels of its border or smaller than SURE_SIDE."""
+    sure = set(markers_in_view(pan))
+    return tuple(i for i in _found(pan, SEEN_SIDE, _EDGE) if i not in sure)
 
 
 def framed_at(pan: float) -> tuple[str, ...]:
     """The pictures ("cat", "dog") whose four markers are all in view at `pan` degrees."""
-    ids = set(markers_in_view(pan))
-    return tuple(name for name, markers in PICTURES.items() if ids.issuperset(markers))
+    return _framed(markers_in_view(pan))
+
+
+def maybe_framed_at(pan: float) -> tuple[str, ...]:
+    """The pictures a detector may or may not find framed at `pan` degrees: each of their markers
+    is in view or uncertain, and one at least is uncertain."""
+    sure = framed_at(pan)
+    return tuple(name for name in _framed(markers_in_view(pan) + uncertain_markers(pan)) if name not in sure)
+
+
+def _found(pan: float, min_side: float, margin: float) -> tuple[int, ...]:
+    pan = wrap(pan)
+    if abs(pan) >= _OUT_OF_VIEW:
+        return ()
+    return scenes.detectable_from(pose_at(pan), size=FRAME_SIZE, min_side=min_side, margin=margin)
+
+
+def _framed(ids) -> tuple[str, ...]:
+    return tuple(name for name, markers in PICTURES.items() if set(ids).issuperset(markers))
 
 
 def markers_of(pictures) -> tuple[int, ...]:
@@ -101,3 +138,12 @@ def search_pans(start: float, pictures) -> list[float]:
         pan = wrap(pan + STEP_DEGREES)
         pans.append(pan)
     return pans
+
+
+def search_stops(start: float, pictures) -> list[float]:
+    """The angles where a search from `start` for `pictures` may stop: the last of search_pans
+    (or `start` when it takes no step), and any angle before it where a detector may find the
+    pictures framed (maybe_framed_at), since a node that looks with a real detector stops there."""
+    wanted = set(pictures) or set(PICTURES)
+    pans = [wrap(start), *search_pans(start, pictures)]
+    return [pan for pan in pans if wanted <= set(framed_at(pan)) | set(maybe_framed_at(pan))]

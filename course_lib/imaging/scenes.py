@@ -147,9 +147,10 @@ def _inside(corners: np.ndarray, size: tuple[int, int], margin: float) -> bool:
                 and np.all(corners[:, 1] <= height - 1 - margin))
 
 
-def _detectable_ids(marker_corners: dict[int, np.ndarray], size: tuple[int, int]) -> tuple[int, ...]:
+def _detectable_ids(marker_corners: dict[int, np.ndarray], size: tuple[int, int], min_side: float = MIN_MARKER_SIDE,
+                    margin: float = FRAME_MARGIN) -> tuple[int, ...]:
     return tuple(i for i, c in sorted(marker_corners.items())
-                 if _inside(c, size, FRAME_MARGIN) and _shortest_side(c) >= MIN_MARKER_SIDE)
+                 if _inside(c, size, margin) and _shortest_side(c) >= min_side)
 
 
 def _framed(ids) -> tuple[str, ...]:
@@ -221,14 +222,22 @@ def framed_from(pose: Pose, *, size: tuple[int, int] = (640, 480), board: Board 
     return _framed(detectable_from(pose, size=size, board=board))
 
 
-def detectable_from(pose: Pose, *, size: tuple[int, int] = (640, 480), board: Board | None = None) -> tuple[int, ...]:
+def detectable_from(pose: Pose, *, size: tuple[int, int] = (640, 480), board: Board | None = None,
+                    min_side: float = MIN_MARKER_SIDE, margin: float = FRAME_MARGIN) -> tuple[int, ...]:
     """The picture markers detectable from `pose` (a scene's detectable_ids with that pose, when
-    all are printed and none is covered), ascending. Draws nothing."""
+    all are printed and none is covered), ascending. Draws nothing.
+
+    Args:
+        min_side, margin: the shortest side a marker needs in the frame, and how far (pixels) its
+            corners must be from the border; the defaults are the scenes' (MIN_MARKER_SIDE and
+            FRAME_MARGIN), for frames that may be noisy, blurred and compressed. A clean frame
+            needs less (see pan_camera).
+    """
     size = _check_size(size, "frame size")
     board = board or default_board()
     H = pose.homography(board.size, size)
     corners = {i: _marker_corners(board, H, i) for ids in PICTURES.values() for i in ids}
-    return _detectable_ids(corners, size)
+    return _detectable_ids(corners, size, min_side, margin)
 
 
 def _generators(seed) -> list[np.random.Generator]:

@@ -59,6 +59,32 @@ class _CheckServer:
         teardown.destroy_node(self.node)  # with its action server
 
 
+#: How the lesson waits for a future (the notebook's session spins the node meanwhile).
+_WAIT = "session.wait_for(future.done, timeout=10)"
+
+
+def _not_the_result(answer) -> str:
+    """Why the first of the returned pair is not the goal's result, and the fix."""
+    from rclpy.task import Future
+
+    if isinstance(answer, Future):
+        return (f"The first of the pair is the future of get_result_async(), not the result: the result comes "
+                f"later. Wait until the future is done ({_WAIT}), then return future.result().result.")
+    if hasattr(answer, "status") and hasattr(answer, "result"):
+        return (f"The first of the pair is the answer to get_result (status {answer.status}) that holds the "
+                "result: return its .result, the FindPictures result.")
+    return (f"The first of the pair is {answer!r}, not the goal's result: wait until get_result_async()'s "
+            f"future is done ({_WAIT}), then return future.result().result.")
+
+
+def _unfinished_future(error: Exception) -> str:
+    """The fix when `error` is what reading an unfinished future gives (its result() is None)."""
+    if isinstance(error, AttributeError) and str(error).startswith("'NoneType' object has no attribute"):
+        return (". Is it a future's result() read before the future was done? result() is None until then: "
+                f"wait first ({_WAIT}), after send_goal_async and again after get_result_async.")
+    return ""
+
+
 @progress.while_running("self-check: sending your goal")
 def find_pictures_exercise(find_pictures, action_type) -> Verdict:
     """Exercise (lesson 04): ``find_pictures(node, pictures, action_name)`` sends a FindPictures
@@ -67,8 +93,9 @@ def find_pictures_exercise(find_pictures, action_type) -> Verdict:
     from course_lib.ros import session
 
     hint = ("Write find_pictures(node, pictures, action_name): an ActionClient on the node, send_goal_async with "
-            "a feedback_callback that appends feedback.pan to a list, then wait for the result and return "
-            "(result, pans).")
+            "a feedback_callback that appends feedback.pan to a list; wait until its future is done "
+            f"({_WAIT}); then get_result_async() on the goal handle, wait again until that future is done, "
+            "and return (future.result().result, pans).")
     if (problem := _not_a_function(find_pictures, "find_pictures", hint)) is not None:
         return problem
     server = _CheckServer(action_type)
@@ -84,13 +111,12 @@ def find_pictures_exercise(find_pictures, action_type) -> Verdict:
             return _verdict(False, "Not done yet: replace the raise NotImplementedError with your code. " + hint)
         except Exception as error:  # a check never raises on a wrong answer
             return _verdict(False, f"find_pictures(node, ['cat'], {CHECK_ACTION!r}) raised "
-                                   f"{type(error).__name__}: {error}")
+                                   f"{type(error).__name__}: {error}" + _unfinished_future(error))
         if not (isinstance(answer, tuple) and len(answer) == 2):
             return _verdict(False, f"find_pictures returned {answer!r}; return a pair (result, pans).")
         result, pans = answer
         if not hasattr(result, "pan") or not hasattr(result, "framed"):
-            return _verdict(False, f"The first of the pair is {result!r}, not the goal's result: return "
-                                   "get_result_async()'s future.result().result.")
+            return _verdict(False, _not_the_result(result))
         if not isinstance(pans, list) or not pans:
             return _verdict(False, f"The second of the pair is {pans!r}: collect feedback.pan of every feedback "
                                    "message in a list (the feedback_callback gets a message whose .feedback has it).")

@@ -32,10 +32,11 @@ def _untouched(course_dir: str):
 def entries(course_dir: str) -> dict[str, dict]:
     return {
         "services_actions_full": dict(edits=[], scores={"service": 4, "action": 5, "cancel": 2}, reasons=[]),
-        # Nothing written: the node's __init__ raises NotImplementedError, no check earns a point.
+        # Nothing written: the node's __init__ raises NotImplementedError, no check earns a point,
+        # and none says the node runs (it appears in the graph for a moment before it raises).
         "services_actions_stub": dict(edits=[_untouched(course_dir)],
                                       scores={"service": 0, "action": 0, "cancel": 0},
-                                      reasons=["NotImplementedError"]),
+                                      reasons=["NotImplementedError"], absent=["node pan_camera runs"]),
         # The two typical mistakes: the service answers success=False, and the action turns
         # without publishing feedback (so it cannot be canceled after its first feedback either).
         "services_actions_mistakes": dict(
