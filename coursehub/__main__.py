@@ -11,7 +11,7 @@ import shutil
 import sys
 from pathlib import Path
 
-from coursehub import accounts, exchange, instructor
+from coursehub import accounts, closed_repository, exchange, instructor
 from coursehub import course as course_settings
 
 REPO = Path(__file__).resolve().parent.parent
@@ -39,15 +39,16 @@ def create_course(roster_csv: Path, instructor_name: str, hub_dir: Path, group: 
         if accounts.ensure_user(user, group) or user not in passwords:
             passwords[user] = accounts.set_password(user)
     _write_passwords(course.passwords, passwords)
+    _close_repository(course)
     exchange.create_exchange(exchange_root)
     exchange.write_settings(course)
     for student in students:
         home = Path(pwd.getpwnam(student).pw_dir)
         exchange.write_student_settings(home, student)
-        if not (home / "notebooks").exists():  # the lessons, the student's own copy
-            shutil.copytree(REPO / "notebooks", home / "notebooks",
-                            ignore=shutil.ignore_patterns(".ipynb_checkpoints", "__pycache__"))
-            accounts.chown_tree(home / "notebooks", student)
+        if not os.path.lexists(home / "notebooks"):  # the lessons, the student's own copy, made as the student
+            accounts.as_user(student, lambda home=home: shutil.copytree(
+                REPO / "notebooks", home / "notebooks", ignore=shutil.ignore_patterns(".ipynb_checkpoints",
+                                                                                       "__pycache__")))
     course_dir = release.prepare_course(course.course_dir)
     roster.import_roster(course_dir, roster_csv)
     accounts.chown_tree(course_dir, instructor_name)
@@ -72,6 +73,14 @@ def _write_passwords(path: Path, passwords: dict) -> None:
         writer.writerows(sorted(passwords.items()))
 
 
+def _close_repository(course) -> None:
+    """What students must not read of this repository, closed to the course's accounts (an ssh login
+    is one); a filesystem without ACLs leaves it open, and the admin is told."""
+    for failure in closed_repository.close_to_students(course):
+        print(f"python -m coursehub: students can read {failure}: put the repository on one that has "
+              "them (ext4, xfs and btrfs do)", file=sys.stderr)
+
+
 def remove_course(course) -> None:
     """Delete the course's accounts (and homes), its group, its exchange folder and the hub directory.
 
@@ -85,6 +94,7 @@ def remove_course(course) -> None:
     if running:
         raise ValueError(f"the course's accounts still run {len(running)} processes (e.g. {running[:5]}): stop the hub "
                          "first (Ctrl-C where `make hub` runs), then remove the course")
+    closed_repository.reopen_to_students(course)
     for user in [course.instructor, *course.students]:
         accounts.remove_user(user, course.group)
     accounts.remove_group(course.group)
@@ -93,14 +103,20 @@ def remove_course(course) -> None:
 
 
 def start(course) -> int:
-    """Run the hub in the foreground (Ctrl-C stops it and every server)."""
+    """Close the repository's folders to the course's accounts (again), then run the hub in the
+    foreground, its files in course.private_dir (Ctrl-C stops it and every server)."""
     proxy = Path(sys.prefix) / "chp" / "node_modules" / ".bin" / "configurable-http-proxy"
     if not proxy.exists():
         raise FileNotFoundError(f"configurable-http-proxy is not installed at {proxy}: "
                                 "run `make hub-deps` (or `make hub`)")
     env = dict(os.environ, COURSEHUB_HUB_DIR=str(course.hub_dir), PYTHONPATH=str(REPO),
                PATH=os.pathsep.join([str(Path(sys.executable).parent), os.environ.get("PATH", os.defpath)]))
-    os.chdir(course.hub_dir)
+    _close_repository(course)  # again: the repository may be a fresh clone since create-course
+    course.private_dir.mkdir(mode=0o700, exist_ok=True)
+    os.chmod(course.private_dir, 0o700)
+    for earlier in course.hub_dir.glob("jupyterhub*"):  # where a hub before private/ kept them, readable
+        os.replace(earlier, course.private_dir / earlier.name)
+    os.chdir(course.private_dir)  # where JupyterHub writes what it is not told where to write
     config = Path(__file__).resolve().parent / "jupyterhub_config.py"
     os.execve(sys.executable, [sys.executable, "-m", "jupyterhub", "-f", str(config)], env)
 

@@ -18,8 +18,8 @@ from pathlib import Path
 
 from nbgrader.exchange.default.collect import ExchangeCollect
 
-from autograder import untrusted
-from coursehub import inbound
+# autograder (and coursehub.inbound, which uses it) is imported where collecting needs it: every
+# server of the hub loads this class with nbgrader's settings, and a student's hides autograder/.
 
 
 class CheckedCollect(ExchangeCollect):
@@ -65,6 +65,9 @@ class CheckedCollect(ExchangeCollect):
 
     def refusal(self, path: Path) -> str | None:
         """Why the submission folder `path` is not collected, or None."""
+        from autograder import untrusted
+        from coursehub import inbound
+
         parsed = inbound.parse_name(path.name)
         if parsed is None:
             return f"{untrusted.shown(path.name)} is not named as nbgrader's submit names a submission"
@@ -82,6 +85,9 @@ class CheckedCollect(ExchangeCollect):
 
     def do_copy(self, src, dest, log=None):
         """Copy a submission (checked in init_src) without following anything out of it."""
+        from autograder import untrusted
+        from coursehub import inbound
+
         try:
             untrusted.copy_tree(src, dest, owner=pwd.getpwnam(inbound.parse_name(Path(src).name)[0]).pw_uid,
                                 ignore=self.coursedir.ignore)

@@ -1,9 +1,13 @@
 """The course's settings on this server (``<hub dir>/course.json``) and where everything lives.
 
-One hub directory holds what the hub keeps (root only, except ``run/``, which students traverse to
-reach their server's socket): course.json, the JupyterHub database and cookie secret, the initial
-passwords, the nbgrader settings every server reads (``jupyter/``) and configurable-http-proxy's
-auth token.
+One hub directory (mode 0711: nobody else lists it) holds what the hub keeps: course.json and the
+initial passwords (0600), what JupyterHub writes (``private/``, 0700: its database with SQLite's
+journal beside it, the cookie secret, its and the proxy's pid files), the nbgrader settings and
+Submit rules every server reads (``jupyter/``, readable by all) and ``run/``, which students
+traverse to reach their server's socket.
+
+What students must not read of the repository the hub runs from is closed to the course's group on
+the real filesystem too (coursehub.closed_repository).
 """
 
 from __future__ import annotations
@@ -64,6 +68,12 @@ class Course:
         return Path(pwd.getpwnam(self.instructor).pw_dir) / "course"
 
     @property
+    def private_dir(self) -> Path:
+        """What JupyterHub writes (its database, cookie secret and pid files), in a folder only root
+        enters, whatever modes the files get (SQLite's journal takes the database's)."""
+        return self.hub_dir / "private"
+
+    @property
     def passwords(self) -> Path:
         return self.hub_dir / "passwords.csv"
 
@@ -88,3 +98,4 @@ def load(hub_dir=DEFAULT_HUB_DIR) -> Course:
     data = json.loads(path.read_text())
     data["hub_dir"], data["exchange"] = Path(data["hub_dir"]), Path(data["exchange"])
     return Course(**data)
+

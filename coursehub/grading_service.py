@@ -67,6 +67,7 @@ class Service:
         self._rules, self._rules_read, self._rules_lock = {}, None, threading.Lock()
         self._contents, self._contents_lock = {}, threading.Lock()
         self._retry: dict[int, tuple[float, int]] = {}  # row id -> (when to release again, tries so far)
+        self._students, self._roster_read = list(getattr(course, "students", [])), None
 
     def start(self) -> None:
         from autograder import work_folders
@@ -112,11 +113,23 @@ class Service:
                 for name, rule in self._rules.items()})
 
     def students(self) -> dict[str, int]:
-        """The roster's accounts and their uids: a submission counts for the student who owns it."""
+        """The roster's accounts and their uids: a submission counts for the student who owns it.
+        The roster is read again when course.json changes (create-course run again to add students)."""
         import pwd
 
-        roster = set(self.course.students)
+        roster = set(self.roster())
         return {entry.pw_name: entry.pw_uid for entry in pwd.getpwall() if entry.pw_name in roster}
+
+    def roster(self) -> list[str]:
+        settings = Path(getattr(self.course, "hub_dir", "")) / "course.json"
+        with self._rules_lock:
+            try:
+                stamp = settings.stat().st_mtime_ns
+            except OSError:  # a course without a hub directory (a benchmark's): its students as given
+                return list(getattr(self.course, "students", []))
+            if stamp != self._roster_read:
+                self._students, self._roster_read = course_settings.load(settings.parent).students, stamp
+            return self._students
 
     def look_once(self) -> int:
         """Queue the new complete submissions of assignments graded on submission, and refuse the

@@ -18,9 +18,12 @@ c.JupyterHub.hub_ip = "127.0.0.1"
 c.JupyterHub.hub_port = course.hub_port
 c.ConfigurableHTTPProxy.api_url = f"http://127.0.0.1:{course.port + 1}"
 c.ConfigurableHTTPProxy.command = [str(Path(sys.prefix) / "chp" / "node_modules" / ".bin" / "configurable-http-proxy")]
-c.JupyterHub.db_url = f"sqlite:///{course.hub_dir / 'jupyterhub.sqlite'}"
-c.JupyterHub.cookie_secret_file = str(course.hub_dir / "jupyterhub_cookie_secret")
-c.JupyterHub.pid_file = str(course.hub_dir / "jupyterhub.pid")
+# All that JupyterHub writes, in a folder only root enters: the database holds every user's name and
+# last activity, cookie ids, hashed tokens and OAuth codes, and SQLite gives its journal the database's mode.
+c.JupyterHub.db_url = f"sqlite:///{course.private_dir / 'jupyterhub.sqlite'}"
+c.JupyterHub.cookie_secret_file = str(course.private_dir / "jupyterhub_cookie_secret")
+c.JupyterHub.pid_file = str(course.private_dir / "jupyterhub.pid")
+c.ConfigurableHTTPProxy.pid_file = str(course.private_dir / "jupyterhub-proxy.pid")
 c.JupyterHub.cleanup_servers = True
 c.JupyterHub.cleanup_proxy = True
 

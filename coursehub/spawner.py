@@ -45,7 +45,7 @@ class IsolatedSpawner(LocalProcessSpawner):
 
     async def _open_hub_door(self, course) -> None:
         if IsolatedSpawner._hub_door is None:
-            course.run_dir.mkdir(parents=True, exist_ok=True)
+            course.run_dir.mkdir(mode=0o711, parents=True, exist_ok=True)  # entered, never listed, by others
             os.chmod(course.run_dir, 0o711)
             # Anyone may connect: it leads to the hub's API, which the proxy serves to anyone too.
             IsolatedSpawner._hub_door = await forward.unix_to_tcp(
@@ -63,7 +63,7 @@ class IsolatedSpawner(LocalProcessSpawner):
         await self._open_hub_door(course)
         account = pwd.getpwnam(self.user.name)
         folder = course.run_dir / self.user.name
-        folder.mkdir(exist_ok=True)
+        folder.mkdir(mode=0o700, exist_ok=True)  # not listable by others while it is still root's
         os.chown(folder, account.pw_uid, account.pw_gid)
         os.chmod(folder, 0o700)
         course.server_socket(self.user.name).unlink(missing_ok=True)

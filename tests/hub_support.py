@@ -11,7 +11,9 @@ and find every process of the course's users.
   grader's sandboxes do) while the hub is stopped;
 - ``grading_service``, ``sandboxed``, ``submission_states``: the hub's grading service process,
   its processes in the grader's sandbox (a grading runs), and the rows of its queue as its page
-  shows them to a student.
+  shows them to a student;
+- ``student_access``: what a student's uid opens of the hub's, the course's and the repository's
+  closed files beyond ``STUDENT_MAY_READ``, and what their server needs that does not open.
 """
 
 from __future__ import annotations
@@ -24,7 +26,10 @@ import dataclasses
 import json
 import os
 import pwd
+import re
 import signal
+import socket
+import stat
 import subprocess
 import sys
 import threading
@@ -335,3 +340,106 @@ def submission_states(html_text: str) -> list[dict]:
 
     return [{"state": state, "assignment": assignment, "attempt": int(attempt), "says": html.unescape(says)}
             for state, assignment, attempt, says in re.findall(_STATUS_ROW, html_text)]
+
+
+#: What a student may open of the hub directory ({hub}; {me}: the student; * within a folder, ** across
+#: folders): the nbgrader settings and Submit rules every server reads, the hub's socket, their own
+#: server's folder, and nbgrader's exchange as nbgrader makes it (outbound/ for all; a submission or a
+#: feedback page by its unguessable name, in a folder nobody may list). Nothing of the instructor's
+#: course directory or of the repository's closed folders.
+STUDENT_MAY_READ = ("{hub}/jupyter", "{hub}/jupyter/nbgrader_config.py", "{hub}/jupyter/submit_rules.json",
+                    "{hub}/jupyter/.submit_rules.json.tmp", "{hub}/run/hub.sock", "{hub}/run/{me}",
+                    "{hub}/run/{me}/**", "{hub}/exchange", "{hub}/exchange/*", "{hub}/exchange/*/outbound",
+                    "{hub}/exchange/*/outbound/**", "{hub}/exchange/*/inbound/**", "{hub}/exchange/*/feedback/**")
+#: What a student's server and login need to open: the settings, the hub's and their server's sockets,
+#: the course's library and lessons in the repository.
+STUDENT_NEEDS = ("{hub}/jupyter/nbgrader_config.py", "{hub}/run/hub.sock", "{hub}/run/{me}/server.sock",
+                 f"{REPO}/course_lib/__init__.py", f"{REPO}/notebooks")
+
+
+def closed_folders() -> list[Path]:
+    """The repository's folders no student may open on the real filesystem: at least the instructor's
+    folders their servers hide (autograder.sandbox.HIDDEN_FROM_STUDENTS), the git history and `make
+    lab`'s course, and whatever else coursehub closes."""
+    from autograder.sandbox import HIDDEN_FROM_STUDENTS
+    from coursehub import closed_repository
+
+    closed = {*HIDDEN_FROM_STUDENTS, REPO / ".git", REPO / ".lab", *closed_repository.closed_folders()}
+    return sorted(path for path in closed if path.exists())
+
+
+def student_access(hub: Hub, student: str) -> dict[str, list[str]]:
+    """Every file and folder of the hub directory, the instructor's course directory and the
+    repository's closed folders that `student` opens (their uid and groups, as a login gives them)
+    and STUDENT_MAY_READ does not allow; and what of STUDENT_NEEDS they cannot open."""
+    places = {"hub": hub.hub_dir, "me": student}
+    allowed = [re.compile(re.escape(glob.format(**places)).replace(r"\*\*", ".*").replace(r"\*", "[^/]*") + "$")
+               for glob in STUDENT_MAY_READ]
+    found = [str(path) for root in [hub.hub_dir, hub.course_dir, *closed_folders()] for path in _every_path(root)]
+    needed = [glob.format(**places) for glob in STUDENT_NEEDS]
+    opened = set(opened_as(student, found + needed))
+    return {"opened, not allowed": [p for p in found if p in opened and not any(a.match(p) for a in allowed)],
+            "needed, not opened": [p for p in needed if p not in opened]}
+
+
+def _every_path(root: Path) -> list[Path]:
+    paths = [root]
+    for folder, dirs, files in os.walk(root):  # (a file gone meanwhile is left out, or found not to open)
+        paths += [Path(folder) / name for name in dirs + files]
+    return paths
+
+
+def opened_as(user: str, paths: list[str]) -> list[str]:
+    """Those of `paths` that `user` opens (a file or folder for reading, a socket to connect to), tried
+    in a child process with the user's uid, gid and groups."""
+    account = pwd.getpwnam(user)
+    groups = os.getgrouplist(user, account.pw_gid)
+    read, write = os.pipe()
+    pid = os.fork()
+    if pid == 0:  # the child never returns: it answers through the pipe and exits
+        code = 1
+        try:
+            os.close(read)
+            os.setgroups(groups)
+            os.setgid(account.pw_gid)
+            os.setuid(account.pw_uid)
+            with os.fdopen(write, "w") as answer:
+                answer.write(json.dumps([n for n, path in enumerate(paths) if _opens(path)]))
+            code = 0
+        finally:
+            os._exit(code)
+    os.close(write)
+    with os.fdopen(read) as answer:
+        text = answer.read()
+    _, status = os.waitpid(pid, 0)
+    assert status == 0 and text, f"the check as {user} failed (wait status {status})"
+    return [paths[n] for n in json.loads(text)]
+
+
+def _opens(path: str) -> bool:
+    try:
+        if stat.S_ISSOCK(os.lstat(path).st_mode):
+            with socket.socket(socket.AF_UNIX) as door:
+                door.connect(path)
+        else:
+            os.close(os.open(path, os.O_RDONLY | os.O_NONBLOCK | os.O_NOCTTY))
+    except (PermissionError, FileNotFoundError):
+        return False
+    except OSError:  # allowed, but not now (a socket nobody listens on, say)
+        return True
+    return True
+
+
+def enroll(hub: Hub, students: list[str]) -> None:
+    """Add accounts of the course's group to the roster of the running hub, as running create-course
+    again with a longer roster does for the grading service (its roster is course.json), without
+    the lessons and settings each new home would get."""
+    from coursehub import accounts
+    from coursehub import course as course_settings
+
+    group = f"{hub.instructor[:-1]}g"
+    for student in students:
+        accounts.ensure_user(student, group)
+    course = course_settings.load(hub.hub_dir)
+    course.students = sorted({*course.students, *students})
+    course.save()

@@ -85,3 +85,22 @@ def test_a_refused_entry_is_set_aside_under_the_queues_name_for_it(tmp_path):
     moved = inbound.set_aside(entry, 7, tmp_path / "course")
     assert moved == tmp_path / "course" / "autograder" / "refused" / "7" and moved.is_dir()
     assert not entry.exists() and sorted(p.name for p in (tmp_path / "course").iterdir()) == ["autograder"]
+
+
+def test_the_collect_class_loads_on_a_students_server_where_autograder_is_hidden():
+    """Every server loads nbgrader's exchange classes from the hub's settings; a student's hides
+    autograder/ (autograder.sandbox.HIDDEN_FROM_STUDENTS), so coursehub.checked_collect must import
+    without it."""
+    import subprocess
+    import sys
+
+    code = ("import sys\n"
+            "class Hidden:\n"
+            "    def find_spec(self, name, path=None, target=None):\n"
+            "        if name.split('.')[0] == 'autograder':\n"
+            "            raise ModuleNotFoundError(name)\n"
+            "sys.meta_path.insert(0, Hidden())\n"
+            "from coursehub.checked_collect import CheckedCollect\n"
+            "print(CheckedCollect.__name__)\n")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0 and done.stdout.strip() == "CheckedCollect", done.stderr
