@@ -41,11 +41,34 @@ def release(course_dir, assignments: list[str] | None = None, duedate: str | Non
     written = []
     for name in assignments or assignments_in(course):
         nbgrader_cli.generate_assignment(course, name)
+        unanswered_questions(course / "release" / name, name)
         if duedate:
             late.set_duedate(course, name, duedate)
         written.append(course / "release" / name)
     return written
 
+
+
+def unanswered_questions(folder: Path, assignment: str) -> None:
+    """Give each multiple-choice answer cell of a release the stub ``q3 = None`` instead of
+    nbgrader's ``raise NotImplementedError``: a question unanswered is not an error, so Run All on
+    the untouched release reaches the last cell, whose self-check names what is still unanswered.
+    The cells are the solution cells named after the assignment's questions (assignments/build.py
+    writes them), which are neither locked nor graded: no checksum of nbgrader's covers them."""
+    import nbformat
+
+    from course_lib.checks import assignments as specs
+
+    spec = specs.ASSIGNMENTS.get(assignment)
+    if spec is None or not spec.questions:
+        return
+    for path in sorted(Path(folder).glob("*.ipynb")):
+        nb = nbformat.read(path, as_version=4)
+        for cell in nb.cells:
+            name = cell.metadata.get("nbgrader", {}).get("grade_id")
+            if name in spec.questions and config.CODE_STUB in cell.source:
+                cell.source = cell.source.replace(config.CODE_STUB, f"{name} = None")
+        nbformat.write(nb, path)
 
 
 def release_to_exchange(course_dir, exchange, assignments: list[str]) -> None:

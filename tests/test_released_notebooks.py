@@ -45,15 +45,8 @@ def check_cells(nb) -> dict[str, dict]:
             if cell.metadata.get("nbgrader", {}).get("grade_id", "").startswith("check_")}
 
 
-#: The quiz's released answer cells are nbgrader's stub (`raise NotImplementedError`), so Run All
-#: stops at its first question (issue #51, left to the quiz's own work: assignments/build.py's
-#: question cells or nbgrader's code stub). Strict: the day it is fixed this test says so.
-QUIZ_STOPS = pytest.mark.xfail(strict=True, reason="the quiz's answer cells raise NotImplementedError when released")
-
-
 @pytest.mark.slow  # nbgrader's release and a kernel per notebook
-@pytest.mark.parametrize("name", [pytest.param(name, marks=QUIZ_STOPS) if name == "quiz" else name
-                                  for name in ASSIGNMENTS if name != "brightness"])
+@pytest.mark.parametrize("name", [name for name in ASSIGNMENTS if name != "brightness"])
 def test_run_all_on_an_untouched_release_reaches_every_check(nbclient, released, tmp_path, monkeypatch, name):
     """No cell before a check raises on the release's stubs (the "try it" cells say "Not done
     yet" instead). Run as graded, which skips the build cell and the self-checks' runs (the

@@ -90,10 +90,9 @@ class RobotSimulator(Node):
         else:
             self.wall_start = time.monotonic()
             self.timer = self.create_timer(1.0 / (self.scan_rate * self.real_time_factor), self.on_tick, clock=steady)
-        self.get_logger().info(
-            f"Robot in world '{world}' (seed {seed}){self.pillar_words()}, "
-            + ("lock-step: waiting for a /scan subscriber and a /cmd_vel publisher" if self.lock_step
-               else f"real time x{self.real_time_factor:g}"))
+        pace = ("lock-step: waiting for a /scan subscriber and a /cmd_vel publisher" if self.lock_step
+                else f"real time x{self.real_time_factor:g}")
+        self.get_logger().info(f"Robot in world '{world}' (seed {seed}){self.pillar_words()}, {pace}")
 
     @property
     def now(self) -> float:

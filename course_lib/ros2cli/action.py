@@ -137,7 +137,16 @@ def _send_goal(args) -> str | None:
 
     try:
         print("Waiting for an action server to become available...")
-        if not wait_until(client.server_is_ready):  # as long as it takes, like wait_for_server()
+        # With --feedback, also until the server's feedback publisher is discovered: the server is
+        # "ready" when its services are, and feedback published before the two endpoints match is
+        # lost (rcl's feedback topic is volatile).
+        feedback_topic = f"{args.action_name.rstrip('/')}/_action/feedback"
+
+        def ready() -> bool:
+            return client.server_is_ready() and (
+                not args.feedback or session.tool_node().count_publishers(feedback_topic) > 0)
+
+        if not wait_until(ready):  # as long as it takes, like wait_for_server()
             return f"No action server for '{args.action_name}' (time limit under test or grading)"
         print(f"Sending goal:\n     {_yaml(goal)}")
         sent = client.send_goal_async(goal, show_feedback if args.feedback else None)
