@@ -443,3 +443,38 @@ def enroll(hub: Hub, students: list[str]) -> None:
     course = course_settings.load(hub.hub_dir)
     course.students = sorted({*course.students, *students})
     course.save()
+
+
+def wait_until_gone(process, timeout: float = 60) -> None:
+    """Wait until `process` has ended (a zombie its parent has not reaped yet counts as ended)."""
+    deadline = time.monotonic() + timeout
+    while True:
+        try:
+            if process.status() == psutil.STATUS_ZOMBIE:
+                return
+        except psutil.NoSuchProcess:
+            return
+        assert time.monotonic() < deadline, f"{process} still runs after {timeout:.0f} s"
+        time.sleep(0.1)
+
+
+def wait_until(condition, timeout: float = 60) -> None:
+    """Wait until `condition()` holds (the suite's backstop: `timeout` s)."""
+    deadline = time.monotonic() + timeout
+    while not condition():
+        assert time.monotonic() < deadline, f"not true after {timeout:.0f} s: {condition}"
+        time.sleep(0.1)
+
+
+def work_folders_of(processes: list[psutil.Process]) -> set[Path]:
+    """The grading work folders (autograder.work_folders) the sandboxed `processes` run in, read
+    from their command lines (nbgrader's --CourseDirectory.root=<work folder>/course)."""
+    from autograder import work_folders
+
+    found = set()
+    for process in processes:
+        for word in _cmdline(process):
+            for part in Path(word.split("=", 1)[-1]).parents:
+                if part.name.startswith(work_folders.PREFIX):
+                    found.add(part)
+    return found

@@ -48,7 +48,10 @@ from hub_support import (  # noqa: E402  # noqa: E402
     sandboxed,
     student_access,
     submission_states,
+    wait_until,
+    wait_until_gone,
     why_no_hub,
+    work_folders_of,
 )
 from zoo.brightness import SUM  # noqa: E402
 
@@ -356,21 +359,6 @@ def _drop_in_inbound(hub, student: str, like: Path) -> str:
     return folder.name
 
 
-def _wait_until_gone(process, timeout: float = 60) -> None:
-    """Wait until `process` has ended (a zombie its parent has not reaped yet counts as ended)."""
-    import psutil
-
-    deadline = time.monotonic() + timeout
-    while True:
-        try:
-            if process.status() == psutil.STATUS_ZOMBIE:
-                return
-        except psutil.NoSuchProcess:
-            return
-        assert time.monotonic() < deadline, f"{process} still runs after {timeout:.0f} s"
-        time.sleep(0.1)
-
-
 def _queue_rows(hub, students) -> dict:
     import sqlite3
 
@@ -422,15 +410,18 @@ def test_submissions_at_once_are_each_graded_once_across_a_kill_of_the_service(h
 
     _wait_for_rows(hub, students, grading_in_sandbox)
     running = sandboxed(service)
+    cut_short = work_folders_of(running)
+    assert cut_short, [p.cmdline() for p in running]
     with open(hub.course_dir / "nbgrader_config.py", "a") as handle:  # read when the service starts again
         handle.write(f"c.GradeOnSubmit.workers = {WORKERS}\n")
     service.kill()
-    _wait_until_gone(service)
+    wait_until_gone(service)
     for process in running:  # the sandbox goes with the service (course_lib.processes: never an orphan)
-        _wait_until_gone(process)
+        wait_until_gone(process)
     for student in students[AT_ONCE:]:  # handed in while the service is down
         _drop_in_inbound(hub, student, like)
     assert grading_service(hub, timeout=180).pid != service.pid  # the hub restarts it
+    wait_until(lambda: not any(folder.exists() for folder in cut_short), 60)  # swept by the new service
 
     rows = _wait_for_rows(hub, students, lambda rows: len(rows) == len(students) and all(
         r["state"] == "released" for r in rows.values()))
@@ -497,4 +488,4 @@ def test_stopping_the_hub_stops_every_process_of_the_course(hub):
             pinned.close()
     killed = [p.pid for p in bystanders if p.returncode == -signal.SIGKILL]
     assert killed == [], f"stopping the hub killed {len(killed)} of {len(bystanders)} processes of other namespaces"
-    _wait_until_gone(service)  # the grading service (root) stops with the hub
+    wait_until_gone(service)  # the grading service (root) stops with the hub
