@@ -34,7 +34,8 @@ REQUIREMENTS := $(VENV)/requirements-without-ros.txt
 endif
 
 CHP_VERSION := 5.3.0
-HUB_DIR ?= /srv/ros2cv-hub
+# The hub directory: coursehub.course.DEFAULT_HUB_DIR unless HUB_DIR=... is given.
+HUB_DIR ?=
 
 .PHONY: setup lab test check browser-deps hub-deps hub clean
 
@@ -135,7 +136,7 @@ $(VENV)/.bytecode-done: $(VENV)/.setup-done
 # The course's JupyterHub on http://127.0.0.1:8000 (the port given to create-course).
 hub: setup hub-deps
 	@if [ "$$(id -u)" != 0 ]; then echo "make hub runs the servers as the students' Linux accounts: run it as root"; exit 1; fi
-	$(PY) -m coursehub --hub-dir $(HUB_DIR) start
+	$(PY) -m coursehub $(if $(HUB_DIR),--hub-dir $(HUB_DIR)) start
 
 # After the tests, Fast DDS's own tool removes the shared-memory segments of the processes the
 # tests killed (each holds up to 32 MB of memory in /dev/shm until removed; `python -m course_lib doctor` counts them).

@@ -1,10 +1,10 @@
 """Writes the nbgrader source notebooks of the graded assignments: ``python assignments/build.py``.
 
 The notebooks under assignments/source/ are what instructors edit in JupyterLab; this script is
-how they are made, from each assignment's spec (course_lib/checks/assignments.py: its packages, the
-module of its plain functions, its questions, the words of its notebook), its checks and its reference packages,
-and how a test checks that their graded cells match the checks (points of each test cell = points
-of its check in course_lib/checks/).
+how they are made, from each assignment's file (course_lib/checks/assignments/<name>.py: its spec with its
+packages, the module of its plain functions, its questions, the words of its notebook; its checks) and its
+reference packages, and how a test checks that their graded cells match the checks (points of each test
+cell = points of its check). It also writes the table of contracts in assignments/README.md from the specs.
 
 The solutions are the reference packages in assignments/reference_ws/src (the only copy): each
 file of an assignment's packages becomes a ``%%writefile ros2_ws/src/<package>/<file>`` cell. A
@@ -19,10 +19,15 @@ from pathlib import Path, PurePosixPath
 
 import nbformat
 
-from course_lib.checks.assignments import ASSIGNMENTS, WORKSPACE, Assignment, spec
+from course_lib.checks import assignments as specs
+from course_lib.checks.spec import Assignment
+from course_lib.contract import ASSIGNMENTS_SOURCE as SOURCE
+from course_lib.contract import ROOT, WORKSPACE
 
-HERE = Path(__file__).resolve().parent
-SOURCE = HERE / "source"
+README = SOURCE.parent / "README.md"
+#: The lines around the generated table of assignments/README.md.
+TABLE_START = "<!-- the contracts' table: written by python assignments/build.py from the specs -->"
+TABLE_END = "<!-- end of the table -->"
 
 
 def _meta(kind: str, grade_id: str, points: float = 0) -> dict:
@@ -183,18 +188,47 @@ def assignment_notebook(spec: Assignment) -> nbformat.NotebookNode:
     return notebook(cells)
 
 
+def contract_table(assignments: dict[str, Assignment]) -> str:
+    """The table of assignments/README.md: each assignment's lesson, points, packages and checks, from its spec."""
+    from course_lib.checks import registry
+
+    rows = ["| assignment | after lesson | points | packages (executables) | checks (points) |",
+            "|---|---|---|---|---|"]
+    for spec in assignments.values():
+        checks = registry.checks_of(spec.name).values()
+        packages = ", ".join(f"`{package}`" + (" (" + ", ".join(f"`{e}`" for e in executables) + ")" if executables
+                                               else "") for package, executables in spec.packages.items())
+        rows.append(f"| `{spec.name}` | {spec.lesson} | {sum(check.points for check in checks):g} | "
+                    f"{packages or 'none'} | {', '.join(f'`{check.name}` {check.points:g}' for check in checks)} |")
+    return "\n".join([TABLE_START, *rows, TABLE_END])
+
+
+def readme_with_table(text: str, assignments: dict[str, Assignment]) -> str:
+    """assignments/README.md's text with its table of contracts written from the specs."""
+    before, rest = text.split(TABLE_START, 1)
+    return before + contract_table(assignments) + rest.split(TABLE_END, 1)[1]
+
+
 def build(names=None) -> list[Path]:
     """Write the source notebooks (all, or the given assignments) and return their paths."""
-    sys.path.insert(0, str(HERE.parent))
+    sys.path.insert(0, str(ROOT))
     written = []
-    for name in names or ASSIGNMENTS:
+    for name in names or specs.ASSIGNMENTS:
         path = SOURCE / name / f"{name}.ipynb"
         path.parent.mkdir(parents=True, exist_ok=True)
-        nbformat.write(assignment_notebook(spec(name)), path)
+        nbformat.write(assignment_notebook(specs.spec(name)), path)
         written.append(path)
     return written
+
+
+def write_readme() -> Path:
+    """Write the table of contracts in assignments/README.md from the specs (a test compares them)."""
+    README.write_text(readme_with_table(README.read_text(), specs.ASSIGNMENTS))
+    return README
 
 
 if __name__ == "__main__":
     for path in build(sys.argv[1:] or None):
         print(path)
+    if len(sys.argv) == 1:
+        print(write_readme())

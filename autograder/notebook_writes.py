@@ -17,6 +17,8 @@ import os
 import shlex
 from pathlib import Path, PurePosixPath
 
+from course_lib.contract import WORKSPACE
+
 #: Characters that make a shell line more than a list of plain paths (quotes are allowed: shlex).
 _SHELL_SPECIAL = set("$`;&|<>*?[]{}~\\")
 
@@ -137,7 +139,7 @@ def folder_digest(folder: Path) -> str:
         here = Path(directory)
         relative = here.relative_to(folder)
         dirs[:] = sorted(d for d in dirs if d not in _NOT_COMPARED_DIRS
-                         and not (relative == Path("ros2_ws") and d in _COLCON_OUTPUT))
+                         and not (relative == Path(WORKSPACE) and d in _COLCON_OUTPUT))
         for name in sorted(files):
             path = here / name
             if relative == Path(".") and name.endswith(".ipynb"):

@@ -49,7 +49,8 @@ from autograder.build_caches import (
     workspace_key,
 )
 from course_lib import contract
-from course_lib.checks.assignments import ASSIGNMENTS, WORKSPACE
+from course_lib.checks.assignments import ASSIGNMENTS
+from course_lib.contract import WORKSPACE
 from course_lib.ros import colcon, package_files, workspace
 
 #: Seconds one colcon build may take (an interface package takes 10-40 s on a busy machine).

@@ -174,7 +174,7 @@ def choose_environment(g: Grading) -> None:
     worker's uid and process limit for the student's code."""
     work = g.work
     grader = stage_grader(work)
-    g.env = {"COURSE_LIB_GRADING": "1", "COURSE_LIB_UNDER_TEST": None, "AUTOGRADER_SEED": None,
+    g.env = {contract.GRADING_ENV: "1", contract.UNDER_TEST_ENV: None, contract.SEED_ENV: None,
              contract.CHECKS_OUTSIDE_ENV: "1",
              "JUPYTER_PATH": str(work / "jupyter"), "JUPYTER_RUNTIME_DIR": str(work / "runtime"),
              "JUPYTER_CONFIG_DIR": str(work / "jupyter-config"), contract.KERNEL_TMP_ENV: str(work / "kernel-tmp"),

@@ -11,7 +11,8 @@ from pathlib import Path
 
 import nbformat
 
-SOURCE = Path(__file__).resolve().parent.parent / "assignments" / "source"
+from course_lib.contract import ASSIGNMENTS_SOURCE as SOURCE
+from course_lib.contract import WORKSPACE
 
 
 def solution_source(text: str) -> str:
@@ -48,8 +49,6 @@ def package_files(package: str) -> list[tuple[str, str]]:
     """(path beside the notebook, ros2_ws/src/<package>/..., text with its solution markers) of
     each file of a reference package, its tests and caches left out: what its source notebook's
     cells write (assignments/build.py)."""
-    from course_lib.checks.assignments import WORKSPACE
-
     folder = REFERENCE_SRC / package
     files = []
     for path in sorted(p for p in folder.rglob("*") if p.is_file()):
@@ -85,4 +84,4 @@ def _write(files: dict[str, str], folder: Path, edits, where: str) -> Path:
         path = Path(folder) / name
         path.parent.mkdir(parents=True, exist_ok=True)
         path.write_text(text)
-    return Path(folder) / "ros2_ws"
+    return Path(folder) / WORKSPACE

@@ -7,9 +7,9 @@ import shutil
 from pathlib import Path
 
 from autograder import config, nbgrader_cli
+from course_lib.contract import ASSIGNMENTS_SOURCE as REPO_SOURCE
+from course_lib.contract import ROOT as REPO
 
-REPO = Path(__file__).resolve().parent.parent
-REPO_SOURCE = REPO / "assignments" / "source"
 #: What of an assignment's source folder a course does not take.
 SOURCE_IGNORE = shutil.ignore_patterns(".ipynb_checkpoints", "__pycache__", "*.py")
 

@@ -52,8 +52,8 @@ def _tree_digest(paths: list[Path], digest, skip: tuple = ()) -> None:
 
 
 #: The modules of course_lib.checks that run every assignment's checks (a change regrades).
-CHECK_MODULES = ["registry", "result", "runner", "check_process", "context", "student_calls", "student_processes",
-                 "student_server", "probe", "student", "answers", "packages"]
+CHECK_MODULES = ["spec", "registry", "result", "runner", "check_process", "context", "student_calls",
+                 "student_processes", "student_server", "probe", "student", "answers", "packages"]
 
 
 def submission_digest(sub: Submission, course: Path, content_only: bool = False) -> str:
@@ -68,7 +68,7 @@ def submission_digest(sub: Submission, course: Path, content_only: bool = False)
     code = [here / "kernel.py", here / "config.py", here / "hidden_checks_process.py", here / "student_uid.py",
             here / "run_as.py", here / "packages.py",
             here / "answers" / f"{sub.assignment}.py",
-            *(checks / f"{name}.py" for name in CHECK_MODULES), checks / f"{sub.assignment}.py"]
+            *(checks / f"{name}.py" for name in CHECK_MODULES), checks / "assignments" / f"{sub.assignment}.py"]
     _tree_digest([path for path in code if path.exists()], digest)
     return digest.hexdigest()
 

@@ -1,5 +1,7 @@
 """What the grader (autograder/) and the checks (course_lib/checks/) agree on, each defined once:
-the environment variables one sets for the other, the seeds, and the limits of the student's code.
+the environment variables one sets for the other, the seeds, the folders, and the limits of the
+student's code. A test (tests/test_repository.py) fails when one of these names or folders is
+spelled out again elsewhere: import it from here.
 
 The grader sets these variables for the processes it starts (the notebook's kernel, the hidden
 checks, the student's nodes); the checks and course_lib read them. Nothing here is secret: the
@@ -10,9 +12,20 @@ student's package holds this module, and the answer keys stay on the instructor'
 from __future__ import annotations
 
 import os
+from pathlib import Path
 
 #: nbgrader's course id: the course's assignments in an exchange, on a hub and in a student's lab alike.
 COURSE_ID = "ros2-jazzy-opencv"
+
+# --- folders ------------------------------------------------------------------------------------
+
+#: The folder that holds course_lib: in a course checkout, the repository's root (autograder/,
+#: assignments/, coursehub/ beside it); in a student's installed wheel, site-packages.
+ROOT = Path(__file__).resolve().parents[1]
+#: The colcon workspace beside an assignment's notebook (``ros2_ws/src/<package>/``).
+WORKSPACE = "ros2_ws"
+#: The nbgrader source notebooks of the assignments in the repository (assignments/build.py writes them).
+ASSIGNMENTS_SOURCE = ROOT / "assignments" / "source"
 
 # --- who runs: grading, the test suite ---------------------------------------------------------
 

@@ -11,10 +11,9 @@ import shutil
 import sys
 from pathlib import Path
 
+from course_lib.contract import ROOT as REPO
 from coursehub import accounts, closed_repository, exchange, instructor
 from coursehub import course as course_settings
-
-REPO = Path(__file__).resolve().parent.parent
 
 
 def create_course(roster_csv: Path, instructor_name: str, hub_dir: Path, group: str, exchange_root: Path,
@@ -109,7 +108,7 @@ def start(course) -> int:
     if not proxy.exists():
         raise FileNotFoundError(f"configurable-http-proxy is not installed at {proxy}: "
                                 "run `make hub-deps` (or `make hub`)")
-    env = dict(os.environ, COURSEHUB_HUB_DIR=str(course.hub_dir), PYTHONPATH=str(REPO),
+    env = dict(os.environ, **{course_settings.HUB_DIR_ENV: str(course.hub_dir)}, PYTHONPATH=str(REPO),
                PATH=os.pathsep.join([str(Path(sys.executable).parent), os.environ.get("PATH", os.defpath)]))
     _close_repository(course)  # again: the repository may be a fresh clone since create-course
     course.private_dir.mkdir(mode=0o700, exist_ok=True)

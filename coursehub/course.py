@@ -18,6 +18,8 @@ import pwd
 from pathlib import Path
 
 DEFAULT_HUB_DIR = Path("/srv/ros2cv-hub")
+#: The hub directory, in the environment of the hub and its services (set by ``python -m coursehub start``).
+HUB_DIR_ENV = "COURSEHUB_HUB_DIR"
 DEFAULT_EXCHANGE = Path("/srv/nbgrader/exchange")  # nbgrader's documented default place
 #: The hub's grading service (coursehub.grading_service): its name, and its page's path on the hub.
 GRADING_SERVICE = "grading"

@@ -234,7 +234,7 @@ class Service:
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="python -m coursehub.grading_service", description=__doc__.split("\n")[0])
-    parser.add_argument("--hub-dir", type=Path, default=Path(os.environ.get("COURSEHUB_HUB_DIR",
+    parser.add_argument("--hub-dir", type=Path, default=Path(os.environ.get(course_settings.HUB_DIR_ENV,
                                                                            course_settings.DEFAULT_HUB_DIR)))
     parser.add_argument("--workers", type=int, help="submissions graded at the same time (default: "
                         f"c.GradeOnSubmit.workers in the course's nbgrader_config.py, else {config.SUBMIT_WORKERS})")

@@ -1,5 +1,5 @@
 """The hub's configuration: JupyterHub reads this file (``python -m coursehub start`` passes it),
-and it reads the course from ``$COURSEHUB_HUB_DIR/course.json``."""
+and it reads the course from ``course.json`` in the hub directory that ``course.HUB_DIR_ENV`` names."""
 
 import json
 import os
@@ -10,7 +10,7 @@ from course_lib.notebook.student_lab import terminal
 from coursehub import course as course_settings
 
 c = get_config()  # noqa: F821 (provided by JupyterHub)
-course = course_settings.load(os.environ["COURSEHUB_HUB_DIR"])
+course = course_settings.load(os.environ[course_settings.HUB_DIR_ENV])
 
 c.JupyterHub.ip = course.ip
 c.JupyterHub.port = course.port
@@ -47,7 +47,7 @@ c.JupyterHub.services = [{
     "name": course_settings.GRADING_SERVICE, "url": f"http://127.0.0.1:{course.grading_port}", "display": True,
     "oauth_no_confirm": True,
     "command": [sys.executable, "-m", "coursehub.grading_service"],
-    "environment": {"COURSEHUB_HUB_DIR": str(course.hub_dir)},
+    "environment": {course_settings.HUB_DIR_ENV: str(course.hub_dir)},
 }]
 c.JupyterHub.load_roles = [{"name": "user",
                             "scopes": ["self", f"access:services!service={course_settings.GRADING_SERVICE}"]}]

@@ -15,7 +15,7 @@ from pathlib import Path
 
 from course_lib import contract
 
-REPO = Path(__file__).resolve().parent.parent
+REPO = contract.ROOT
 
 
 def as_user(course, user: str, command: list[str]) -> list[str]:

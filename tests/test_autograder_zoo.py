@@ -32,6 +32,13 @@ from zoo import services_actions as services_actions_zoo  # noqa: E402
 pytestmark = [pytest.mark.slow, pytest.mark.timeout(1500)]
 
 
+def _total(assignment: str) -> float:
+    """The most an assignment earns: the points of its checks (its spec's file in course_lib/checks/assignments/)."""
+    from course_lib.checks import registry
+
+    return sum(check.points for check in registry.checks_of(assignment).values())
+
+
 def _hashes(folder: Path) -> dict[str, str]:
     return {str(p.relative_to(folder)): hashlib.sha256(p.read_bytes()).hexdigest()
             for p in sorted(folder.rglob("*")) if p.is_file()}
@@ -124,7 +131,7 @@ def test_reference_solution_gets_full_marks_beside_its_own_hostile_cell(graded):
     """The reference solution with a hostile cell, graded next to hostile submissions, gets every
     point: what the cell tries changes nothing."""
     result = graded["results"]["hostile"]
-    assert (result.score, result.max_score) == (11, 11)
+    assert (result.score, result.max_score) == (_total("brightness"), _total("brightness"))
 
 
 def test_hostile_submission_is_contained(graded):
@@ -190,7 +197,7 @@ def test_grading_report_lists_every_submission(graded):
         rows = list(csv.DictReader(handle))
     assert {r["student_id"] for r in rows} == (set(graded["entries"]) | set(pubsub_zoo.entries())
                                                | set(services_actions_zoo.entries("")))
-    max_scores = {"brightness": "11", "pubsub": "10", "services_actions": "11"}
+    max_scores = {name: f"{_total(name):g}" for name in ("brightness", "pubsub", "services_actions")}
     assert all(r["max_score"] == max_scores[r["assignment"]] for r in rows)
     assert {r["student_id"]: float(r["score"]) for r in rows} == {s: r.score for s, r in graded["results"].items()}
 

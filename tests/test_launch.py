@@ -236,7 +236,7 @@ def test_processes_that_end_are_reported_and_then_the_launch_ends(prefix, ros_do
     assert f"[{sh}] hidden" not in lines  # output="log" by default: stdout only in launch.log
     # The catdog check's launch item stops waiting on these lines (a marker_reader that died at start
     # kept it waiting for its whole backstop while the launch's camera went on).
-    from course_lib.checks.catdog_warp import _ended
+    from course_lib.checks.assignments.catdog_warp import _ended
 
     finished = types.SimpleNamespace(log=output)
     assert _ended(finished, "crasher") and _ended(finished, "quitter") and not _ended(finished, "endings")

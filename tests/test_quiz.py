@@ -1,4 +1,4 @@
-"""The graded quiz (course_lib/checks/quiz.py): the answer key gets full marks, a blank quiz 0, a
+"""The graded quiz (course_lib/checks/assignments/quiz.py): the answer key gets full marks, a blank quiz 0, a
 wrong answer loses exactly its points with its explanation; the self-check only judges the form;
 the key stays with the grader; the right letters are spread and a wrong answer's feedback says why
 that choice is wrong without naming the right one. The check runs in this process, as the grader's check process runs

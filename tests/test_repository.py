@@ -164,7 +164,7 @@ def test_course_lib_packages_depend_on_each_other_in_one_direction():
 
 def course_sources():
     roots = (*PACKAGES, "tests", "benchmarks")
-    return [path for path in tracked("*.py") if path.relative_to(ROOT).parts[0] in roots]
+    return [path for path in tracked("*.py") if path.relative_to(ROOT).parts[0] in roots and path.exists()]
 
 
 def opens_with_a_docstring(text: str) -> bool:
@@ -175,7 +175,7 @@ def opens_with_a_docstring(text: str) -> bool:
 
 
 def test_each_source_file_opens_with_a_docstring():
-    """A file's first lines say its job (STYLE.md), so that a reader finds the file of a job."""
+    """A file's first lines say its job, so that a reader finds the file of a job."""
     assert not opens_with_a_docstring("import os\n") and opens_with_a_docstring('#!/bin/python\n"""Job."""\n')
     silent = [str(path.relative_to(ROOT)) for path in course_sources()
               if not opens_with_a_docstring(path.read_text())]
@@ -239,3 +239,38 @@ def test_every_course_lib_module_the_lessons_and_guides_name_exists():
     assert ("05_recording_and_replaying.ipynb", "course_lib.imaging.camera") in named
     missing = sorted((file, name) for file, name in named if importlib.util.find_spec(name) is None)
     assert not missing, f"no such module: {missing}"
+
+
+# --- every fact once --------------------------------------------------------------------------------
+
+#: The modules whose ``Path(__file__).resolve().parent.parent`` is the folder that holds *their* copy of
+#: autograder (under grading, the grader's private staged copy: autograder.staging), not the repository.
+STAGED_ROOTS = {"autograder/config.py", "autograder/nbgrader_cli.py", "autograder/outputs.py", "autograder/sandbox.py"}
+
+
+def test_every_fact_is_spelled_out_once():
+    """An environment name of course_lib.contract, the hub directory and its variable, the workspace's
+    folder, the source notebooks' folder and the repository's root are written in the one module that
+    owns them (contract.py, coursehub/course.py) and imported everywhere else."""
+    from course_lib import contract
+
+    facts = {f'"{value}"': "course_lib/contract.py" for name, value in vars(contract).items() if name.endswith("_ENV")}
+    facts.update({'"ros2_ws"': "course_lib/contract.py", '"assignments" / "source"': "course_lib/contract.py",
+                  '"/srv/ros2cv-hub"': "coursehub/course.py", '"COURSEHUB_HUB_DIR"': "coursehub/course.py"})
+    # autograder/sandbox_entry.py runs with ``python -I -S`` and imports nothing of the course (contract.py says so).
+    allowed = {"autograder/sandbox_entry.py": {f'"{contract.EXPOSE_ENV}"', f'"{contract.BLOCKED_ENV}"',
+                                               f'"{contract.STAGE_ENV}"'}}
+    root = re.compile(r"Path\(__file__\)\.resolve\(\)\.(parent\.parent|parents\[[12]\])")
+    again = []
+    for path in course_sources() + [ROOT / "assignments" / "build.py"]:
+        name = str(path.relative_to(ROOT))
+        if name.startswith(("tests/", "benchmarks/")) or not path.exists():
+            continue
+        text = path.read_text().replace("'", '"')
+        again += [f"{name}: {fact} (defined in {owner})" for fact, owner in facts.items()
+                  if fact in text and owner != name and fact not in allowed.get(name, ())]
+        if root.search(text) and name != "course_lib/contract.py" and name not in STAGED_ROOTS:
+            again.append(f"{name}: the repository's root (contract.ROOT)")
+    makefile = (ROOT / "Makefile").read_text()
+    again += [f"Makefile: {fact}" for fact in ('/srv/ros2cv-hub', 'COURSEHUB_HUB_DIR') if fact in makefile]
+    assert not again, f"import these from the module that defines them: {again}"

@@ -132,7 +132,7 @@ def test_the_wheel_holds_the_student_package_only(wheel_files):
     the instructor's side."""
     tops = {name.split("/", 1)[0] for name in wheel_files if not name.split("/", 1)[0].endswith(".dist-info")}
     assert tops == {"course_lib"}
-    assert "course_lib/checks/brightness.py" in wheel_files
+    assert "course_lib/checks/assignments/brightness.py" in wheel_files
     assert "course_lib/checks/recorded/brightness.json" in wheel_files
     # The student lab's Validate progress: its configuration and lab extension.
     lab = "course_lib/notebook/student_lab/"

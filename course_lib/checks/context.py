@@ -176,20 +176,18 @@ class Context:
         """The dotted name of the student's module of plain functions (its assignment's spec)."""
         from course_lib.checks import assignments
 
-        return assignments.spec(self.spec.assignment).functions[1]
+        return assignments.module(self.spec.assignment).SPEC.functions[1]
 
     @property
     def module_root(self) -> Path:
         """The folder the student's module is imported from: its package's source, ros2_ws/src/<package>."""
         from course_lib.checks import assignments
 
-        return self.package_dir(assignments.spec(self.spec.assignment).functions[0])
+        return self.package_dir(assignments.module(self.spec.assignment).SPEC.functions[0])
 
     def workspace_dir(self) -> Path:
         """The assignment's workspace beside the notebook, ros2_ws."""
-        from course_lib.checks import assignments
-
-        return Path(self.workdir) / assignments.WORKSPACE
+        return Path(self.workdir) / contract.WORKSPACE
 
     def package_dir(self, package: str) -> Path:
         """A package's source folder beside the notebook, ros2_ws/src/<package>."""

@@ -1,6 +1,6 @@
 """Multiple-choice questions: how one reads in a notebook and what counts as a well-formed answer.
 
-The graded quiz (course_lib/checks/quiz.py, its questions in course_lib/checks/quiz_questions.py)
+The graded quiz (course_lib/checks/assignments/quiz.py, its questions in course_lib/checks/quiz_questions.py)
 and the short quizzes at the end of the lessons (course_lib.selfcheck.lesson_quiz) share them. A question holds
 no answer: the graded quiz's answers stay with the grader (autograder/answers/quiz.py).
 """

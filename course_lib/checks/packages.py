@@ -25,7 +25,6 @@ import xml.etree.ElementTree as ElementTree
 from pathlib import Path
 
 from course_lib import contract
-from course_lib.checks.assignments import WORKSPACE
 from course_lib.checks.context import StudentError, clip, scaled
 from course_lib.checks.student_processes import student_env as _student_env
 from course_lib.ros import package_files
@@ -46,8 +45,8 @@ def require_build(ctx) -> Path:
             raise StudentError(f"your workspace did not build, so this cannot run. {data['reason']}")
         return Path(data["workspace"])
     if not (ws / "install" / "setup.bash").is_file():
-        raise StudentError(f"{WORKSPACE} is not built yet: run the notebook's build cell "
-                                   f"(in a terminal: cd {WORKSPACE} && colcon build --symlink-install)")
+        raise StudentError(f"{contract.WORKSPACE} is not built yet: run the notebook's build cell "
+                                   f"(in a terminal: cd {contract.WORKSPACE} && colcon build --symlink-install)")
     return ws
 
 

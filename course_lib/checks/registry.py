@@ -1,6 +1,6 @@
 """The registry of graded checks: what a check is (points, time, what it checks).
 
-A check is a function in ``course_lib/checks/<assignment>.py`` decorated with :func:`check`,
+A check is a function in ``course_lib/checks/assignments/<assignment>.py`` decorated with :func:`check`,
 which gives it its points and its time limit; its docstring's first line says what it checks::
 
     @check(points=4, timeout=40)
@@ -24,7 +24,7 @@ class Check:
     """One graded check of an assignment.
 
     Attributes:
-        assignment: the assignment's name (the checks module's name).
+        assignment: the assignment's name (its module's name in course_lib/checks/assignments/).
         name: the check's name, unique in the assignment (what selfcheck()/grade() take).
         points: the most it earns.
         timeout: seconds the check may take, student processes included.
@@ -58,7 +58,7 @@ def check(points: float, timeout: float):
 
 def checks_of(assignment: str) -> dict[str, Check]:
     """The checks of an assignment, in the order they are defined (imports the checks module)."""
-    importlib.import_module(f"course_lib.checks.{assignment}")
+    importlib.import_module(f"course_lib.checks.assignments.{assignment}")
     return dict(_REGISTRY.get(assignment, {}))
 
 

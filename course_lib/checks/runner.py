@@ -167,7 +167,7 @@ def embed_images(result: Result, out: Path) -> None:
 def child_pythonpath() -> str:
     """The directory holding course_lib (in a course checkout also the autograder), first on the
     path of child processes."""
-    root = str(Path(__file__).resolve().parents[2])
+    root = str(contract.ROOT)
     rest = [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p and p != root]
     return os.pathsep.join([root] + rest)
 

@@ -1,5 +1,6 @@
 """Checks of the quiz: multiple-choice questions on lessons 00-05, answered as variables of the
-notebook (``q3 = "b"``; the questions: course_lib/checks/quiz_questions.py).
+notebook (``q3 = "b"``; the questions: course_lib/checks/quiz_questions.py): its spec, its
+notebook's words and its checks.
 
 The notebook's check cell saves the answers into ANSWERS_FILE beside the notebook (:func:`save_answers`,
 from the notebook's variables), in the self-check and at grading alike. The self-check says only
@@ -23,8 +24,27 @@ from course_lib.checks.context import Context
 from course_lib.checks.multiple_choice import answer_problem, normalized
 from course_lib.checks.quiz_questions import QUIZ_QUESTIONS
 from course_lib.checks.registry import check
+from course_lib.checks.spec import Assignment, NotebookText
 
-ASSIGNMENT = "quiz"
+# --- the notebook's words (markdown) and the spec ----------------------------------------
+
+QUIZ_INTRO = """
+# Quiz: lessons 00-05
+
+Sixteen multiple-choice questions on what the lessons taught: ROS 2's concepts, reading what the
+`ros2` command prints, choosing a QoS, reading a launch file, images, markers, actions and bags. Each has one
+right answer and earns one point.
+
+**How to answer:** write the letter of your choice as a string into the cell under the question,
+e.g. `q3 = "b"`, and run it. The check cell at the end saves your answers and says whether each is
+one of the question's letters; whether it is right is graded after you hand the quiz in, and the
+feedback explains each wrong answer. Run every cell (Run All) before you hand it in.
+"""
+
+#: The spec: what assignments/build.py, the grader and the checks below read about it.
+SPEC = Assignment("quiz", "05", {}, NotebookText(intro=QUIZ_INTRO, checks={"answers": ("your answers",)}),
+       questions=QUIZ_QUESTIONS, answers="secret")
+
 #: Where the check cell saves the notebook's answers (beside the notebook), and the most it reads.
 ANSWERS_FILE = "quiz_answers.json"
 ANSWERS_MAX_BYTES = 64 * 1024
@@ -102,7 +122,7 @@ def selfcheck(name: str) -> None:
 def grade(name: str):
     """Save the notebook's answers, then grade check `name` (the grader runs it outside the kernel)."""
     save_answers()
-    return runner.grade(ASSIGNMENT, name)
+    return runner.grade(SPEC.name, name)
 
 
 @check(points=sum(question.points for question in QUIZ_QUESTIONS.values()), timeout=30)

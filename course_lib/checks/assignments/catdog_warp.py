@@ -1,27 +1,10 @@
-"""Checks of the catdog_warp assignment: ``crop_pictures`` and ``MarkerReader``, on generated scenes.
+"""The catdog_warp assignment: its spec, its notebook's words and its checks (``crop_pictures`` and
+``MarkerReader``, on generated scenes).
 
-The contract (also in the notebook and in assignments/README.md); the board convention is
-course_lib.imaging.marker_board's (markers of DICT_4X4_50; "cat" framed by markers 1-4, "dog" by 5-8, in the
-order top-left, top-right, bottom-right, bottom-left; the picture's corners are those marker
-corners that touch it, marker_board.CORNER_OF_MARKER):
-
-- ``crop_pictures(frame_bgr, size=(320, 240)) -> dict``: ``{"cat": crop, "dog": crop}`` with a
-  key only when all four of that picture's markers are found; each crop is a BGR uint8 image of
-  ``size`` (width, height), the picture's top-left corner at pixel (0, 0), upright, not mirrored.
-- ``MarkerReader()``: node ``marker_reader``; subscribes ``image`` (sensor_msgs/Image, any QoS);
-  for each frame publishes each crop it finds on ``cropped_img`` as a
-  ``catdog_interfaces/msg/CroppedPicture``: ``int32 picture`` (CAT = 1, DOG = 2) and
-  ``sensor_msgs/CompressedImage image`` (e.g. images.image_to_compressed(crop, "png")).
-- ``main(args=None)`` runs the node until Ctrl-C.
-
-The packages (``ros2_ws/src``): ``catdog_interfaces`` (the message), ``webcam`` (executable
-``image_publisher``) and ``readmarker`` (``readmarker/crop.py`` with crop_pictures,
-``readmarker/marker_reader.py`` with the node, executable ``marker_reader``, and
-``launch/catdog_warp.launch.xml`` starting both nodes).
-
-Crops are compared with the ground truth of the generated scene (Scene.expected_crops) by
-marker_board.crop_similarity, passing at marker_board.SAME_CROP_THRESHOLD; colours are checked separately
-(crop_similarity compares grey levels, so a red/blue swap would pass it).
+The contract is the notebook's introduction (CATDOG_WARP_INTRO); the board convention is
+course_lib.imaging.marker_board's. Crops are compared with the ground truth of the generated scene
+(Scene.expected_crops) by marker_board.crop_similarity, passing at marker_board.SAME_CROP_THRESHOLD;
+colours are checked separately (crop_similarity compares grey levels, so a red/blue swap would pass it).
 """
 
 from __future__ import annotations
@@ -31,27 +14,74 @@ import time
 
 import numpy as np
 
-from course_lib.checks import packages, runner
+from course_lib.checks import packages
 from course_lib.checks.context import Context, clip, scaled
 from course_lib.checks.registry import check
+from course_lib.checks.spec import Assignment, NotebookText
 
-ASSIGNMENT = "catdog_warp"
+# --- the notebook's words (markdown) and the spec ----------------------------------------
+
+CATDOG_WARP_INTRO = """
+# Assignment: cat and dog, warped upright
+
+A camera looks at the course's marker board: a cat picture framed by ArUco markers 1-4 and a dog
+picture framed by markers 5-8 (dictionary `DICT_4X4_50`), in the order top-left, top-right,
+bottom-right, bottom-left. Each marker touches its picture with one corner: marker 1 with its
+corner 2, marker 2 with corner 3, marker 3 with corner 0, marker 4 with corner 1
+(`course_lib.imaging.marker_board.PICTURES` and `CORNER_OF_MARKER`; OpenCV numbers a marker's corners
+clockwise from its top-left).
+
+**Contract** (this is exactly what is graded). Your workspace `ros2_ws/src` holds three packages:
+
+1. **`catdog_interfaces`**: the message `msg/CroppedPicture.msg` with `int32 picture` (constants
+   `CAT=1`, `DOG=2`) and `sensor_msgs/CompressedImage image`.
+2. **`webcam`**: the executable **`image_publisher`** (given: the course's simulated board, a video
+   file or a real camera on `image`).
+3. **`readmarker`**:
+   - `readmarker/crop.py`: `crop_pictures(frame_bgr, size=(320, 240)) -> dict`, `{"cat": crop,
+     "dog": crop}` with a key **only when all four markers** of that picture are found; each crop is
+     a BGR `uint8` image of `size` = (width, height), upright and not mirrored (the picture's
+     top-left corner at pixel (0, 0));
+   - `readmarker/marker_reader.py`: the node **`marker_reader`** (executable `marker_reader`);
+     subscribes **`image`** (`sensor_msgs/msg/Image`) and for every frame publishes each crop it
+     finds on **`cropped_img`** as a `CroppedPicture` (`picture` 1 for the cat, 2 for the dog; the
+     crop as a PNG, `images.image_to_compressed(crop, "png")`);
+   - `launch/catdog_warp.launch.xml`, starting `image_publisher` and `marker_reader`
+     (`ros2 launch readmarker catdog_warp.launch.xml`); `package.xml` declares every ROS package the
+     code imports.
+
+The grader renders scenes (`course_lib.imaging.scenes.render_scene`) with poses and lighting you have not
+seen, and compares your crops with the true ones (`marker_board.crop_similarity`, passing at
+`marker_board.SAME_CROP_THRESHOLD`). Try your function on `scenes.render_scene(seed).frame`.
+"""
+
+#: The spec: what assignments/build.py, the grader and the checks below read about it.
+SPEC = Assignment("catdog_warp", "03", {"catdog_interfaces": (), "webcam": ("image_publisher",),
+                           "readmarker": ("marker_reader",)},
+           NotebookText(intro=CATDOG_WARP_INTRO, plain_ros=(
+               "In plain ROS 2 the packages come from `ros2 pkg create` (`--build-type ament_cmake` for "
+               "`catdog_interfaces`, `ament_python` for the others)."),
+               checks={"easy": ("easy views",), "hard": ("hard views",), "missing_and_none": ("missing markers",),
+                       "noisy": ("noise, blur, another size",), "node": ("the node",)},
+               imports="from course_lib import marker_board, scenes\n", names="crop_pictures",
+               try_text="Try it on a generated scene (this cell is yours to change):", try_code="""
+scene = scenes.render_scene(1)
+try:
+    print(sorted(crop_pictures(scene.frame)))   # ['cat', 'dog']
+except NotImplementedError:  # the stub: Run All goes on to the checks, which say what is missing
+    print("Not done yet: crop_pictures still raises NotImplementedError. Write it in the crop.py "
+          "cell above, run that cell and the import cell, then this one.")
+"""),
+           functions=("readmarker", "readmarker.crop"))
+selfcheck, grade = SPEC.selfcheck, SPEC.grade  # what the notebook calls: checks.selfcheck("...")
+
+INTERFACES, _WEBCAM, PACKAGE = SPEC.packages
 #: The message of a crop: which picture (CAT = 1, DOG = 2) and the crop.
 MESSAGE_FIELDS = [("int32", "picture"), ("sensor_msgs/CompressedImage", "image")]
 PICTURE_NUMBERS = {"cat": 1, "dog": 2}
 SIZE = (320, 240)
 #: Largest difference of the per-channel means of a crop and its expected crop (grey levels).
 COLOUR_TOLERANCE = 20.0
-
-
-def selfcheck(name: str):
-    """Run check `name` with the self-check seed and print what is right and wrong."""
-    return runner.selfcheck(ASSIGNMENT, name)
-
-
-def grade(name: str):
-    """Run check `name` with a fresh seed (grading)."""
-    return runner.grade(ASSIGNMENT, name)
 
 
 def _seed(ctx) -> int:
@@ -208,12 +238,12 @@ def node(ctx: Context) -> None:
     """marker_reader: node marker_reader turns frames on image into CroppedPicture messages on cropped_img."""
     from concurrent.futures import ThreadPoolExecutor
 
-    proc = packages.run(ctx, "readmarker", "marker_reader")  # ros2 run readmarker marker_reader
+    proc = packages.run(ctx, PACKAGE, SPEC.executable(PACKAGE))  # ros2 run readmarker marker_reader
     packages.use_interfaces(ctx)
     from catdog_interfaces.msg import CroppedPicture
 
-    packages.message_item(ctx, "catdog_interfaces", "CroppedPicture", MESSAGE_FIELDS)
-    packages.dependency_items(ctx, "readmarker")
+    packages.message_item(ctx, INTERFACES, "CroppedPicture", MESSAGE_FIELDS)
+    packages.dependency_items(ctx, PACKAGE)
     # The launch file's nodes run at the same time, in a ROS domain of their own: its
     # marker_reader must not answer this node's frames, nor this node its camera's.
     with ThreadPoolExecutor(1) as pool:
@@ -286,7 +316,7 @@ def _single_node_items(ctx: Context, proc, message_type) -> bool:
 
 
 #: The launch file that starts the camera and the marker reader.
-LAUNCH = ("readmarker", "catdog_warp.launch.xml")
+LAUNCH = (PACKAGE, "catdog_warp.launch.xml")
 
 
 def _ended(launch, node: str) -> bool:

@@ -1,20 +1,9 @@
-"""Checks of the pubsub assignment: the MsgTutorial publisher and subscriber, as ROS 2 packages.
+"""The pubsub assignment: its spec, its notebook's words and its checks (the MsgTutorial publisher
+and subscriber, as ROS 2 packages).
 
-The contract (also in the notebook and in assignments/README.md). The workspace ``ros2_ws/src``
-holds two packages:
-
-- ``tutorial_interfaces`` (ament_cmake): ``msg/MsgTutorial.msg`` with ``builtin_interfaces/Time
-  stamp`` and ``int32 data``;
-- ``pubsub`` (ament_python), depending on rclpy and tutorial_interfaces, with two executables:
-  ``topic_publisher`` (module ``pubsub/topic_publisher.py``, class ``TopicPublisher``, node
-  ``topic_publisher``): publishes MsgTutorial on ``ros_tutorial_msg`` with a queue depth of 100 at
-  10 Hz, ``stamp`` = the time of publishing, ``data`` = a counter 0, 1, 2, ...;
-  ``topic_subscriber`` (``pubsub/topic_subscriber.py``, ``TopicSubscriber``, node
-  ``topic_subscriber``): subscribes ``ros_tutorial_msg`` (depth 100) and logs each field of every
-  message, e.g. ``I heard: stamp 1718000000.250000000 data 7``.
-
-The checks start the executables as ``ros2 run pubsub topic_publisher`` would (the grader builds
-the workspace first); the checker's own node uses the reference MsgTutorial.
+The contract is the notebook's introduction (PUBSUB_INTRO). The checks start the executables as
+``ros2 run pubsub topic_publisher`` would (the grader builds the workspace first); the checker's own
+node uses the reference MsgTutorial.
 """
 
 from __future__ import annotations
@@ -23,13 +12,50 @@ import re
 from itertools import pairwise
 
 from course_lib import waiting
-from course_lib.checks import packages, runner
+from course_lib.checks import packages
 from course_lib.checks.context import Context, StudentError, scaled
 from course_lib.checks.registry import check
+from course_lib.checks.spec import Assignment, NotebookText
 
-ASSIGNMENT = "pubsub"
-PACKAGE = "pubsub"
-INTERFACES = "tutorial_interfaces"
+# --- the notebook's words (markdown) and the spec ----------------------------------------
+
+PUBSUB_INTRO = """
+# Assignment: publisher and subscriber
+
+Two nodes that talk over a topic with the lecture's own message, `MsgTutorial`, as in Lesson 01b:
+a message package and a package of nodes that depends on it.
+
+**Contract** (this is exactly what is graded):
+
+1. The interface package **`tutorial_interfaces`** (`ament_cmake`) with `msg/MsgTutorial.msg`:
+   `builtin_interfaces/Time stamp` and `int32 data`.
+2. The package **`pubsub`** (`ament_python`, depending on `rclpy` and `tutorial_interfaces`) with two
+   executables:
+   - **`topic_publisher`** (`pubsub/topic_publisher.py`, class `TopicPublisher`, node
+     **`topic_publisher`**): publishes `MsgTutorial` on **`ros_tutorial_msg`** with a queue depth of
+     **100**, at **10 Hz** (a 0.1 s timer); `stamp` is the time of publishing, `data` a counter that
+     starts at 0 and grows by one per message.
+   - **`topic_subscriber`** (`pubsub/topic_subscriber.py`, class `TopicSubscriber`, node
+     **`topic_subscriber`**): subscribes `ros_tutorial_msg` with a queue depth of 100 and logs each
+     field of every message: `I heard: stamp <sec>.<nanosec> data <data>`.
+
+The grader builds your workspace, starts your executables as `ros2 run pubsub topic_publisher` and
+`ros2 run pubsub topic_subscriber` in separate processes, listens to your publisher, talks to your
+subscriber (reading its log), and runs both together.
+"""
+
+#: The spec: what assignments/build.py, the grader and the checks below read about it.
+SPEC = Assignment("pubsub", "01b", {"tutorial_interfaces": (), "pubsub": ("topic_publisher", "topic_subscriber")},
+       NotebookText(intro=PUBSUB_INTRO, plain_ros=(
+           "In plain ROS 2: `ros2 pkg create --build-type ament_cmake tutorial_interfaces` and "
+           "`ros2 pkg create --build-type ament_python --dependencies rclpy tutorial_interfaces "
+           "--node-name topic_publisher pubsub`, then the edits of Lesson 01b."),
+           checks={"publisher": ("the publisher",), "subscriber": ("the subscriber",),
+                   "together": ("both together",)}))
+selfcheck, grade = SPEC.selfcheck, SPEC.grade  # what the notebook calls: checks.selfcheck("...")
+
+INTERFACES, PACKAGE = SPEC.packages
+PUBLISHER, SUBSCRIBER = SPEC.executables(PACKAGE)
 MESSAGE_FIELDS = [("builtin_interfaces/Time", "stamp"), ("int32", "data")]
 TOPIC = "/ros_tutorial_msg"
 RATE_HZ = 10.0
@@ -42,16 +68,6 @@ RATE_MESSAGES = 16
 RATE_SPAN = (RATE_MESSAGES - 1) / RATE_HZ
 #: A subscriber's log line: the stamp (seconds, and nanoseconds when shown) and the data.
 HEARD = re.compile(r"I heard:.*?stamp\D{0,4}(\d+)(?:\.(\d+))?.*?data\D{0,4}(-?\d+)")
-
-
-def selfcheck(name: str):
-    """Run check `name` with the self-check seed and print what is right and wrong."""
-    return runner.selfcheck(ASSIGNMENT, name)
-
-
-def grade(name: str):
-    """Run check `name` with a fresh seed (grading)."""
-    return runner.grade(ASSIGNMENT, name)
 
 
 def _stamp_seconds(stamp) -> float:
@@ -89,7 +105,7 @@ def _start(ctx, executable: str, tag: str = ""):
 @check(points=5, timeout=90)
 def publisher(ctx: Context) -> None:
     """topic_publisher: MsgTutorial on ros_tutorial_msg at 10 Hz, data +1 per message, increasing stamps."""
-    proc = _start(ctx, "topic_publisher")
+    proc = _start(ctx, PUBLISHER)
     packages.use_interfaces(ctx)
     from tutorial_interfaces.msg import MsgTutorial
 
@@ -138,7 +154,7 @@ def publisher(ctx: Context) -> None:
 @check(points=3, timeout=90)
 def subscriber(ctx: Context) -> None:
     """topic_subscriber: node topic_subscriber hears every MsgTutorial on ros_tutorial_msg and logs its stamp and data."""  # noqa: E501 (the check's description, one line: registry.check)
-    proc = _start(ctx, "topic_subscriber")
+    proc = _start(ctx, SUBSCRIBER)
     packages.use_interfaces(ctx)
     from tutorial_interfaces.msg import MsgTutorial
 
@@ -183,8 +199,8 @@ def _heard(log: str) -> list[tuple[int, int]]:
 @check(points=2, timeout=60)
 def together(ctx: Context) -> None:
     """The subscriber receives what the publisher publishes: consecutive data, none lost."""
-    pub = _start(ctx, "topic_publisher")
-    sub = _start(ctx, "topic_subscriber")
+    pub = _start(ctx, PUBLISHER)
+    sub = _start(ctx, SUBSCRIBER)
     try:
         waiting.spin_until(lambda: len(_heard(sub.log)) >= 15 or not (sub.running() and pub.running()), scaled(20.0),
                            poll=0.1)

@@ -1,39 +1,76 @@
-"""Checks of the services_actions assignment: the pan camera's service and action, in a package.
+"""The services_actions assignment: its spec, its notebook's words and its checks (the pan camera's
+service and action, in a package).
 
-The contract (also in the notebook and in assignments/README.md). The workspace ``ros2_ws/src``
-holds two packages:
-
-- ``camera_interfaces`` (given): ``srv/MarkersInView.srv`` (``float64 pan`` -> ``int32[] ids``,
-  ``string[] framed``, ``bool success``, ``string message``) and ``action/FindPictures.action``
-  (goal ``string[] pictures``; result ``float64 pan``, ``string[] framed``; feedback ``float64
-  pan``, ``int32[] ids``);
-- ``pan_camera`` (ament_python), executable ``pan_camera_node`` (module
-  ``pan_camera/pan_camera_node.py``, node ``pan_camera``, parameter ``start_pan``): the service
-  ``markers_in_view`` answers what course_lib.pan_camera sees at the angle asked for, success true;
-  the action ``find_pictures`` turns the camera STEP_DEGREES at a time from where it is until the
-  pictures asked for (empty: both) are framed, with feedback after every step, and stops when
-  canceled (status CANCELED, the result where it stopped).
-
-The expected answers are the simulation's own (course_lib.pan_camera), for angles and start
-angles drawn from the check's seed. A node may look with a real detector instead: the markers a
-detector may find or miss at an angle (pan_camera.uncertain_markers) count neither way, nor do the
-pictures they frame, and a search may stop where such a picture is first framed
-(pan_camera.search_stops). The checker's nodes use the reference interfaces.
+The contract is the notebook's introduction (SERVICES_ACTIONS_INTRO). The expected answers are the
+simulation's own (course_lib.pan_camera), for angles and start angles drawn from the check's seed. A
+node may look with a real detector instead: the markers a detector may find or miss at an angle
+(pan_camera.uncertain_markers) count neither way, nor do the pictures they frame, and a search may
+stop where such a picture is first framed (pan_camera.search_stops). The checker's nodes use the
+reference interfaces.
 """
 
 from __future__ import annotations
 
 import math
 
-from course_lib.checks import packages, runner
+from course_lib.checks import packages
 from course_lib.checks.context import Context, scaled
 from course_lib.checks.registry import check
+from course_lib.checks.spec import Assignment, NotebookText
 from course_lib.imaging import pan_camera
 from course_lib.imaging.marker_board import PICTURES
 
-ASSIGNMENT = "services_actions"
-PACKAGE = "pan_camera"
-EXECUTABLE = "pan_camera_node"
+# --- the notebook's words (markdown) and the spec ----------------------------------------
+
+SERVICES_ACTIONS_INTRO = """
+# Assignment: the pan camera's service and action
+
+The camera of Lesson 04 sits on a pan head in front of the marker board (`course_lib.pan_camera`):
+turned to `pan` degrees (positive to the right) it sees some of the board's markers, and at about
+0 degrees both pictures. You write the node that offers what Lesson 04 taught: a service that answers
+a question at once, and an action that takes a while, reports its progress and can be canceled.
+
+**Contract** (this is exactly what is graded). Your workspace `ros2_ws/src` holds two packages:
+
+1. **`camera_interfaces`** (given, as built in Lesson 04): `srv/MarkersInView.srv` and
+   `action/FindPictures.action`.
+2. **`pan_camera`** (`ament_python`, depending on `rclpy` and `camera_interfaces`) with the
+   executable **`pan_camera_node`** (`pan_camera/pan_camera_node.py`, class `PanCameraNode`, node
+   **`pan_camera`**), whose camera starts at the parameter **`start_pan`** (degrees; default
+   `pan_camera.START_PAN`):
+   - the service **`markers_in_view`** (`camera_interfaces/srv/MarkersInView`): for the request's
+     `pan`, `ids` = `markers_in_view(pan)`, `framed` = `framed_at(pan)` (as lists), `success` true and
+     a short `message`; asking does not turn the camera;
+   - the action **`find_pictures`** (`camera_interfaces/action/FindPictures`): from where the camera
+     is, turn `STEP_DEGREES` (5) per step, one step per `STEP_SECONDS` (0.1 s), until every picture
+     of the goal's `pictures` (empty: both) is framed; after each step publish feedback (`pan`, and the
+     `ids` in view there); then succeed with the result `pan` and `framed`. A goal naming another
+     picture is rejected. A cancel request is accepted, and the search stops before its next step
+     (status CANCELED, the result where it stopped): the service and cancel requests must be served
+     while a goal runs (a `ReentrantCallbackGroup`, spun by the `MultiThreadedExecutor` that `main`
+     already uses).
+
+The grader builds your workspace, starts `ros2 run pan_camera pan_camera_node` (with `-p
+start_pan:=...` for the action) in a ROS domain of its own, asks the service about angles it draws
+fresh, sends goals from start angles it draws fresh, and compares with what `course_lib.pan_camera`
+says the camera sees. Try your node from a terminal, as in Lesson 04:
+`ros2 service call /markers_in_view camera_interfaces/srv/MarkersInView "{pan: -10.0}"` and
+`ros2 action send_goal --feedback /find_pictures camera_interfaces/action/FindPictures "{pictures: [cat]}"`.
+"""
+
+#: The spec: what assignments/build.py, the grader and the checks below read about it.
+SPEC = Assignment("services_actions", "04", {"camera_interfaces": (), "pan_camera": ("pan_camera_node",)},
+       NotebookText(intro=SERVICES_ACTIONS_INTRO, plain_ros=(
+           "In plain ROS 2 the packages come from `ros2 pkg create --build-type ament_cmake camera_interfaces` "
+           "(then the edits of Lesson 04) and `ros2 pkg create --build-type ament_python --dependencies rclpy "
+           "camera_interfaces --node-name pan_camera_node pan_camera`."),
+           checks={"service": ("the service `markers_in_view`",),
+                   "action": ("the action `find_pictures`",),
+                   "cancel": ("canceling a goal",)}))
+selfcheck, grade = SPEC.selfcheck, SPEC.grade  # what the notebook calls: checks.selfcheck("...")
+
+INTERFACES, PACKAGE = SPEC.packages
+EXECUTABLE = SPEC.executable(PACKAGE)
 NODE = "pan_camera"
 SERVICE = "/markers_in_view"
 SERVICE_TYPE = "camera_interfaces/srv/MarkersInView"
@@ -41,16 +78,6 @@ ACTION = "/find_pictures"
 ACTION_TYPE = "camera_interfaces/action/FindPictures"
 #: Angles the service is asked about per check: most near the board, one past 180 degrees (wrapped).
 SERVICE_QUESTIONS = 6
-
-
-def selfcheck(name: str):
-    """Run check `name` with the self-check seed and print what is right and wrong."""
-    return runner.selfcheck(ASSIGNMENT, name)
-
-
-def grade(name: str):
-    """Run check `name` with a fresh seed (grading)."""
-    return runner.grade(ASSIGNMENT, name)
 
 
 def _start(ctx, start_pan: float | None = None):

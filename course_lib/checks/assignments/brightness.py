@@ -1,43 +1,75 @@
-"""Checks of the brightness assignment: ``average_brightness`` and ``BrightnessNode``.
+"""The brightness assignment: its spec, its notebook's words and its checks (``average_brightness``
+and ``BrightnessNode``).
 
-The contract (also in the notebook and in assignments/README.md):
-
-- ``average_brightness(image: np.ndarray) -> int``: the mean of all bytes of the image (every
-  channel of every pixel), rounded down as the tutorial's integer division does
-  (``sum // count``), returned as an int. Works for colour (H, W, 3) and grey (H, W) images.
-- ``BrightnessNode()``: node name ``brightness_node``; subscribes ``/image`` (sensor_msgs/Image,
-  sensor-data QoS) and publishes ``/brightness`` (std_msgs/UInt8, sensor-data QoS), one value
-  per frame; accepts bgr8 and mono8 frames; keeps up with 1920x1080 frames at 30 Hz; its names
-  can be remapped (``--ros-args -r __node:=... -r /image:=...``).
-- ``main(args=None)`` in brightness_node.py runs the node until Ctrl-C.
-
-They live in the ament_python package ``brightness`` (``ros2_ws/src/brightness``), module
-``brightness/brightness_node.py``, executable ``brightness_node``; its package.xml declares
-rclpy, sensor_msgs and std_msgs. Whether the node keeps up with 30 Hz is judged on processor time
-against a yardstick node (:mod:`course_lib.checks.brightness_throughput`).
+The contract is the notebook's introduction (BRIGHTNESS_INTRO). Whether the node keeps up with
+30 Hz is judged on processor time against a yardstick node (:mod:`course_lib.checks.brightness_throughput`).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from course_lib.checks import brightness_throughput, packages, runner
+from course_lib.checks import brightness_throughput, packages
 from course_lib.checks.context import Context, scaled
 from course_lib.checks.registry import check
+from course_lib.checks.spec import Assignment, NotebookText
 
-ASSIGNMENT = "brightness"
+# --- the notebook's words (markdown) and the spec ----------------------------------------
+
+BRIGHTNESS_INTRO = """
+# Assignment: image brightness
+
+You write a small vision node in two layers, as in the lecture: a plain numpy function that does
+the work, and a ROS 2 node that only converts messages and calls it, in an `ament_python` package.
+
+**Contract** (this is exactly what is graded):
+
+1. The package **`brightness`** in `ros2_ws/src/brightness`, with the executable
+   **`brightness_node`** (`ros2 run brightness brightness_node`), whose `package.xml` declares every
+   ROS package its code imports (`rclpy`, `sensor_msgs`, `std_msgs`).
+2. In `brightness/brightness_node.py`: `average_brightness(image: np.ndarray) -> int`, the mean of
+   *all* bytes of the image (every channel of every pixel), rounded **down** as the tutorial's integer
+   division `sum // count`, returned as a Python `int`. It works for colour `(H, W, 3)` and grey
+   `(H, W)` images.
+3. `BrightnessNode()`: a node named **`brightness_node`** (the name lesson 02 gives it) that subscribes **`/image`**
+   (`sensor_msgs/msg/Image`) and publishes **`/brightness`** (`std_msgs/msg/UInt8`), both with the
+   **sensor-data QoS** (`qos_profile_sensor_data`), one value per frame. It accepts `bgr8` and
+   `mono8` frames, keeps up with 1920×1080 frames at 30 Hz, and its names can be remapped
+   (`--ros-args -r __node:=other -r /image:=/camera/image`). `main(args=None)` runs it until Ctrl-C
+   (the executable calls it).
+
+The grader builds your workspace, runs `ros2 run brightness brightness_node` in a separate process,
+publishes generated frames and compares what comes back with the right answer. Each check cell prints
+what is right and what is wrong; at grading the same checks run again with frames you have not seen.
+"""
+
+BRIGHTNESS_NODE_CHECK = """\
+The check starts your node as `ros2 run brightness brightness_node` (build first) in a ROS domain of
+its own, publishes frames on `/image` and reads `/brightness`. A Python loop over every byte is too
+slow for 30 frames of 1920×1080 per second: let numpy do the sum.
+"""
+
+#: The spec: what assignments/build.py, the grader and the checks below read about it.
+SPEC = Assignment("brightness", "02", {"brightness": ("brightness_node",)},
+           NotebookText(intro=BRIGHTNESS_INTRO, plain_ros=(
+               "In plain ROS 2 the package comes from `ros2 pkg create --build-type "
+               "ament_python --dependencies rclpy sensor_msgs std_msgs --node-name brightness_node brightness`."),
+               checks={"values": ("`average_brightness`",), "node": ("`BrightnessNode`", BRIGHTNESS_NODE_CHECK)},
+               names="average_brightness, BrightnessNode",
+               try_text="Try your function (this cell is yours to change):", try_code="""
+grey = np.array([[0, 255], [255, 255]], dtype=np.uint8)
+try:
+    print(average_brightness(grey))   # (0 + 255 + 255 + 255) // 4 = 191
+except NotImplementedError:  # the stub: Run All goes on to the checks, which say what is missing
+    print("Not done yet: average_brightness still raises NotImplementedError. Write it in the "
+          "brightness_node.py cell above, run that cell and the import cell, then this one.")
+"""),
+           functions=("brightness", "brightness.brightness_node"), answers="key")
+selfcheck, grade = SPEC.selfcheck, SPEC.grade  # what the notebook calls: checks.selfcheck("...")
+
 #: The package and executable of the node: ``ros2 run brightness brightness_node``.
-PACKAGE, EXECUTABLE = "brightness", "brightness_node"
-
-
-def selfcheck(name: str):
-    """Run check `name` with the self-check seed and print what is right and wrong."""
-    return runner.selfcheck(ASSIGNMENT, name)
-
-
-def grade(name: str):
-    """Run check `name` with a fresh seed (grading)."""
-    return runner.grade(ASSIGNMENT, name)
+(PACKAGE,) = SPEC.packages
+EXECUTABLE = SPEC.executable(PACKAGE)
 
 
 def _test_images(rng: np.random.Generator) -> list[tuple[str, np.ndarray]]:
