@@ -47,6 +47,12 @@ def test_the_package_is_what_colcon_would_install(tmp_path):
     assert (tmp_path / "share/robot_sim/launch/husky.launch.xml").is_file()
     script = tmp_path / "lib/robot_sim/simulator"
     assert script.read_text().startswith(f"#!{sys.executable}\n") and "simulator_node import main" in script.read_text()
+    # the stand-ins of tools PyPI lacks, under upstream's package and executable names
+    for package, executable in (("tf2_ros", "static_transform_publisher"), ("tf2_ros", "tf2_echo"),
+                                ("tf2_tools", "view_frames"), ("teleop_twist_keyboard", "teleop_twist_keyboard")):
+        assert (tmp_path / "share/ament_index/resource_index/packages" / package).is_file()
+        assert f"<name>{package}</name>" in (tmp_path / "share" / package / "package.xml").read_text()
+        assert (tmp_path / "lib" / package / executable).stat().st_mode & 0o111
 
 
 def first_scan(domain_id, command: list[str]) -> LaserScan:

@@ -239,17 +239,40 @@ class Buffer:
         r.x, r.y, r.z, r.w = (float(v) for v in rotation)
         return found
 
-    def can_transform(self, target_frame: str, source_frame: str, time, timeout: Duration | None = None) -> bool:
+    def can_transform(self, target_frame: str, source_frame: str, time, timeout: Duration | None = None,
+                      return_debug_tuple: bool = False):
+        """Whether the lookup would succeed; with `return_debug_tuple`, (that, tf2's reason why not)."""
         try:
             self.lookup_transform(target_frame, source_frame, time, timeout)
-            return True
-        except TransformException:
-            return False
+            return (True, "") if return_debug_tuple else True
+        except TransformException as error:
+            if not return_debug_tuple:
+                return False
+            known = self._frames()
+            for frame, argument in ((target_frame, "target_frame"), (source_frame, "source_frame")):
+                if frame.lstrip("/") not in known:  # canTransform's words, not lookupTransform's
+                    return False, (f'Invalid frame ID "{frame}" passed to canTransform argument {argument} '
+                                   "- frame does not exist")
+            return False, str(error)
 
     def all_frames_as_yaml(self) -> str:
-        """Each frame with its parent, as tf2's ``allFramesAsYAML`` (what view_frames reads)."""
+        """Each frame with its parent and what the buffer holds of it, as tf2's ``allFramesAsYAML``
+        (what view_frames draws): a static transform's rate is tf2's 10000 (one entry over no time)."""
+        lines = []
         with self._changed:
-            return "".join(f"{child}: \n  parent: '{link.parent}'\n" for child, link in sorted(self._links.items()))
+            for child, link in sorted(self._links.items()):
+                newest, oldest = link.stamps[-1] / 1e9, link.stamps[0] / 1e9
+                rate = len(link.stamps) / max(newest - oldest, 0.0001)
+                lines.append(f"{child}: \n  parent: '{link.parent}'\n  broadcaster: 'default_authority'\n"
+                             f"  rate: {rate:.3f}\n  most_recent_transform: {newest:.6f}\n"
+                             f"  oldest_transform: {oldest:.6f}\n  buffer_length: {newest - oldest:.3f}\n")
+        return "".join(lines)
+
+    def all_frames_as_string(self) -> str:
+        """One line per frame, as tf2's ``allFramesAsString`` (what tf2_echo prints on a failure)."""
+        with self._changed:
+            return "".join(f"Frame {child} exists with parent {link.parent}.\n"
+                           for child, link in sorted(self._links.items()))
 
 
 class TransformListener:
