@@ -12,10 +12,14 @@ from launch_demo import make_prefix
 from process_support import marker, processes_with
 
 from autograder import answers
+from course_lib.ros2cli import daemon
 
 # The tests run graded checks (runner.execute(..., mode="graded")) as the grader does: the grader
 # hands its checks the answer keys through the contract (course_lib.checks.answers).
 os.environ.update(answers.environment())
+# A ros2 daemon that a test's `ros2` command starts ends with this worker at the latest, and in a
+# reserved ROS domain as soon as the reservation ends (course_lib.ros2cli.daemon).
+os.environ[daemon.OWNER_ENV] = str(os.getpid())
 
 
 #: Seconds after pytest-timeout's limit at which a test still running ends its worker process.

@@ -131,6 +131,21 @@ def wait_for_every_process(timeout: float) -> bool:
         return waiting.spin_until(lambda: _every_process_shown(node, heard, here), timeout, poll=_SETTLE_POLL)
 
 
+def processes_not_shown(node, heard) -> dict:
+    """The other ROS processes on this machine, in the node's domain, whose nodes and endpoints
+    the graph does not show in full yet (a long-lived reader ``heard`` of their announcements,
+    the ros2 daemon's, asks before each answer): {process id: what it announced last, None when
+    nothing was heard from it yet}. Processes of another user cannot be told and are left out."""
+    here = [pid for pid in _participants_here(node.context.get_domain_id())
+            if pid is not None and pid != os.getpid() and process_tree.running(pid)]
+    if not here:
+        return {}
+    latest = heard.latest()
+    shown = _processes_shown(node, latest)
+    announced = {_process_of(participant): what for participant, what in latest.items()}
+    return {pid: announced.get(pid & 0xFFFF) for pid in here if pid & 0xFFFF not in shown}
+
+
 def _announcements(node, here: list[int | None]):
     """A reader of what the processes of `here` announce, for the length of a wait; none when no
     other process is here."""

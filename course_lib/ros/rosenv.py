@@ -306,7 +306,8 @@ class DomainReservation:
         return f"DomainReservation({self.domain_id})"
 
 
-def _lock_dir() -> Path:
+def reservation_dir() -> Path:
+    """The folder of this user's domain reservations (one lock file per reserved domain id)."""
     path = Path(tempfile.gettempdir()) / f"course_lib-domains-{os.getuid()}"
     path.mkdir(mode=0o700, exist_ok=True)
     return path
@@ -318,7 +319,7 @@ def reserve_domain_id(candidates=RESERVABLE_DOMAIN_IDS) -> DomainReservation:
     Raises:
         RuntimeError: every candidate is taken (stop other test or grading runs).
     """
-    lock_dir = _lock_dir()
+    lock_dir = reservation_dir()
     start = os.getpid() % len(candidates)  # spread parallel callers over the range
     ordered = list(candidates)[start:] + list(candidates)[:start]
     for domain_id in ordered:

@@ -16,6 +16,7 @@ real tool's verbs, options and output for what it supports, each a thin layer ov
 ``ros2 param list|get|set|dump|load``          :mod:`.param` (course_lib.ros.parameters)
 ``ros2 interface show|list|package|packages``  :mod:`.interface` (course_lib.ros.interfaces)
 ``ros2 pkg create|list|executables|prefix``    :mod:`.pkg` (course_lib.ros.workspace, ament)
+``ros2 daemon start|stop|status``              :mod:`.daemon` (the graph verbs ask it: .daemon_server)
 =============================================  =============================================
 
 Anything else (a command, a verb or an option) prints one line that says so and names what is

@@ -6,6 +6,7 @@ from course_lib.ros2cli.common import (
     DEFAULT_SPIN_TIME,
     Verb,
     print_names,
+    print_types,
     print_types_of,
     run_group,
     wait_for_answer,
@@ -34,9 +35,19 @@ def _list_arguments(parser) -> None:
                         help="Only display the number of actions discovered")
 
 
-def _list(args) -> None:
+def _pairs_of(args) -> list[tuple[str, list[str]]]:
+    """action_pairs from the daemon, else from this process's graph after discovery."""
+    from course_lib.ros2cli import daemon
+
+    pairs = daemon.graph_answer(args, "actions")
+    if pairs is not daemon.DIRECT:
+        return [(name, kinds) for name, kinds in pairs]
     wait_for_whole_graph(DEFAULT_SPIN_TIME)  # ros2action's verbs have no --spin-time
-    print_names(action_pairs(), args.show_types, args.count_actions)
+    return action_pairs()
+
+
+def _list(args) -> None:
+    print_names(_pairs_of(args), args.show_types, args.count_actions)
 
 
 def _type_arguments(parser) -> None:
@@ -44,6 +55,11 @@ def _type_arguments(parser) -> None:
 
 
 def _type(args) -> int:
+    from course_lib.ros2cli import daemon
+
+    pairs = daemon.graph_answer(args, "actions")
+    if pairs is not daemon.DIRECT:
+        return print_types(dict(pairs).get(args.action_name, []))
     return print_types_of(args.action_name, action_pairs, DEFAULT_SPIN_TIME)
 
 
@@ -56,7 +72,12 @@ def _info_arguments(parser) -> None:
                         help="Only display the number of action clients and action servers")
 
 
-def _info(args) -> str | None:
+def action_ends(action_name: str) -> dict[str, list[tuple[str, list[str]]]]:
+    """{"clients": [(node, [type, ...]), ...], "servers": [...]} of an action, as the graph shows them.
+
+    Raises:
+        ValueError: the name is not a valid one (rclpy's words).
+    """
     from rclpy.action import get_action_client_names_and_types_by_node, get_action_server_names_and_types_by_node
     from rclpy.exceptions import InvalidTopicNameException
 
@@ -64,16 +85,33 @@ def _info(args) -> str | None:
 
     node = session.tool_node()
     try:
-        name = node.resolve_topic_name(args.action_name)
+        name = node.resolve_topic_name(action_name)
     except InvalidTopicNameException as error:
-        return str(error)
-    wait_for_whole_graph(DEFAULT_SPIN_TIME)  # all the clients and servers, not the first found
+        raise ValueError(str(error)) from None
     ends = {"clients": [], "servers": []}
     for node_name, namespace in node.get_node_names_and_namespaces():
         full = namespace.rstrip("/") + "/" + node_name
         for side, by_node in (("clients", get_action_client_names_and_types_by_node),
                               ("servers", get_action_server_names_and_types_by_node)):
             ends[side] += [(full, kinds) for action, kinds in by_node(node, node_name, namespace) if action == name]
+    return ends
+
+
+def _info(args) -> str | None:
+    from course_lib.ros2cli import daemon
+
+    ends = daemon.graph_answer(args, "action_ends", action_name=args.action_name)
+    if ends is daemon.DIRECT:
+        from rclpy.exceptions import InvalidTopicNameException
+
+        from course_lib.ros import session
+
+        try:  # an invalid name fails before the wait
+            session.tool_node().resolve_topic_name(args.action_name)
+        except InvalidTopicNameException as error:
+            return str(error)
+        wait_for_whole_graph(DEFAULT_SPIN_TIME)  # all the clients and servers, not the first found
+        ends = action_ends(args.action_name)
     print(f"Action: {args.action_name}")
     for side in ("clients", "servers"):
         print(f"Action {side}: {len(ends[side])}")

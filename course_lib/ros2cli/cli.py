@@ -15,6 +15,7 @@ from course_lib.ros2cli.common import FULL_INSTALL, Unsupported, unsupported
 COMMANDS = {
     "action": "Various action related sub-commands",
     "bag": "Various rosbag related sub-commands",
+    "daemon": "Various daemon related sub-commands",
     "interface": "Show information about ROS interfaces",
     "launch": "Run a launch file",
     "node": "Various node related sub-commands",
@@ -26,7 +27,7 @@ COMMANDS = {
 }
 
 #: Commands of a full ros2cli install that the course's ros2 leaves out (named in --help).
-LEFT_OUT = ("component", "daemon", "doctor", "lifecycle", "multicast", "wtf")
+LEFT_OUT = ("component", "doctor", "lifecycle", "multicast", "wtf")
 
 
 #: ros2cli's one option before the command (Jazzy), with its help text.

@@ -134,17 +134,52 @@ def print_names_of_type(pairs: list[tuple[str, list[str]]], type_name: str, coun
     print_names([(name, kinds) for name, kinds in pairs if type_name in kinds], False, count)
 
 
+# --- argument types (ros2topic's) ------------------------------------------------------
+
+def positive_float(text: str) -> float:
+    """An argparse type: a number above 0, in ros2topic's words when it is not."""
+    import argparse
+
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError("Expects a floating point number") from None
+    if value <= 0:
+        raise argparse.ArgumentTypeError("Value must be positive")
+    return value
+
+
+def positive_int(text: str) -> int:
+    """An argparse type: a whole number above 0."""
+    import argparse
+
+    try:
+        value = int(text)
+    except ValueError:
+        value = -1
+    if value <= 0:
+        raise argparse.ArgumentTypeError("value must be a positive integer")
+    return value
+
+
+def nonnegative_int(text: str) -> int:
+    """An argparse type: a whole number, 0 or more."""
+    value = int(text)
+    if value < 0:
+        raise ValueError("Value must be positive or zero")
+    return value
+
+
 # --- discovery ----------------------------------------------------------------------------
 
 def add_discovery_arguments(parser: argparse.ArgumentParser, daemon: bool = True) -> None:
     """ros2cli's node options: --spin-time and (where ros2cli has it) --no-daemon."""
     parser.add_argument(
         "--spin-time", type=float, default=DEFAULT_SPIN_TIME,
-        help="Spin time in seconds to wait for discovery (default: %(default)s)")
+        help="Spin time in seconds to wait for discovery (only applies when not using an already running daemon)"
+        if daemon else "Spin time in seconds to wait for discovery (default: %(default)s)")
     if daemon:
-        parser.add_argument(
-            "--no-daemon", action="store_true",
-            help="Do not spawn nor use a daemon (the course's ros2 never does)")
+        parser.add_argument("--no-daemon", action="store_true", help="Do not spawn nor use an already running daemon")
 
 
 def wait_for_whole_graph(spin_time: float) -> None:

@@ -15,10 +15,14 @@ def _list_arguments(parser) -> None:
 
 
 def _list(args) -> None:
-    from course_lib.ros import graph
+    from course_lib.ros2cli import daemon
 
-    wait_for_whole_graph(args.spin_time)
-    names = graph.node_list(all=args.all)
+    names = daemon.graph_answer(args, "nodes", all=args.all)
+    if names is daemon.DIRECT:
+        from course_lib.ros import graph
+
+        wait_for_whole_graph(args.spin_time)
+        names = graph.node_list(all=args.all)
     if args.count_nodes:
         print(len(names))
     elif names:
@@ -36,14 +40,23 @@ def _info_arguments(parser) -> None:
 
 
 def _info(args) -> str | None:
-    from course_lib.ros import graph, graph_info
+    from course_lib.ros import graph_info
+    from course_lib.ros2cli import daemon
 
-    wait_for_whole_graph(args.spin_time)  # all the node's endpoints, not the first found
     # Like ros2cli: the name as given (a full name), among the nodes --include-hidden shows.
-    count = graph.node_list(all=args.include_hidden).count(args.node_name)
+    answer = daemon.graph_answer(args, "node_info", name=args.node_name, include_hidden=args.include_hidden)
+    if answer is None:
+        count, info = 0, None
+    elif answer is not daemon.DIRECT:
+        count, info = answer["count"], daemon.node_info_of(answer["info"])
+    else:
+        from course_lib.ros import graph
+
+        wait_for_whole_graph(args.spin_time)  # all the node's endpoints, not the first found
+        count = graph.node_list(all=args.include_hidden).count(args.node_name)
+        info = graph.node_info(args.node_name, include_hidden=args.include_hidden, timeout=0.0) if count else None
     if not count:
         return f"Unable to find node '{args.node_name}'"
-    info = graph.node_info(args.node_name, include_hidden=args.include_hidden, timeout=0.0)
     if count > 1:
         print(f'There are {count} nodes in the graph with the exact name "{info.name}". '
               "You are seeing information about only one of them.", file=sys.stderr)

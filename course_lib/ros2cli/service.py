@@ -10,6 +10,7 @@ from course_lib.ros2cli.common import (
     add_discovery_arguments,
     print_names,
     print_names_of_type,
+    print_types,
     print_types_of,
     run_group,
     wait_for_answer,
@@ -33,6 +34,19 @@ def service_pairs(include_hidden: bool) -> list[tuple[str, list[str]]]:
                   if include_hidden or not topic_or_service_is_hidden(name))
 
 
+def _pairs_of(args, include_hidden: bool, settle: bool = True) -> list[tuple[str, list[str]]]:
+    """service_pairs from the daemon, else from this process's graph (after discovery, if
+    ``settle``)."""
+    from course_lib.ros2cli import daemon
+
+    pairs = daemon.graph_answer(args, "services", include_hidden=include_hidden)
+    if pairs is not daemon.DIRECT:
+        return [(name, kinds) for name, kinds in pairs]
+    if settle:
+        wait_for_whole_graph(getattr(args, "spin_time", DEFAULT_SPIN_TIME))
+    return service_pairs(include_hidden)
+
+
 def _add_hidden_argument(parser) -> None:
     parser.add_argument("--include-hidden-services", action="store_true", help="Consider hidden services as well")
 
@@ -48,8 +62,7 @@ def _list_arguments(parser) -> None:
 
 
 def _list(args) -> None:
-    wait_for_whole_graph(args.spin_time)
-    print_names(service_pairs(args.include_hidden_services), args.show_types, args.count_services)
+    print_names(_pairs_of(args, args.include_hidden_services), args.show_types, args.count_services)
 
 
 # --- ros2 service type -------------------------------------------------------------------
@@ -61,6 +74,11 @@ def _type_arguments(parser) -> None:
 
 def _type(args) -> int:
     # Like ros2service: an unknown service prints nothing and ends with exit code 1.
+    from course_lib.ros2cli import daemon
+
+    pairs = daemon.graph_answer(args, "services", include_hidden=args.include_hidden_services)
+    if pairs is not daemon.DIRECT:
+        return print_types(dict(pairs).get(args.service_name, []))
     return print_types_of(args.service_name, lambda: service_pairs(args.include_hidden_services), DEFAULT_SPIN_TIME)
 
 
@@ -75,8 +93,7 @@ def _find_arguments(parser) -> None:
 
 
 def _find(args) -> None:
-    wait_for_whole_graph(DEFAULT_SPIN_TIME)
-    print_names_of_type(service_pairs(args.include_hidden_services), args.service_type, args.count_services)
+    print_names_of_type(_pairs_of(args, args.include_hidden_services), args.service_type, args.count_services)
 
 
 # --- ros2 service call -------------------------------------------------------------------

@@ -12,6 +12,7 @@ from course_lib.ros2cli.common import (
     loop_limit,
     print_names,
     print_names_of_type,
+    print_types,
     print_types_of,
     qos_from_arguments,
     qos_overridden,
@@ -22,6 +23,9 @@ from course_lib.ros2cli.common import (
     wait_for_whole_graph,
     wait_until,
 )
+from course_lib.ros2cli.common import nonnegative_int as _nonnegative_int
+from course_lib.ros2cli.common import positive_float as _positive_float
+from course_lib.ros2cli.common import positive_int as _positive_int
 
 #: Verbs of ros2cli's ``ros2 topic`` that the course leaves out.
 LEFT_OUT = ()
@@ -33,43 +37,20 @@ DELAY_WINDOW = 10000
 ACK_SECONDS = 10.0
 
 
-def _positive_float(text: str) -> float:
-    import argparse
-
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError("Expects a floating point number") from None
-    if value <= 0:
-        raise argparse.ArgumentTypeError("Value must be positive")
-    return value
-
-
-def _positive_int(text: str) -> int:
-    import argparse
-
-    try:
-        value = int(text)
-    except ValueError:
-        value = -1
-    if value <= 0:
-        raise argparse.ArgumentTypeError("value must be a positive integer")
-    return value
-
-
-def _nonnegative_int(text: str) -> int:
-    value = int(text)
-    if value < 0:
-        raise ValueError("Value must be positive or zero")
-    return value
-
-
 def _topic_shown(topic: str):
     """A function telling whether the graph shows ``topic`` (hidden or not) with its type."""
     from course_lib.ros import graph, session
 
     name = session.tool_node().resolve_topic_name(topic)
     return lambda: any(other == name for other in graph.topic_list(include_hidden=True))
+
+
+def _daemon_says_not_shown(args) -> bool:
+    """True when the daemon answers and its graph has no topic ``args.topic_name``: a verb that
+    needs the topic's type fails at once (ros2cli's echo asks its daemon for it)."""
+    from course_lib.ros2cli import daemon
+
+    return daemon.graph_answer(args, "topic_shown", name=args.topic_name) is False
 
 
 def _not_published_yet(topic: str) -> None:
@@ -87,13 +68,40 @@ def _list_arguments(parser) -> None:
     parser.add_argument("-v", "--verbose", action="store_true", help="List full details about each topic")
 
 
-def _list(args) -> None:
+def _topic_pairs(args, include_hidden: bool) -> list[tuple[str, list[str]]]:
+    """(name, [type, ...]) of every topic, from the daemon, else after discovery in this process."""
+    from course_lib.ros2cli import daemon
+
+    pairs = daemon.graph_answer(args, "topics", include_hidden=include_hidden)
+    if pairs is not daemon.DIRECT:
+        return [(name, kinds) for name, kinds in pairs]
     from course_lib.ros import graph
 
     wait_for_whole_graph(args.spin_time)
-    pairs = graph.topic_list(types=True, include_hidden=args.include_hidden_topics)
+    return graph.topic_list(types=True, include_hidden=include_hidden)
+
+
+def _topic_info(args, name: str, verbose: bool, settled: bool = False):
+    """The graph_info.TopicInfo of topic ``name``, from the daemon, else from this process's graph
+    (after discovery unless ``settled``: waited for already); None when the graph has no such topic."""
+    from course_lib.ros import graph
+    from course_lib.ros2cli import daemon
+
+    answer = daemon.graph_answer(args, "topic_info", name=name, verbose=verbose)
+    if answer is not daemon.DIRECT:
+        return None if answer is None else daemon.topic_info_of(answer)
+    if not settled:
+        wait_for_whole_graph(args.spin_time)  # counts and endpoints: all of them, not the first found
+    if not _topic_shown(name)():
+        return None
+    # The wait is for the endpoints' node names, which DDS may announce a moment after them.
+    return graph.topic_info(name, verbose=verbose, timeout=args.spin_time + DISCOVERY_BACKSTOP)
+
+
+def _list(args) -> None:
+    pairs = _topic_pairs(args, args.include_hidden_topics)
     if pairs and args.verbose and not args.count_topics:
-        counts = {name: graph.topic_info(name, verbose=False) for name, _ in pairs}
+        counts = {name: _topic_info(args, name, verbose=False, settled=True) for name, _ in pairs}
         for title, count_of, noun in (("Published", "publisher_count", "publisher"),
                                       ("Subscribed", "subscription_count", "subscriber")):
             print(f"{title} topics:")
@@ -139,7 +147,7 @@ def _echo(args) -> int | str | None:
             message_yaml.message_class(args.message_type)
         except ValueError:
             return "The passed message type is invalid"
-    elif not wait_for_name(_topic_shown(args.topic_name), args.spin_time):
+    elif _daemon_says_not_shown(args) or not wait_for_name(_topic_shown(args.topic_name), args.spin_time):
         _not_published_yet(args.topic_name)
         return "Could not determine the type for the passed topic"
     truncate = None if args.full_length else args.truncate_length
@@ -327,7 +335,11 @@ def _type_arguments(parser) -> None:
 
 def _type(args) -> int:
     from course_lib.ros import graph
+    from course_lib.ros2cli import daemon
 
+    pairs = daemon.graph_answer(args, "topics", include_hidden=args.include_hidden_topics)
+    if pairs is not daemon.DIRECT:
+        return print_types(dict(pairs).get(args.topic_name, []))
     return print_types_of(args.topic_name,
                           lambda: graph.topic_list(types=True, include_hidden=args.include_hidden_topics),
                           args.spin_time)
@@ -342,11 +354,7 @@ def _find_arguments(parser) -> None:
 
 
 def _find(args) -> None:
-    from course_lib.ros import graph
-
-    wait_for_whole_graph(args.spin_time)
-    print_names_of_type(graph.topic_list(types=True, include_hidden=args.include_hidden_topics), args.topic_type,
-                        args.count_topics)
+    print_names_of_type(_topic_pairs(args, args.include_hidden_topics), args.topic_type, args.count_topics)
 
 
 # --- ros2 topic info ---------------------------------------------------------------------
@@ -360,13 +368,11 @@ def _info_arguments(parser) -> None:
 
 
 def _info(args) -> str | None:
-    from course_lib.ros import graph, graph_info
+    from course_lib.ros import graph_info
 
-    wait_for_whole_graph(args.spin_time)  # counts and endpoints: all of them, not the first found
-    if not _topic_shown(args.topic_name)():
+    info = _topic_info(args, args.topic_name, args.verbose)
+    if info is None:
         return f"Unknown topic '{args.topic_name}'"
-    # The wait is for the endpoints' node names, which DDS may announce a moment after them.
-    info = graph.topic_info(args.topic_name, verbose=args.verbose, timeout=args.spin_time + DISCOVERY_BACKSTOP)
     # ros2cli ends every part (the last one too) with a blank line in verbose mode.
     print(graph_info.format_topic_info(info, verbose=args.verbose), end="\n" if args.verbose else "")
     return None
