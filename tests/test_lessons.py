@@ -9,6 +9,7 @@ from itertools import pairwise
 from pathlib import Path
 
 import nbformat
+import numpy as np
 from rclpy.qos import ReliabilityPolicy
 
 from course_lib.checks import assignments
@@ -17,6 +18,7 @@ from course_lib.ros import session
 
 NOTEBOOKS = Path(__file__).resolve().parents[1] / "notebooks"
 LESSON_02 = NOTEBOOKS / "02_images_and_brightness.ipynb"
+LESSON_06 = NOTEBOOKS / "06_mobile_robot.ipynb"
 
 
 def _cells(path: Path, kind: str) -> list[str]:
@@ -150,3 +152,28 @@ def test_lesson_04_defines_the_interfaces_the_services_actions_assignment_gives(
     code = "\n".join(_cells(NOTEBOOKS / "04_services_and_actions.ipynb", "code"))
     for name, path in (("MARKERS_IN_VIEW", "srv/MarkersInView.srv"), ("FIND_PICTURES", "action/FindPictures.action")):
         assert f'{name} = """{(reference / path).read_text()}"""' in code, path
+
+
+def test_lesson_06_drives_its_plain_functions_to_the_pillar_for_other_seeds_too():
+    """Lesson 06's pillar_in_scan and p_controller, in the plain simulation as its drive_in_simulation
+    runs them: within the lesson's 20 simulated seconds the front of the robot (0.495 m ahead of
+    base_link) stops about half a metre from the pillar, as the lesson says, never touching it, for
+    the lesson's seed and for pillars far off to either side; its PILLAR_RADIUS is the world's."""
+    import math
+
+    from course_lib.robot.simulation import Simulation, pillar_position
+
+    code = "\n".join(_cells(LESSON_06, "code"))
+    constants = {name: float(re.search(rf"^{name} = ([\d.]+)", code, re.M).group(1))
+                 for name in ("SEED", "PILLAR_RADIUS", "SCAN_RATE", "DRIVE_SECONDS")}
+    assert constants["PILLAR_RADIUS"] == Simulation("pillar").pillar_radius
+    space: dict = dict(constants)
+    exec(_classes_and_functions(_cells(LESSON_06, "code")), space)  # noqa: S102 (the lesson's own code)
+    for seed in (int(constants["SEED"]), 7, 10):
+        sim, path = space["drive_in_simulation"](seed, constants["DRIVE_SECONDS"])
+        x, y, _ = sim.pose()
+        px, py = pillar_position(seed)
+        front_gap = math.hypot(px - x, py - y) - constants["PILLAR_RADIUS"] - 0.495
+        assert 0.4 < front_gap < 0.55, (seed, front_gap)
+        assert len(path) == constants["DRIVE_SECONDS"] * constants["SCAN_RATE"] + 1
+        assert not sim.touching() and float(np.hypot(*np.diff(path[-5:], axis=0).T).max()) < 1e-3, seed

@@ -130,7 +130,7 @@ def test_the_pad_publishes_while_a_key_is_held_and_stops_on_release(pad):
     beats = iter(range(1, 10**6))
 
     def hold(keys):
-        widget.keys, widget.beat = keys, next(beats)
+        widget.held, widget.beat = keys, next(beats)
 
     def heard_values():
         return heard and (heard[-1].linear.x, heard[-1].angular.z)
@@ -150,7 +150,7 @@ def test_the_pad_publishes_while_a_key_is_held_and_stops_on_release(pad):
 
 def test_the_pad_stops_when_the_browser_goes_silent(pad):
     widget, heard = pad
-    widget.keys, widget.beat = ["i"], widget.beat + 1
+    widget.held, widget.beat = ["i"], widget.beat + 1
     assert wait_until(lambda: heard and heard[-1].linear.x == 0.5)
     # no further heartbeat: a closed tab or a lost connection; the deadman stops the robot
     assert wait_until(lambda: heard[-1].linear.x == 0.0 and not widget.moving)

@@ -32,7 +32,7 @@ function render({ model, el }) {
   pad.style.cssText = "display:inline-block;padding:8px 12px;border:2px solid #888;border-radius:6px;" +
     "font-family:monospace;white-space:pre;outline:none;cursor:pointer;user-select:none";
   const show = () => {
-    const held = model.get("keys");
+    const held = model.get("held");
     pad.textContent = "   u    i    o\\n   j    k    l\\n   m    ,    .\\n" +
       (document.activeElement === pad ? "driving: hold a key" + (held.length ? " [" + held.join("") + "]" : "")
                                       : "click here to drive") + "\\n" + model.get("status");
@@ -41,7 +41,7 @@ function render({ model, el }) {
   const held = new Set();
   let beat = null;
   const send = () => {
-    model.set("keys", [...held]);
+    model.set("held", [...held]);
     model.set("beat", model.get("beat") + 1);
     model.save_changes();
     show();
@@ -84,7 +84,8 @@ class KeyboardTeleop(anywidget.AnyWidget):
     """The keyboard pad (see the module's docstring)."""
 
     _esm = traitlets.Unicode(_ESM).tag(sync=True)
-    keys = traitlets.List(traitlets.Unicode()).tag(sync=True)
+    # Not `keys`: ipywidgets' Widget.keys lists the synced traits, and a trait of that name empties the state
+    held = traitlets.List(traitlets.Unicode()).tag(sync=True)
     beat = traitlets.Int(0).tag(sync=True)
     speed_keys = traitlets.List(traitlets.Unicode(), list(SPEED_BINDINGS)).tag(sync=True)
     status = traitlets.Unicode("").tag(sync=True)
@@ -103,7 +104,7 @@ class KeyboardTeleop(anywidget.AnyWidget):
         self.node = session.add_node(Node("teleop_widget"))
         self.publisher = self.node.create_publisher(Twist, topic, 10)
         self.timer = self.node.create_timer(1.0 / rate, self.tick)
-        self.observe(self.on_beat, names=["keys", "beat"])
+        self.observe(self.on_beat, names=["held", "beat"])
         self.on_msg(self.on_message)
         self.status = self.speeds()
 
@@ -120,7 +121,7 @@ class KeyboardTeleop(anywidget.AnyWidget):
 
     def held_direction(self) -> tuple | None:
         """The Twist's values for the newest held moving key, or None when none is held (or heard of lately)."""
-        moving = [key for key in self.keys if key in MOVE_BINDINGS]
+        moving = [key for key in self.held if key in MOVE_BINDINGS]
         if not moving or time.monotonic() - self.last_beat > self.deadman:
             return None
         apply_key(self.state, moving[-1])

@@ -13,6 +13,7 @@ A lesson calls them as ``selfcheck.<name>``; they live by kind of answer:
 - :mod:`.brightness_package`: a package built and run as ``ros2 run`` (lesson 02);
 - :mod:`.action_exercise`: an action client, against an action server of the check's (lesson 04);
 - :mod:`.bag_exercise`: a function that reads a recorded bag (lesson 05);
+- :mod:`.mobile_robot`: a function of a laser scan, on the simulated robot's scans (lesson 06);
 - :mod:`.lesson_quiz`: the short quiz at the end of each lesson (``show_quiz``, ``check_quiz``),
   with course_lib.checks.multiple_choice (a question and a well-formed answer), which the graded
   quiz shares;
@@ -31,6 +32,7 @@ from course_lib.selfcheck.brightness_package import (
 )
 from course_lib.selfcheck.launch_exercise import task_launch_yaml
 from course_lib.selfcheck.lesson_quiz import check_quiz, show_quiz
+from course_lib.selfcheck.mobile_robot import nearest_obstacle_exercise
 from course_lib.selfcheck.node_exercises import publisher_exercise, subscriber_exercise
 from course_lib.selfcheck.tasks import (
                                                      task1_node_name,
@@ -43,6 +45,6 @@ from course_lib.selfcheck.verdicts import PLACEHOLDERS, Verdict
 
 __all__ = ["BRIGHTNESS_ENTRY_POINT", "BRIGHTNESS_EXECUTABLE", "BRIGHTNESS_PACKAGE", "CHECK_CAMERA_TOPIC",
            "PLACEHOLDERS", "PYTHON_DEPENDENCIES", "Verdict", "brightness_package_exercise", "check_quiz",
-           "find_pictures_exercise", "publisher_exercise", "read_topic_exercise", "show_quiz", "subscriber_exercise",
-           "task1_node_name", "task2_echo", "task3_brightness_on_change", "task4_order_corners", "task_launch_yaml",
-           "task_picture_corners"]
+           "find_pictures_exercise", "nearest_obstacle_exercise", "publisher_exercise", "read_topic_exercise",
+           "show_quiz", "subscriber_exercise", "task1_node_name", "task2_echo", "task3_brightness_on_change",
+           "task4_order_corners", "task_launch_yaml", "task_picture_corners"]

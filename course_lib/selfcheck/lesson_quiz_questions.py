@@ -272,4 +272,41 @@ LESSON_QUIZZES: dict[str, tuple[Answered, ...]] = {
                 "c": "The node subscribes to a topic, not to a camera: a player's messages serve as well.",
                 "d": "`--loop` starts the play again at its end, until Ctrl-C."}),
     ),
+    "06": (
+        Answered(Question("A LaserScan has `angle_min` = -2.356, `angle_increment` = 0.00873 (half a degree) and "
+                          "541 ranges. Where does `ranges[100]` point?", {
+            "a": "at 0.873 rad (100 × angle_increment), to the left",
+            "b": "at -1.483 rad (angle_min + 100 × angle_increment), to the right",
+            "c": "at 100°, to the left",
+            "d": "straight ahead: the beams are counted from the middle"}),
+            "b", "Beam i points at angle_min + i × angle_increment; a negative angle is to the right (REP 103).", {
+                "a": "Beam 0 points at angle_min, not at 0 rad: the angle of beam 100 starts from there.",
+                "c": "ROS angles are in radians, and beam 0 is not straight ahead.",
+                "d": "Beam 0 is the first beam of the sweep, at angle_min, and the beams count up from there."}),
+        Answered(Question("A node answers each scan with one `/cmd_vel`, and the simulator runs with "
+                          "`lock_step:=true`. Why does the drive end at the same place on a busy machine as on "
+                          "an idle one?", {
+            "a": "lock-step makes DDS deliver the messages faster",
+            "b": "the simulator follows the wall clock more closely",
+            "c": "the node reads the computer's clock instead of `/clock`",
+            "d": "the simulator advances one tick only after the answer to each scan has come"}),
+            "d", "The robot never moves on before the node has answered, so the node sees the same scans and sends "
+                 "the same commands, however slowly it answers.", {
+                "a": "Lock-step changes nothing in how DDS delivers; the messages take as long as they take.",
+                "b": "Lock-step does the opposite: the simulated time no longer follows the wall clock at all.",
+                "c": "A node that works with a simulator should read /clock (use_sim_time); the computer's clock is "
+                     "what differs from one run to the next."}),
+        Answered(Question("`buffer.lookup_transform(\"odom\", \"laser\", Time())` returns a transform. What is its "
+                          "translation?", {
+            "a": "where the laser is in the odom frame, now",
+            "b": "where odom's origin is in the laser's frame, now",
+            "c": "how far the robot has driven since the last scan",
+            "d": "where the laser was when the simulator started (time zero)"}),
+            "a", "lookup_transform(target, source, time) carries points from source to target: its translation is "
+                 "the source frame's origin in the target frame. Time() asks for the newest.", {
+                "b": "The first frame named is the target, the second the source: this asks the other way round.",
+                "c": "A transform is a pose between two frames, not a distance driven; the odometry's twist holds "
+                     "the robot's speed.",
+                "d": "Time() (zero) asks for the newest transform the buffer has, not for the one at time zero."}),
+    ),
 }
