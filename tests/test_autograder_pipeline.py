@@ -81,12 +81,17 @@ def feedback_pages(course):
 @pytest.mark.slow
 @pytest.mark.timeout(900)
 def test_release_has_stubs_and_no_solutions_or_hidden_tests(course):
-    """release/ holds the notebooks with stubs: no solution code, no hidden tests."""
+    """release/ holds the notebooks with stubs: no solution code, no hidden tests; a question's
+    answer cell holds `q3 = None`, the others nbgrader's raise (autograder.release)."""
+    from course_lib.checks.assignments import ASSIGNMENTS as SPECS
+
     root, _ = course
     for assignment in ASSIGNMENTS:
         text = (root / "release" / assignment / f"{assignment}.ipynb").read_text()
         assert "BEGIN SOLUTION" not in text and "HIDDEN TESTS" not in text and "checks.grade(" not in text
-        assert "NotImplementedError" in text
+        questions = SPECS[assignment].questions
+        assert all(f"{name} = None" in text for name in questions), assignment
+        assert questions or "NotImplementedError" in text, assignment
 
 
 @pytest.mark.slow

@@ -4,7 +4,8 @@ One module-scoped grading run (2 workers) is shared by the tests: release the br
 pubsub and services_actions assignments into a fresh course directory, hand in the zoo
 (tests/zoo/brightness.py: the reference solution with a hostile cell, and hostile submissions;
 tests/zoo/pubsub.py: mistakes in the packages; tests/zoo/services_actions.py: the reference, the
-untouched release and the typical mistakes of a service and an action server), grade, and check
+untouched release and the typical mistakes of a service and an action server; tests/zoo/pillar.py:
+the reference of the drive to the pillar and its typical mistakes), grade, and check
 each grade, its reason (for the package mistakes on the feedback page), the submitted files,
 leftover processes, and a second (cached) run.
 """
@@ -25,10 +26,11 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import course_support  # noqa: E402
 import zoo  # noqa: E402
 from zoo import brightness as brightness_zoo  # noqa: E402
+from zoo import pillar as pillar_zoo  # noqa: E402
 from zoo import pubsub as pubsub_zoo  # noqa: E402
 from zoo import services_actions as services_actions_zoo  # noqa: E402
 
-# The shared grading run (twelve submissions, 2 workers) happens in the first test's set-up.
+# The shared grading run (sixteen submissions, 2 workers) happens in the first test's set-up.
 pytestmark = [pytest.mark.slow, pytest.mark.timeout(1500)]
 
 
@@ -49,7 +51,7 @@ def graded(tmp_path_factory):
     from autograder import grading
 
     course = course_support.released_course(tmp_path_factory, tmp_path_factory.mktemp("zoo_course"),
-                                            ["brightness", "pubsub", "services_actions"])
+                                            ["brightness", "pubsub", "services_actions", "pillar"])
     course_support.seed_interface_cache(tmp_path_factory, course, ["pubsub", "services_actions"])
     entries = {k: v for k, v in brightness_zoo.entries(str(course)).items() if v.get("level") != "check"}
     for student, entry in entries.items():
@@ -58,6 +60,8 @@ def graded(tmp_path_factory):
         zoo.submit(course, student, "pubsub", entry["edits"])
     for student, entry in services_actions_zoo.entries(str(course)).items():
         zoo.submit(course, student, "services_actions", entry["edits"])
+    for student, entry in pillar_zoo.entries(str(course)).items():
+        zoo.submit(course, student, "pillar", entry["edits"])
     before = _hashes(course / "submitted")
     started = time.monotonic()
     results = grading.grade(course, workers=2, progress=False)
@@ -101,7 +105,7 @@ def test_zoo_entry_gets_its_expected_score_and_reason(graded, student):
 
 
 #: (assignment, zoo module) of the submissions graded per check with the reasons on the feedback page.
-PACKAGE_ZOOS = [("pubsub", pubsub_zoo), ("services_actions", services_actions_zoo)]
+PACKAGE_ZOOS = [("pubsub", pubsub_zoo), ("services_actions", services_actions_zoo), ("pillar", pillar_zoo)]
 
 
 @pytest.mark.parametrize("assignment, student", [(a, s) for a, z in PACKAGE_ZOOS for s in sorted(z.entries(""))])
@@ -196,8 +200,8 @@ def test_grading_report_lists_every_submission(graded):
     with open(graded["course"] / "grading_report.csv") as handle:
         rows = list(csv.DictReader(handle))
     assert {r["student_id"] for r in rows} == (set(graded["entries"]) | set(pubsub_zoo.entries())
-                                               | set(services_actions_zoo.entries("")))
-    max_scores = {name: f"{_total(name):g}" for name in ("brightness", "pubsub", "services_actions")}
+                                               | set(services_actions_zoo.entries("")) | set(pillar_zoo.entries("")))
+    max_scores = {name: f"{_total(name):g}" for name in ("brightness", "pubsub", "services_actions", "pillar")}
     assert all(r["max_score"] == max_scores[r["assignment"]] for r in rows)
     assert {r["student_id"]: float(r["score"]) for r in rows} == {s: r.score for s, r in graded["results"].items()}
 
