@@ -1,5 +1,6 @@
 """The notebook's RViz in JupyterLab in headless Chromium: a marker at a known pose, a scan of a
-known wall and a TF frame land at the expected pixels of the canvas, with the camera fixed.
+known wall and a TF frame land at the expected pixels of the canvas, with the camera fixed; a click
+with Publish Point and a drag with 2D Goal Pose publish the point and pose under the mouse.
 
 The notebook's kernel publishes (a node in its own session, 5 Hz) a scan of a wall 2 m ahead of
 the laser, the laser 1 m along x of odom (as geometry_msgs/TransformStamped on /rviz_test_tf:
@@ -69,10 +70,12 @@ view.add("Marker")
 view""",
 ]
 
-# The statuses once the scan and the marker are drawn in odom.
+# The statuses once the scan and the marker are drawn in odom and the newest drawing is on screen
+# (a drawing exactly as the last one is not sent again, so one drawing may be all there is).
 DRAWN_JS = """() => { const lines = [...document.querySelectorAll('.rviz-display')].map(e => e.innerText);
-  const el = document.querySelector('.rviz-canvas') && document.querySelector('.rviz-canvas').parentElement;
-  return el && Number(el.dataset.seq || 0) > 1 && lines.some(l => l.includes('points of 720 beams'))
+  const el = document.querySelector('.rviz-view');
+  return el && Number(el.dataset.seq || 0) >= 1 && el.dataset.seq === el.dataset.received
+    && lines.some(l => l.includes('points of 720 beams'))
     && lines.some(l => l.includes('1 markers (test: 1)')) ? lines : null; }"""
 
 
@@ -98,22 +101,32 @@ def lab(tmp_path_factory):
         yield server
 
 
-@pytest.mark.timeout(400)
-def test_a_marker_a_wall_scan_and_a_tf_frame_are_drawn_at_their_pixels(browser, lab):
+@pytest.fixture(scope="module")
+def shown(browser, lab):
+    """The notebook run in JupyterLab, its view drawn: (page, the statuses)."""
     path = "rviz.ipynb"
     page = open_notebook(browser, lab, path)
     try:
         run = run_notebook(page, path, code_cell_count(lab.root_dir / path), 240)
         assert run.problems() == [], run.problems()
         statuses = page.wait_for_function(DRAWN_JS, timeout=60_000, polling=100).json_value()
-        # The canvas may start at a fractional pixel of the page: its box, rounded, is the clip.
-        canvas = page.locator(".rviz-canvas")
-        canvas.scroll_into_view_if_needed()
-        box = canvas.bounding_box()
-        shot = page.screenshot(path=str(_target()), clip={"x": round(box["x"]), "y": round(box["y"]),
-                                                           "width": WIDTH, "height": HEIGHT})
+        yield page, statuses
     finally:
         close_notebook(page, lab, path)
+
+
+def canvas_box(page) -> dict:
+    """The canvas's box on the page; it may start at a fractional pixel, so rounded."""
+    canvas = page.locator(".rviz-canvas")
+    canvas.scroll_into_view_if_needed()
+    box = canvas.bounding_box()
+    return {"x": round(box["x"]), "y": round(box["y"]), "width": WIDTH, "height": HEIGHT}
+
+
+@pytest.mark.timeout(400)
+def test_a_marker_a_wall_scan_and_a_tf_frame_are_drawn_at_their_pixels(shown):
+    page, statuses = shown
+    shot = page.screenshot(path=str(_target()), clip=canvas_box(page))
     picture = cv2.cvtColor(cv2.imdecode(np.frombuffer(shot, np.uint8), cv2.IMREAD_COLOR), cv2.COLOR_BGR2RGB)
     assert picture.shape == (HEIGHT, WIDTH, 3), picture.shape
     assert "TF: 2 frames" in " ".join(statuses), statuses
@@ -128,6 +141,45 @@ def test_a_marker_a_wall_scan_and_a_tf_frame_are_drawn_at_their_pixels(browser, 
     # The laser frame's y axis: green, 1 m long from (1, 0) up to (1, 1).
     green = colours_near(picture, 1.0, 0.5)
     assert any(c[1] > 200 and c[0] < 60 and c[2] < 60 for c in green), green
+
+
+@pytest.mark.timeout(200)
+def test_a_click_publishes_the_point_and_a_drag_the_goal_pose_under_the_mouse(shown):
+    """Publish Point at the pixel of odom's (1.5, -1) and a 2D Goal Pose dragged from (-1, -1)
+    towards +y reach a subscriber in this process (real DDS) in the fixed frame."""
+    from geometry_msgs.msg import PointStamped, PoseStamped
+
+    from course_lib.ros import session
+
+    page, _ = shown
+    session.start()
+    node = session.tool_node()
+    got = {}
+    subscriptions = [node.create_subscription(PointStamped, "/clicked_point", lambda m: got.setdefault("point", m), 10),
+                     node.create_subscription(PoseStamped, "/goal_pose", lambda m: got.setdefault("goal", m), 10)]
+    try:
+        box = canvas_box(page)
+
+        def use_tools():  # again until both arrive: the view's publishers are made at first use
+            page.get_by_role("button", name="Publish Point").click()
+            column, row = pixel(1.5, -1.0)
+            page.mouse.click(box["x"] + column, box["y"] + row)
+            page.get_by_role("button", name="2D Goal Pose").click()
+            page.mouse.move(box["x"] + pixel(-1, -1)[0], box["y"] + pixel(-1, -1)[1])
+            page.mouse.down()
+            page.mouse.move(box["x"] + pixel(-1, 0)[0], box["y"] + pixel(-1, 0)[1], steps=4)
+            page.mouse.up()
+            page.wait_for_timeout(200)
+            return len(got) == 2
+        assert session.wait_for(use_tools, timeout=60)
+    finally:
+        for subscription in subscriptions:
+            node.destroy_subscription(subscription)
+    point, goal = got["point"], got["goal"]
+    assert point.header.frame_id == "odom" and goal.header.frame_id == "odom"
+    assert np.allclose([point.point.x, point.point.y, point.point.z], [1.5, -1.0, 0.0], atol=0.03)
+    assert np.allclose([goal.pose.position.x, goal.pose.position.y], [-1.0, -1.0], atol=0.03)
+    assert np.allclose([goal.pose.orientation.z, goal.pose.orientation.w], [0.5 ** 0.5] * 2, atol=0.01)
 
 
 def _target() -> Path:

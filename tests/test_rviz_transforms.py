@@ -80,3 +80,13 @@ def test_a_loop_or_a_self_parent_is_refused_with_the_reason():
         tree.set("laser", "odom", matrix())
     with pytest.raises(ValueError, match="must differ"):
         tree.set("odom", "/odom", matrix())
+
+
+def test_a_rotation_matrix_gives_back_its_quaternion():
+    from course_lib.notebook.rviz.transforms import quaternion_from_matrix, rotation_matrix
+
+    rng = np.random.default_rng(3)
+    for q in rng.normal(size=(50, 4)):
+        q = q / np.linalg.norm(q) * np.sign(q[3])
+        assert np.allclose(quaternion_from_matrix(rotation_matrix(*q)), q, atol=1e-9)
+    assert quaternion_from_matrix(np.eye(3)) == (0.0, 0.0, 0.0, 1.0)

@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import math
 
+#: Outer size (m: length, width, height), the data sheet's 990 x 670 x 390 mm.
+BODY_SIZE = (0.99, 0.67, 0.39)
 #: Wheel radius (m): 13 in tyres.
 WHEEL_RADIUS = 0.165
 #: Distance between the wheels' contact points (m), the data sheet's effective track.

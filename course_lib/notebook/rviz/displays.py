@@ -15,10 +15,13 @@ import threading
 
 import numpy as np
 
-from course_lib.notebook.rviz import geometry, markers
-from course_lib.notebook.rviz.transforms import NoTransform, TransformTree, pose_matrix
+from course_lib.notebook.rviz import clouds, geometry, markers
+from course_lib.notebook.rviz.transforms import NoTransform, TransformTree, matrix, pose_matrix
+from course_lib.robot import husky
 
 NO_MESSAGES = "No messages received"
+#: The yellow of the Husky's model (husky.xml); its size is course_lib.robot.husky.BODY_SIZE.
+HUSKY_COLOR = (242, 191, 26, 255)
 
 
 class Display:
@@ -108,6 +111,25 @@ class LaserScan(_Latest):
 
     def _summary(self, msg):
         return f"{self.points} points of {len(msg.ranges)} beams"
+
+
+class PointCloud2(_Latest):
+    """RViz's PointCloud2: the newest cloud's points, coloured by RGB8 (else intensity, else z)."""
+
+    kind, msg_type, default_topic, reliable = "PointCloud2", "sensor_msgs/msg/PointCloud2", "/points", False
+
+    def __init__(self, name, topic=None, size: float = 0.02):
+        super().__init__(name, topic)
+        self.size = size
+        self.points = 0
+
+    def _items(self, msg, fixed_from_msg, tree, fixed_frame):
+        items = clouds.point_cloud(msg, fixed_from_msg, self.size)
+        self.points = len(items[0]["positions"])
+        return items
+
+    def _summary(self, msg):
+        return f"{self.points} points"
 
 
 class PoseStamped(_Latest):
@@ -243,5 +265,49 @@ class TF(Display):
         return geometry.tf_frames(frames, self.length, self.names, self.text_height)
 
 
+class RobotModel(Display):
+    """The robot's shape: a box of the Husky's outer size standing on base_link (RViz's RobotModel
+    draws the URDF's links; the course's robot is one box, and no URDF is read)."""
+
+    kind = "RobotModel"
+
+    def __init__(self, name, topic=None, frame: str = husky.BASE_FRAME, size=husky.BODY_SIZE, color=HUSKY_COLOR):
+        super().__init__(name, None)
+        self.frame, self.size, self.color = frame, tuple(size), color
+
+    def _draw(self, tree, fixed_frame, now):
+        base = tree.lookup(fixed_frame, self.frame)
+        length, width, height = self.size
+        box = geometry.scaled(base @ matrix((0.0, 0.0, height / 2)), length, width, height)
+        self.status = ("ok", f"a box {length:g} × {width:g} × {height:g} m on [{self.frame}]")
+        return [{"type": "shapes", "shape": "cube", "matrices": box[None].astype(np.float32),
+                 "colors": geometry.repeat_color(self.color, 1)}]
+
+
+class Image(_Latest):
+    """RViz's Image display: the newest picture in a 2D panel over the view (sent as a JPEG)."""
+
+    kind, msg_type, default_topic, reliable = "Image", "sensor_msgs/msg/Image", "/image", False
+
+    def __init__(self, name, topic=None, width: int = 240, quality: int = 80):
+        super().__init__(name, topic)
+        self.width, self.quality = width, quality
+
+    def _draw(self, tree, fixed_frame, now):
+        import cv2
+
+        from course_lib.imaging.images import msg_to_image, to_bgr
+
+        msg, self._drawn = self.latest, self.latest
+        if msg is None:
+            return []
+        picture = to_bgr(msg_to_image(msg), msg.encoding)
+        ok, jpeg = cv2.imencode(".jpg", picture, [cv2.IMWRITE_JPEG_QUALITY, self.quality])
+        self.status = ("ok", f"{msg.width}×{msg.height} {msg.encoding}")
+        return [{"type": "image", "jpeg": jpeg.reshape(-1), "width": int(self.width),
+                 "aspect": msg.height / max(1, msg.width)}]
+
+
 #: The displays by the name `RViz.add` takes (RViz's own names for them).
-KINDS = {cls.kind: cls for cls in (Grid, TF, LaserScan, Marker, MarkerArray, Odometry, Path, PoseStamped)}
+KINDS = {cls.kind: cls for cls in (Grid, TF, LaserScan, PointCloud2, Marker, MarkerArray, Odometry, Path,
+                                   PoseStamped, RobotModel, Image)}

@@ -46,6 +46,17 @@ def quaternion_from_yaw(yaw: float) -> tuple[float, float, float, float]:
     return (0.0, 0.0, float(np.sin(yaw / 2)), float(np.cos(yaw / 2)))
 
 
+def quaternion_from_matrix(rotation) -> tuple[float, float, float, float]:
+    """The quaternion (x, y, z, w) of a 3×3 rotation matrix (e.g. cv2.Rodrigues' of solvePnP's rvec),
+    with w >= 0."""
+    r = np.asarray(rotation, dtype=float)[:3, :3]
+    w = np.sqrt(max(0.0, 1.0 + np.trace(r))) / 2
+    x = np.copysign(np.sqrt(max(0.0, 1.0 + r[0, 0] - r[1, 1] - r[2, 2])) / 2, r[2, 1] - r[1, 2])
+    y = np.copysign(np.sqrt(max(0.0, 1.0 - r[0, 0] + r[1, 1] - r[2, 2])) / 2, r[0, 2] - r[2, 0])
+    z = np.copysign(np.sqrt(max(0.0, 1.0 - r[0, 0] - r[1, 1] + r[2, 2])) / 2, r[1, 0] - r[0, 1])
+    return float(x), float(y), float(z), float(w)
+
+
 def matrix(translation=(0.0, 0.0, 0.0), rotation=(0.0, 0.0, 0.0, 1.0)) -> np.ndarray:
     """The 4×4 transform of a translation (x, y, z) and a quaternion (x, y, z, w)."""
     result = np.eye(4)

@@ -5,8 +5,9 @@
 //   {kind: "layers", seq, layers: {name: [item, ...]}}, arrays as binary buffers
 //     ({buffer: i, dtype, shape}); a layer not named keeps what it shows.
 // Each time a message's layers are on screen the browser answers {kind: "drawn", seq, frames,
-// render_ms}: the kernel sends the next one only then (newest wins; nothing queues).
-// The camera comes from the `camera` trait, the displays' status lines from `displays`.
+// render_ms}: the kernel sends more only while few are unanswered (newest wins; nothing queues).
+// The tools answer {kind: "tool", tool, point, yaw}. Traits: `camera`, `displays` (status lines),
+// `tool`, `frames` and `fixed_frame` (the tool bar's list).
 import * as THREE from "three";
 import { OrbitControls } from "three/addons/controls/OrbitControls.js";
 import { mergeGeometries } from "three/addons/utils/BufferGeometryUtils.js";
@@ -37,7 +38,22 @@ function typedArray(ref, buffers) {
   return ref.dtype === "uint8" ? new Uint8Array(bytes) : new Float32Array(bytes);
 }
 
+// A frame's name is drawn again with every transform: its texture is made once and kept.
+const textTextures = new Map();
+
 function textSprite(text, color, height) {
+  const key = `${text}|${color.join(",")}`;
+  let texture = textTextures.get(key);
+  if (!texture) {
+    texture = textTexture(text, color);
+    textTextures.set(key, texture);
+  }
+  const sprite = new THREE.Sprite(new THREE.SpriteMaterial({ map: texture, depthTest: false }));
+  sprite.scale.set((height * texture.image.width) / texture.image.height, height, 1);
+  return sprite;
+}
+
+function textTexture(text, color) {
   const canvas = document.createElement("canvas");
   const context = canvas.getContext("2d");
   const font = "48px sans-serif";
@@ -48,10 +64,7 @@ function textSprite(text, color, height) {
   context.fillStyle = `rgba(${color[0]},${color[1]},${color[2]},${color[3] / 255})`;
   context.textBaseline = "middle";
   context.fillText(text, 4, 32);
-  const texture = new THREE.CanvasTexture(canvas);
-  const sprite = new THREE.Sprite(new THREE.SpriteMaterial({ map: texture, depthTest: false }));
-  sprite.scale.set((height * canvas.width) / canvas.height, height, 1);
-  return sprite;
+  return new THREE.CanvasTexture(canvas);
 }
 
 class Scene {
@@ -64,7 +77,11 @@ class Scene {
     this.renderer.setSize(width, height);
     this.renderer.domElement.className = "rviz-canvas";
     this.renderer.domElement.style.display = "block";
-    el.appendChild(this.renderer.domElement);
+    this.panelBox = document.createElement("div"); // the canvas and the Image displays' panels over it
+    this.panelBox.style.cssText = `position: relative; width: ${width}px; height: ${height}px;`;
+    this.panelBox.appendChild(this.renderer.domElement);
+    el.appendChild(this.panelBox);
+    this.panels = new Map();
     this.scene = new THREE.Scene();
     this.scene.background = new THREE.Color(BACKGROUND);
     this.scene.add(new THREE.AmbientLight(0xffffff, 1.6));
@@ -99,6 +116,8 @@ class Scene {
     this.controls = new OrbitControls(this.camera, this.renderer.domElement);
     this.controls.target.set(...target);
     this.controls.enableRotate = mode !== "top";
+    this.controls.autoRotate = Boolean(settings.spin) && mode !== "top"; // spin 2: a turn in 30 s
+    this.controls.autoRotateSpeed = Number(settings.spin) || 0;
     this.controls.addEventListener("change", () => this.pointSizes());
     this.controls.update();
     this.pointSizes();
@@ -161,17 +180,26 @@ class Scene {
     if (old) {
       this.scene.remove(old);
       old.traverse((object) => {
-        if (object.material) {
-          if (object.material.map) object.material.map.dispose();
-          object.material.dispose();
-        }
+        if (object.material) object.material.dispose(); // text textures stay in textTextures
         if (object.geometry && !Object.values(this.shapes).includes(object.geometry)) object.geometry.dispose();
       });
     }
     const group = new THREE.Group();
+    this.setPanel(name, items.find((item) => item.type === "image"), buffers);
     for (const item of items) for (const object of this.itemObjects(item, buffers)) group.add(object);
     this.scene.add(group);
     this.layers.set(name, group);
+  }
+
+  // The point of the fixed frame's ground (z = 0) under a pixel of the canvas, or null (the sky).
+  groundPoint(event) {
+    const box = this.renderer.domElement.getBoundingClientRect();
+    const ndc = new THREE.Vector2(((event.clientX - box.left) / box.width) * 2 - 1,
+      -((event.clientY - box.top) / box.height) * 2 + 1);
+    const ray = new THREE.Raycaster();
+    ray.setFromCamera(ndc, this.camera);
+    const hit = new THREE.Vector3();
+    return ray.ray.intersectPlane(new THREE.Plane(new THREE.Vector3(0, 0, 1), 0), hit) ? hit : null;
   }
 
   render() {
@@ -180,6 +208,37 @@ class Scene {
     this.renderMs = performance.now() - started;
     this.frames += 1;
     this.dirty = false;
+  }
+
+  // An Image display's picture: a 2D panel over the canvas's top left corner, as RViz docks it.
+  setPanel(name, item, buffers) {
+    let panel = this.panels.get(name);
+    if (!item) {
+      if (panel) {
+        URL.revokeObjectURL(panel.src);
+        panel.remove();
+        this.panels.delete(name);
+      }
+      return;
+    }
+    if (!panel) {
+      panel = document.createElement("img");
+      panel.className = "rviz-image";
+      panel.dataset.name = name;
+      panel.style.cssText = "position: absolute; border: 1px solid #888; left: 4px;";
+      this.panelBox.appendChild(panel);
+      this.panels.set(name, panel);
+    }
+    const old = panel.src;
+    panel.src = URL.createObjectURL(new Blob([typedArray(item.jpeg, buffers)], { type: "image/jpeg" }));
+    if (old) URL.revokeObjectURL(old);
+    panel.style.width = `${item.width}px`;
+    panel.style.height = `${Math.round(item.width * item.aspect)}px`;
+    let top = 4;
+    for (const other of this.panels.values()) {
+      other.style.top = `${top}px`;
+      top += parseInt(other.style.height, 10) + 4;
+    }
   }
 
   dispose() {
@@ -204,20 +263,97 @@ function statusList(displays) {
   return list;
 }
 
+// RViz's tool bar: the tools (one use each, then back to Move Camera, as RViz's are), the views
+// and the Global Options' fixed frame (a list of the frames the kernel knows).
+const TOOLS = ["Move Camera", "2D Goal Pose", "Publish Point"];
+
+function toolBar(model, scene) {
+  const bar = document.createElement("div");
+  bar.className = "rviz-toolbar";
+  bar.style.cssText = "font: 12px sans-serif; padding: 2px 0; display: flex; gap: 4px; align-items: center;";
+  const buttons = TOOLS.map((tool) => {
+    const button = document.createElement("button");
+    button.textContent = tool;
+    button.dataset.tool = tool;
+    button.onclick = () => { model.set("tool", tool); model.save_changes(); };
+    bar.appendChild(button);
+    return button;
+  });
+  for (const [label, mode] of [["Orbit", "orbit"], ["TopDownOrtho", "top"]]) {
+    const button = document.createElement("button");
+    button.textContent = label;
+    button.onclick = () => { model.set("camera", { ...model.get("camera"), mode }); model.save_changes(); };
+    bar.appendChild(button);
+  }
+  const label = document.createElement("label");
+  label.textContent = "Fixed Frame ";
+  const select = document.createElement("select");
+  select.className = "rviz-fixed-frame";
+  select.onchange = () => { model.set("fixed_frame", select.value); model.save_changes(); };
+  label.appendChild(select);
+  bar.appendChild(label);
+  const show = () => {
+    const tool = model.get("tool");
+    for (const button of buttons) button.style.fontWeight = button.dataset.tool === tool ? "bold" : "normal";
+    scene.controls.enabled = tool === "Move Camera";
+    const frames = [...new Set([model.get("fixed_frame"), ...model.get("frames")])];
+    select.replaceChildren(...frames.map((frame) => new Option(frame, frame, false, frame === model.get("fixed_frame"))));
+  };
+  for (const name of ["tool", "frames", "fixed_frame", "camera"]) model.on(`change:${name}`, show);
+  show();
+  return bar;
+}
+
+// 2D Goal Pose: press where the robot should be, drag the way it should face, release; Publish
+// Point: click. Both on the fixed frame's ground (z = 0); the kernel publishes them.
+function useTools(model, scene) {
+  const canvas = scene.renderer.domElement;
+  let start = null;
+  canvas.addEventListener("pointerdown", (event) => {
+    if (model.get("tool") === "Move Camera" || event.button !== 0) return;
+    start = scene.groundPoint(event);
+  });
+  canvas.addEventListener("pointerup", (event) => {
+    const tool = model.get("tool");
+    if (tool === "Move Camera" || !start) return;
+    const end = scene.groundPoint(event) || start;
+    if (tool === "Publish Point") model.send({ kind: "tool", tool, point: [end.x, end.y, end.z] });
+    else {
+      const moved = end.distanceTo(start) > 1e-6;
+      const yaw = moved ? Math.atan2(end.y - start.y, end.x - start.x) : 0;
+      model.send({ kind: "tool", tool, point: [start.x, start.y, 0], yaw });
+    }
+    start = null;
+    model.set("tool", "Move Camera");
+    model.save_changes();
+  });
+}
+
 function render({ model, el }) {
   const size = model.get("size");
+  el.classList.add("rviz-view"); // its data-received, -seq (shown), -frames, -render-ms: for tests, benchmarks
   const scene = new Scene(el, size[0], size[1]);
   let statusEl = statusList(model.get("displays"));
   el.appendChild(statusEl);
   scene.setCamera(model.get("camera"));
-  let pending = null; // the newest message not on screen yet; an older one is replaced, not queued
+  el.insertBefore(toolBar(model, scene), el.firstChild);
+  useTools(model, scene);
+  // The layers not on screen yet, each the newest drawing of it: a layer drawn again before the next
+  // frame replaces its older drawing (nothing queues), and a layer only the older message had stays.
+  let pending = new Map();
+  let pendingSeq = 0;
   let running = true;
 
   model.on("msg:custom", (content, buffers) => {
     if (content.kind !== "layers") return;
-    pending = { content, buffers };
+    for (const [name, items] of Object.entries(content.layers)) pending.set(name, { items, buffers });
+    pendingSeq = content.seq;
+    el.dataset.received = String(content.seq);
   });
-  model.on("change:camera", () => scene.setCamera(model.get("camera")));
+  model.on("change:camera", () => {
+    scene.setCamera(model.get("camera"));
+    scene.controls.enabled = model.get("tool") === "Move Camera";
+  });
   model.on("change:displays", () => {
     const fresh = statusList(model.get("displays"));
     statusEl.replaceWith(fresh);
@@ -226,16 +362,16 @@ function render({ model, el }) {
 
   function frame() {
     if (!running) return;
-    if (pending) {
-      const { content, buffers } = pending;
-      pending = null;
-      for (const [name, items] of Object.entries(content.layers)) scene.setLayer(name, items, buffers);
+    if (scene.controls.autoRotate) scene.controls.update(); // a spinning orbit: a frame each time
+    if (pending.size) {
+      for (const [name, { items, buffers }] of pending) scene.setLayer(name, items, buffers);
+      pending = new Map();
       scene.pointSizes();
       scene.render();
-      el.dataset.seq = String(content.seq);
+      el.dataset.seq = String(pendingSeq);
       el.dataset.frames = String(scene.frames);
       el.dataset.renderMs = scene.renderMs.toFixed(2);
-      model.send({ kind: "drawn", seq: content.seq, frames: scene.frames, render_ms: scene.renderMs });
+      model.send({ kind: "drawn", seq: pendingSeq, frames: scene.frames, render_ms: scene.renderMs });
     } else if (scene.dirty) {
       scene.render();
       el.dataset.frames = String(scene.frames);
