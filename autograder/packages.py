@@ -33,7 +33,6 @@ from __future__ import annotations
 import dataclasses
 import json
 import os
-import re
 import shutil
 import time
 import xml.etree.ElementTree as ElementTree
@@ -55,11 +54,6 @@ from course_lib.ros import colcon, package_files, workspace
 
 #: Seconds one colcon build may take (an interface package takes 10-40 s on a busy machine).
 BUILD_SECONDS = 240.0
-
-#: Lines that start an error in colcon's, CMake's, the compiler's or setup.py's output.
-_ERROR_LINE = re.compile(r"(CMake Error|error:|Error:|Traceback \(most recent call last\)|SyntaxError|"
-                         r"ModuleNotFoundError|No module named|Failed\s+<<<|ERROR|not found:)")
-
 
 @dataclasses.dataclass
 class BuildReport:
@@ -134,20 +128,8 @@ def _depends(folder: Path) -> set[str]:
 
 # ---- building ----------------------------------------------------------------------------------
 
-def first_error_lines(output: str, lines: int = 8) -> str:
-    """The first error of a build log and the lines after it (or the log's end when no line
-    looks like an error), without colcon's progress lines."""
-    text = [line for line in output.splitlines() if line.strip() and not line.startswith((
-        "Starting >>>", "Finished <<<", "Failed   <<<", "[Processing:", "Summary:"))]
-    for index, line in enumerate(text):
-        if line.startswith("Traceback (most recent call last)"):
-            # colcon's own frames first: the exception (a SyntaxError in setup.py, say) is at the
-            # end of the traceback, with the student's file and line just above it.
-            end = next((i for i in range(index + 1, len(text)) if not text[i].startswith((" ", "\t"))), len(text) - 1)
-            return "\n".join(text[max(index + 1, end - 3):end + 1])
-        if _ERROR_LINE.search(line):
-            return "\n".join(text[index:index + lines])
-    return "\n".join(text[-lines:])
+#: The first error of a build log (shared with the notebook's colcon build).
+first_error_lines = colcon.first_error_lines
 
 
 def _package_log(ws: Path, output: str) -> str:

@@ -18,7 +18,7 @@ def test_build_without_src_names_the_fix(tmp_path):
 
 
 @pytest.mark.slow
-def test_broken_package_gives_a_build_error_with_the_log_tail(tmp_path):
+def test_a_cmake_error_is_the_last_thing_a_build_error_says(tmp_path):
     package = pkg_create.create_interface_package(tmp_path, "broken_interfaces", {"Broken": "int32 data"})
     cmake = package / "CMakeLists.txt"
     # Early in the file, so that CMake fails within seconds instead of after generating code.
@@ -27,19 +27,47 @@ def test_broken_package_gives_a_build_error_with_the_log_tail(tmp_path):
     with pytest.raises(colcon.BuildError) as caught:
         colcon.build(tmp_path, timeout=300)
     message = str(caught.value)
-    assert "failed in package 'broken_interfaces'" in message
-    assert "this_command_does_not_exist" in message  # from the tail of the package's log
+    log = caught.value.result.log_path("broken_interfaces")
+    assert message.splitlines()[0].endswith(f"failed in package 'broken_interfaces' (exit code 1); its full log: {log}")
+    # CMake's first error, from the package's log, ends the message (not colcon's summary after it).
+    cause = message[message.index("The first error in it:\n"):].splitlines()[1:]
+    assert cause[0].startswith("CMake Error at CMakeLists.txt:") and "this_command_does_not_exist" in cause[0], message
+    assert not any(line.startswith(("Failed", "Summary")) for line in cause), message
     assert caught.value.result.failed == ["broken_interfaces"] and caught.value.result.returncode != 0
 
 
 @pytest.mark.slow
-def test_command_line_build_failure_exits_nonzero(tmp_path):
+def test_command_line_build_failure_ends_with_python_s_error_line(tmp_path):
+    """A notebook's build cell (`!course-lib build ...`) shows colcon's package lines, then the cause
+    last: Python's error in setup.py with its file and line, not colcon's traceback or the ten-line
+    `python -c` command colcon ran."""
     package = pkg_create.create_package(tmp_path, "bad_python_pkg")
-    (package / "setup.py").write_text("raise SystemExit('setup.py is broken on purpose')\n")
-    done = subprocess.run([sys.executable, "-m", "course_lib", "build", str(tmp_path)],
-                          capture_output=True, text=True, timeout=300, env=rosenv.ros_environment())
+    setup = package / "setup.py"
+    setup.write_text(setup.read_text() + "this is not python(\n")
+    done = subprocess.run([sys.executable, "-m", "course_lib", "build", str(tmp_path)], stderr=subprocess.STDOUT,
+                          stdout=subprocess.PIPE, text=True, timeout=300, env=rosenv.ros_environment())
     assert done.returncode == 1
-    assert "failed in package 'bad_python_pkg'" in done.stderr and "setup.py is broken on purpose" in done.stderr
+    shown = done.stdout.rstrip().splitlines()
+    assert shown[0] == "Starting >>> bad_python_pkg" and shown[-1] == "SyntaxError: '(' was never closed", done.stdout
+    log = colcon.package_log_path(tmp_path, "bad_python_pkg")
+    assert f'File "{setup}", line' in done.stdout and str(log) in done.stdout
+    assert "Traceback" not in done.stdout and "python -c" not in done.stdout and "'-c'" not in done.stdout, done.stdout
+    assert "--- stderr" not in done.stdout, done.stdout
+
+
+def test_quiet_echo_keeps_a_traceback_of_the_student_s_own_code():
+    shown = []
+    echo = colcon.QuietEcho(shown.append)
+    for line in ["--- stderr: pkg", "Traceback (most recent call last):", '  File "/ws/src/pkg/pkg/node.py", line 3',
+                 "    import nothing", "ModuleNotFoundError: No module named 'nothing'", "---",
+                 "--- stderr: other", "Traceback (most recent call last):",
+                 '  File "/venv/lib/colcon_core/executor/__init__.py", line 91, in __call__',
+                 "subprocess.CalledProcessError: Command '['python', '-c', 'x']' returned non-zero exit status 1.",
+                 "---", "Command '['python', '-c', 'x']' returned non-zero exit status 1."]:
+        echo(line)
+    assert shown == ["--- stderr: pkg", "Traceback (most recent call last):",
+                     '  File "/ws/src/pkg/pkg/node.py", line 3', "    import nothing",
+                     "ModuleNotFoundError: No module named 'nothing'", "---"]
 
 
 @pytest.mark.slow

