@@ -16,6 +16,7 @@ COMMANDS = {
     "action": "Various action related sub-commands",
     "bag": "Various rosbag related sub-commands",
     "daemon": "Various daemon related sub-commands",
+    "doctor": "Check ROS setup and other potential issues",
     "interface": "Show information about ROS interfaces",
     "launch": "Run a launch file",
     "node": "Various node related sub-commands",
@@ -24,10 +25,14 @@ COMMANDS = {
     "run": "Run a package specific executable",
     "service": "Various service related sub-commands",
     "topic": "Various topic related sub-commands",
+    "wtf": "Use `wtf` as alias to `doctor`",
 }
 
+#: Commands that run another command's module, as ros2doctor's `wtf` runs `doctor`.
+ALIASES = {"wtf": "doctor"}
+
 #: Commands of a full ros2cli install that the course's ros2 leaves out (named in --help).
-LEFT_OUT = ("component", "doctor", "lifecycle", "multicast", "wtf")
+LEFT_OUT = ("component", "lifecycle", "multicast")
 
 
 #: ros2cli's one option before the command (Jazzy), with its help text.
@@ -147,5 +152,5 @@ def _dispatch(argv: list[str]) -> int | str | None:
         raise unsupported(f"ros2 {command}", ["-h", "--help", BUFFERING_OPTION])
     if command not in COMMANDS:
         raise unsupported(f"ros2 {command}", sorted(COMMANDS))
-    module = importlib.import_module(f"course_lib.ros2cli.{command}")
-    return module.main(rest)
+    module = importlib.import_module(f"course_lib.ros2cli.{ALIASES.get(command, command)}")
+    return module.main(rest, prog=f"ros2 {command}") if command in ALIASES else module.main(rest)
