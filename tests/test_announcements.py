@@ -31,7 +31,7 @@ def test_a_process_announces_each_node_with_its_endpoints(session_domain):
 
         assert session.wait_for(lambda: mine() and "/announcer" in mine()[0].nodes, timeout=10)
         nodes, gids = mine()[0]
-        assert {"/announcer", "/" + session.TOOL_NODE_NAME} <= nodes
+        assert {"/announcer", "/" + session.tool_node_name()} <= nodes
         publisher = tool.get_publishers_info_by_topic("/announced")[0]
         assert bytes(publisher.endpoint_gid)[:16] in gids
     heard.close()  # a second close does nothing

@@ -133,12 +133,18 @@ def test_validate_says_success_for_the_reference_solution(browser, lab):
 
 def assert_button_followed_the_cells(result, notebook: Path) -> None:
     """The Validate button said "Validating: cell k of m" with m the notebook's code cells and k
-    never going back, and "Validate" again at the end."""
+    never going back, what the build cell and the graded check cells do ("Validating: building the
+    workspace (colcon), cell k of m"), and "Validate" again at the end."""
     from course_lib.notebook.student_lab.validate_progress import code_cells
 
     cells = len(code_cells(json.loads(notebook.read_text())))
-    shown = [re.fullmatch(r"Validating: cell (\d+) of (\d+)(, then the results)?", label) for label in result.labels]
-    counted = [(int(found[1]), int(found[2])) for found in shown if found]
+    shown = [re.fullmatch(r"Validating: (?:(.+), )?cell (\d+) of (\d+)(, then the results)?", label)
+             for label in result.labels]
+    counted = [(int(found[2]), int(found[3])) for found in shown if found]
+    # Both take seconds (colcon's start alone; the node check ~20 s): the button, asked once a
+    # second, shows each.
+    doing = {found[1] for found in shown if found and found[1]}
+    assert doing == {"building the workspace (colcon)", "running the graded checks"}, result.labels
     assert counted, f"the button never said which cell runs: {result.labels}"
     assert {of for _, of in counted} == {cells}, (cells, result.labels)
     assert [cell for cell, _ in counted] == sorted(cell for cell, _ in counted), result.labels
@@ -164,14 +170,15 @@ def test_validate_fails_a_wrong_average_and_shows_the_failing_checks(browser, la
 def test_validate_on_a_lesson_points_at_its_self_checks_at_once_and_leaves_no_kernel(browser, lab):
     """A lesson has no graded cells: Validate answers with the fix first, in a few short lines (no
     traceback), without running the lesson in a kernel that outlives it (each press used to leave
-    one running)."""
-    from course_lib.notebook.student_lab.validate import LESSON_ANSWER
+    one running), under a heading of its own in a dialog that is no error (nbgrader's heading was
+    "There was an error running the validate command:")."""
+    from course_lib.notebook.student_lab.validate import LESSON_ANSWER, LESSON_HEADING
 
     result = validate_in_lab(browser, lab, LESSON, "validate_lesson.png")
-    assert (result.title, result.error) == ("Validation Results", True), said(result, lab)
+    assert (result.title, result.outcome, result.error) == ("Validation Results", "lesson", False), said(result, lab)
     header, _, answer = result.text.partition("\n")
-    assert header == "There was an error running the validate command:", said(result, lab)
-    assert answer.strip() == LESSON_ANSWER and "Traceback" not in result.text, said(result, lab)
+    assert header == LESSON_HEADING and "error" not in result.text, said(result, lab)
+    assert f"{header}\n{answer.strip()}" == LESSON_ANSWER and "Traceback" not in result.text, said(result, lab)
     assert answer.strip().startswith("Use this lesson's self-check cells"), said(result, lab)
 
 

@@ -107,8 +107,8 @@ def test_node_list_sees_a_node_in_another_process(far_talker):
     session.start(domain_id=far_talker)
     names = graph.node_list(wait_for=["/far_talker"], timeout=60)
     assert "/far_talker" in names
-    assert "/" + session.TOOL_NODE_NAME not in names
-    assert "/" + session.TOOL_NODE_NAME in graph.node_list(all=True)
+    assert "/" + session.tool_node_name() not in names
+    assert "/" + session.tool_node_name() in graph.node_list(all=True)
 
 
 def test_discovery_counts_a_process_holding_three_nodes_as_one_participant(domain_id):

@@ -3,12 +3,14 @@ Fibonacci action server in a process of its own, held to ros2action's own test_c
 the same fixture (test_msgs/action/Fibonacci on /fibonacci) and expected lines."""
 
 import re
+import signal
+import subprocess
 import sys
 import types
 
 import pytest
 import yaml
-from ros2cli_support import node_script, ros2, ros2_together
+from ros2cli_support import ROS2, node_script, ros2, ros2_together
 
 from course_lib.ros import processes, rosenv
 
@@ -118,6 +120,68 @@ def test_send_goal(server):
     text = with_feedback.stdout
     assert text.count("Feedback:\n") == 4
     assert text.index("Goal accepted") < text.index("Feedback:") < text.rindex("Feedback:") < text.index("Result:")
+
+
+# A server that accepts a cancel and still publishes feedback for a while before it ends the goal:
+# feedback then arrives after the cancel's answer, as it may from any server under load.
+LATE_FEEDBACK_SERVER = node_script('''
+import sys
+import time
+
+import rclpy
+from rclpy.action import ActionServer, CancelResponse
+from rclpy.callback_groups import ReentrantCallbackGroup
+from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
+from rclpy.node import Node
+from test_msgs.action import Fibonacci
+
+
+class LateFeedbackServer(Node):
+
+    def __init__(self):
+        super().__init__('late_feedback_server')
+        self.server = ActionServer(self, Fibonacci, 'fibonacci', self.execute, callback_group=ReentrantCallbackGroup(),
+                                   cancel_callback=lambda goal_handle: CancelResponse.ACCEPT)
+
+    def execute(self, goal_handle):
+        feedback = Fibonacci.Feedback(sequence=[0, 1])
+        after_cancel = 0
+        while after_cancel < 100:  # feedback every 20 ms, for 2 s after the cancel request
+            goal_handle.publish_feedback(feedback)
+            after_cancel += goal_handle.is_cancel_requested
+            time.sleep(0.02)
+        goal_handle.canceled()
+        return Fibonacci.Result(sequence=feedback.sequence)
+
+''', 'LateFeedbackServer()').replace("rclpy.spin(node)", "rclpy.spin(node, MultiThreadedExecutor())")
+
+
+def test_no_feedback_follows_goal_canceled(tmp_path):
+    """Ctrl-C during `send_goal --feedback` cancels the goal, and feedback that the server still
+    sends after accepting the cancel is not printed after "Goal canceled." (ros2action stops
+    spinning there): the output ends with that line."""
+    script = tmp_path / "late_feedback_server.py"
+    script.write_text(LATE_FEEDBACK_SERVER)
+    with rosenv.reserve_domain_id() as reservation:
+        env = rosenv.ros_environment(domain_id=reservation.domain_id)
+        with processes.NodeProcess([sys.executable, str(script)], name="late_feedback_server",
+                                   domain_id=reservation.domain_id) as server:
+            server.wait_for_node("/late_feedback_server", timeout=30)
+            sending = subprocess.Popen([str(ROS2), "action", "send_goal", "-f", "/fibonacci",
+                                        "test_msgs/action/Fibonacci", "{order: 5}"], env=env,
+                                       stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                                       stdin=subprocess.DEVNULL)
+            try:
+                while sending.stdout.readline() not in ("Feedback:\n", ""):
+                    pass
+                sending.send_signal(signal.SIGINT)
+                out, err = sending.communicate(timeout=60)
+            finally:
+                sending.kill()
+                sending.wait()
+    lines = out.splitlines()
+    assert "Canceling goal..." in lines and lines[-1] == "Goal canceled.", (out, err)
+    assert "Traceback" not in err
 
 
 def test_bad_goals_fail_in_ros2actions_words(server):

@@ -138,3 +138,33 @@ def test_parallel_domains_get_daemons_of_their_own(domain):
         ours, theirs = daemon_pids(int(domain["ROS_DOMAIN_ID"])), daemon_pids(other.domain_id)
         assert len(ours) == len(theirs) == 1 and ours != theirs
     assert wait_until(lambda: not daemon_pids(other.domain_id))
+
+
+#: A notebook's session with its tool node, until Ctrl-C: prints the tool node's name once it runs.
+SESSION = ("import signal\nfrom course_lib.ros import session\nsession.start()\n"
+           "print(session.tool_node().get_name(), flush=True)\ntry:\n    signal.pause()\nexcept KeyboardInterrupt:\n"
+           "    session.stop()\n")
+
+
+def test_every_process_has_a_tool_node_of_its_own_name(domain):
+    """Two notebooks' sessions and the daemon each have a hidden tool node: `ros2 node list -a`
+    lists three names (four with --no-daemon: the command's own) and does not warn that nodes
+    share a name."""
+    sessions = [subprocess.Popen([sys.executable, "-c", SESSION], env=domain, stdout=subprocess.PIPE, text=True)
+                for _ in range(2)]
+    try:
+        names = ["/" + process.stdout.readline().strip() for process in sessions]
+        assert len(set(names)) == 2 and all(name.startswith("/_course_tools_") for name in names), names
+        for args, count in ((["-a"], 3), (["-a", "--no-daemon"], 4)):
+            assert wait_until(lambda args=args: set(names) <= set(ros2("node", "list", *args,
+                                                                        env=domain).stdout.split()))
+            listed = ros2("node", "list", *args, env=domain)
+            tools = [name for name in listed.stdout.split() if name.startswith("/_course_tools")]
+            assert len(tools) == len(set(tools)) == count, listed.stdout
+            assert "share an exact name" not in listed.stderr
+        assert ros2("node", "list", env=domain).stdout == ""
+    finally:
+        for process in sessions:
+            process.send_signal(signal.SIGINT)
+        for process in sessions:
+            process.communicate(timeout=60)

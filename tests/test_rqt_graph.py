@@ -44,4 +44,4 @@ def test_draw_graph_shows_nodes_and_topics_left_to_right(local_session):
     arrows = [t for t in figure.axes[0].texts if isinstance(t, Annotation)]
     assert len(arrows) == 2
     everything = {t.get_text() for t in rqt_graph.draw_graph(all=True, hide_topics=()).axes[0].texts}
-    assert {"/rosout", "/parameter_events", "/" + session.TOOL_NODE_NAME} <= everything
+    assert {"/rosout", "/parameter_events", "/" + session.tool_node_name()} <= everything

@@ -337,7 +337,7 @@ def test_tool_node_is_hidden_lazy_and_single(domain_id):
     assert session._state.tool is None
     tool = session.tool_node()
     assert session.tool_node() is tool
-    assert tool.get_name() == session.TOOL_NODE_NAME
+    assert tool.get_name() == session.tool_node_name()
     assert tool.get_name().startswith("_")
     assert session.nodes() == []
 

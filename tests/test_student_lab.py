@@ -101,14 +101,35 @@ def test_validate_progress_counts_the_code_cells_the_validation_runs():
     progress = ValidateProgress()
     assert progress.of("a/b.ipynb") == {"running": False}
     progress.start("a/b.ipynb", notebook)
-    assert progress.of("a/b.ipynb") == {"running": True, "cell": 0, "cells": 2, "line": ""}
+    assert progress.of("a/b.ipynb") == {"running": True, "cell": 0, "cells": 2, "line": "", "doing": ""}
     hook = progress.hook("a/b.ipynb")
     hook(cell=notebook.cells[1], cell_index=1)
-    assert progress.of("a/b.ipynb") == {"running": True, "cell": 1, "cells": 2, "line": "import os"}
+    assert progress.of("a/b.ipynb") == {"running": True, "cell": 1, "cells": 2, "line": "import os", "doing": ""}
     hook(cell=notebook.cells[3], cell_index=3)
     assert progress.of("a/b.ipynb")["cell"] == 2 and progress.of("other.ipynb") == {"running": False}
     progress.finish("a/b.ipynb")
     assert progress.of("a/b.ipynb") == {"running": False}
+
+
+def test_validate_progress_says_what_a_long_cell_does():
+    """A build cell says it builds (35-67 s under "cell 11 of 14" said nothing), a graded test cell
+    that it runs the checks; an ordinary cell, a solution cell and a cell that only mentions
+    colcon say nothing more than their number."""
+    from course_lib.notebook.student_lab.validate_progress import ValidateProgress
+
+    def graded(source, **meta):
+        return nbformat.v4.new_code_cell(source, metadata={"nbgrader": {"grade": True, "points": 1, **meta}})
+
+    cells = [nbformat.v4.new_code_cell("!python -m course_lib build ros2_ws --symlink-install"),
+             graded("checks.selfcheck('node')"), graded("def f():\n    pass", solution=True),
+             nbformat.v4.new_code_cell("print('colcon build')"), nbformat.v4.new_code_cell("x = 1")]
+    progress = ValidateProgress()
+    progress.start("a.ipynb", nbformat.v4.new_notebook(cells=cells))
+    hook, said = progress.hook("a.ipynb"), []
+    for index, cell in enumerate(cells):
+        hook(cell=cell, cell_index=index)
+        said.append(progress.of("a.ipynb")["doing"])
+    assert said == ["building the workspace (colcon)", "running the graded checks", "", "", ""]
 
 
 def test_the_lab_loads_the_validate_progress_extension_from_the_student_config():
@@ -119,5 +140,6 @@ def test_the_lab_loads_the_validate_progress_extension_from_the_student_config()
 
     config = PyFileConfigLoader("jupyter_server_config.py", path=str(student_lab.CONFIG_DIR)).load_config()
     found = get_federated_extensions(config.LabApp.extra_labextensions_path)
-    extension = found["@course-lib/validate-progress"]
-    assert (Path(extension["ext_path"]) / extension["jupyterlab"]["_build"]["load"]).is_file()
+    for name in ("@course-lib/validate-progress", "@course-lib/validate-lesson"):
+        extension = found[name]
+        assert (Path(extension["ext_path"]) / extension["jupyterlab"]["_build"]["load"]).is_file()

@@ -38,11 +38,21 @@ def scaled(seconds: float) -> int:
     return round(backstop(seconds))
 
 
+def build_cell(cell) -> bool:
+    """Whether a cell builds a workspace with colcon (``python -m course_lib build``)."""
+    return "course_lib build" in cell.get("source", "")
+
+
+def graded_cell(cell) -> bool:
+    """Whether a cell is a graded test cell: it runs the assignment's checks."""
+    meta = cell.get("metadata", {}).get("nbgrader", {})
+    return bool(meta.get("grade") and not meta.get("solution"))
+
+
 def long_cell(cell) -> bool:
     """Whether a cell may run long: a graded test cell (its checks), or a workspace's build cell (a
     message package takes tens of seconds to build). Every other cell is an ordinary one."""
-    meta = cell.get("metadata", {}).get("nbgrader", {})
-    return "course_lib build" in cell.get("source", "") or bool(meta.get("grade") and not meta.get("solution"))
+    return build_cell(cell) or graded_cell(cell)
 
 
 def cell_timeout(cell) -> int:

@@ -31,7 +31,7 @@ In plain ROS 2 the same is an executor spinning in a thread of its own::
     ...
     executor.shutdown(); node.destroy_node(); rclpy.try_shutdown()
 
-A hidden node, :data:`TOOL_NODE_NAME`, serves the introspection helpers of
+A hidden node (its name: :func:`tool_node_name`) serves the introspection helpers of
 :mod:`course_lib.ros.graph`; it is created on first use and never listed by :func:`nodes`.
 """
 
@@ -40,6 +40,7 @@ from __future__ import annotations
 import atexit
 import functools
 import math
+import os
 import sys
 import threading
 import time
@@ -50,8 +51,8 @@ from course_lib import waiting
 from course_lib.ros import node_logs, node_names, rclpy_backports, rosenv, teardown
 from course_lib.ros.run_limits import time_limit
 
-#: Name of the session's hidden helper node (a leading "_" hides it from node listings).
-TOOL_NODE_NAME = "_course_tools"
+#: How the name of every process's hidden helper node starts (a leading "_" hides it from node listings).
+TOOL_NODE_PREFIX = "_course_tools"
 
 # How long the background thread waits for work before it looks at its own state again.
 _SPIN_PERIOD = 0.1
@@ -296,8 +297,8 @@ def add_node(node):
             raise ValueError(f"Node {name} belongs to another ROS context (it was made before "
                              "the session restarted, or with context=...): create it again "
                              "after session.start(), without a context argument")
-        if name == "/" + TOOL_NODE_NAME:
-            raise ValueError(f"The name {TOOL_NODE_NAME} is reserved for the session's tool "
+        if name == "/" + tool_node_name():
+            raise ValueError(f"The name {tool_node_name()} is reserved for the session's tool "
                              "node: give your node another name")
         old = state.nodes.get(name)
         if old is node:
@@ -408,6 +409,14 @@ def nodes() -> list:
         return [] if _state is None else list(_state.nodes.values())
 
 
+def tool_node_name() -> str:
+    """The name of this process's tool node: the prefix and the process id.
+
+    Every notebook kernel, `ros2` command and `ros2` daemon has one; with one name for all, `ros2
+    node list -a` warned that nodes share a name."""
+    return f"{TOOL_NODE_PREFIX}_{os.getpid()}"
+
+
 def tool_node():
     """The session's hidden helper node for graph introspection, created on first use."""
     from rclpy.node import Node
@@ -419,7 +428,7 @@ def tool_node():
             # Without parameter services and type description service: nobody asks a hidden
             # tool node for them, and the latter makes creating the node (and so every `ros2`
             # command) take twice as long.
-            state.tool = Node(TOOL_NODE_NAME, context=state.context, start_parameter_services=False,
+            state.tool = Node(tool_node_name(), context=state.context, start_parameter_services=False,
                               parameter_overrides=[Parameter("start_type_description_service", value=False)])
             state.tool.created_at = time.monotonic()
             state.executor.add_node(state.tool)

@@ -163,11 +163,16 @@ def _send_goal(args) -> str | None:
     handle = None
     # Feedback comes in the session's thread, and may come before this thread has seen the goal
     # accepted: held until then, it is printed after "Goal accepted", as ros2action's one thread does.
+    # Once the goal has ended ("Goal finished", "Goal canceled.") it is dropped: ros2action stops
+    # spinning there, so nothing follows those lines.
     printing = threading.Lock()
     held: list | None = []
+    ended = False
 
     def show_feedback(feedback):
         with printing:
+            if ended:
+                return
             if held is None:
                 print(f"Feedback:\n    {_yaml(feedback.feedback)}")
             else:
@@ -212,16 +217,21 @@ def _send_goal(args) -> str | None:
         with printing:
             print(f"Result:\n    {_yaml(result.result)}")
             print(f"Goal finished with status: {STATUS_WORDS.get(result.status, 'UNKNOWN')}")
+            ended = True
         return None
     finally:
         if handle is not None and STATUS_WORDS.get(handle.status) in ("ACCEPTED", "EXECUTING"):
             # Ctrl-C while the goal runs: like ros2action, cancel it
             _cancel(handle)
+            with printing:
+                print("Goal canceled.")
+                ended = True
         # The client is not destroyed here: the command's process ends, and the session's stop
         # destroys its tool node (the client with it) once the executor no longer waits on it.
 
 
 def _cancel(handle) -> None:
+    """Ask the server to cancel the goal and wait until it accepts (the caller says so)."""
     print("Canceling goal...")
     canceling = handle.cancel_goal_async()
     if not wait_until(canceling.done, DEFAULT_SPIN_TIME * 10):
@@ -229,7 +239,6 @@ def _cancel(handle) -> None:
     goals = canceling.result().goals_canceling
     if len(goals) != 1 or goals[0].goal_id != handle.goal_id:
         raise RuntimeError("Failed to cancel goal")
-    print("Goal canceled.")
 
 
 VERBS = {

@@ -14,8 +14,10 @@ never uses, and say what Validate does:
   without a kernel; an assignment is validated by nbgrader, in a thread), and the Assignments panel
   with :mod:`course_lib.notebook.student_lab.assignment_list` (a refused Submit shows its reason, not a
   traceback);
-- ``jupyter_server_config.py``: JupyterLab also loads the lab extension in ``labextensions/``,
-  which shows on the Validate button which cell the validation runs (``validate_progress``).
+- ``jupyter_server_config.py``: JupyterLab also loads the lab extensions in ``labextensions/``:
+  one shows on the Validate button which cell the validation runs and what a long one does
+  (``validate_progress``), one shows a lesson's answer under its own heading, not nbgrader's error
+  heading (``validate.LESSON_HEADING``).
 
 The same with nbgrader's own commands, for a whole installation::
 

@@ -7,7 +7,7 @@ wrote. This server extension takes the place of nbgrader's ``validate_assignment
 (``jupyter_server_config.json`` beside this file swaps them) and serves the same URLs with the
 same handlers, except that Validate on a notebook without nbgrader cells answers with
 :data:`LESSON_ANSWER` before a kernel starts: nothing runs, nothing is left running, and the
-dialog shows four short lines instead of a traceback. An assignment is validated in a thread, so
+dialog shows a heading and four short lines instead of a traceback. An assignment is validated in a thread, so
 that the server answers meanwhile, among others the lab extension that asks which cell runs
 (:mod:`course_lib.notebook.student_lab.validate_progress`).
 """
@@ -25,9 +25,15 @@ from tornado.ioloop import IOLoop
 
 from course_lib.notebook.student_lab.validate_progress import PROGRESS, PROGRESS_URL, ProgressHandler
 
-#: What Validate answers on a lesson; nbgrader's dialog shows it under "There was an error running
-#: the validate command:". The fix comes first, and the lines are short (the dialog does not wrap them).
-LESSON_ANSWER = ("Use this lesson's self-check cells instead of Validate:\n"
+#: The heading of Validate's answer on a lesson, its first line. nbgrader's dialog shows an answer
+#: that is no validation under "There was an error running the validate command:"; for a notebook
+#: without nbgrader cells the lab extension labextensions/@course-lib/validate-lesson shows this
+#: line as the heading instead, in nbgrader's dialog of a success: the lesson did nothing wrong.
+LESSON_HEADING = "This is a lesson: Validate has nothing to grade here."
+#: What Validate answers on a lesson: the heading, then the fix, in short lines (the dialog does
+#: not wrap them).
+LESSON_ANSWER = (f"{LESSON_HEADING}\n"
+                 "Use this lesson's self-check cells instead of Validate:\n"
                  "each answers ✔ or ✘ and says what is wrong.\n"
                  "Validate checks an assignment's graded cells; a lesson has none.\n"
                  "Your assignments: Nbgrader > Assignment List.")

@@ -1,4 +1,5 @@
-"""What Validate is doing while nbgrader runs an assignment: which cell, of how many.
+"""What Validate is doing while nbgrader runs an assignment: which cell, of how many, and what a
+long cell does (a build, the graded checks).
 
 nbgrader's Validate runs the whole notebook on the server (13-18 s for the brightness
 assignment) while its button says only "Validating...". :class:`ValidateProgress` records, per
@@ -17,21 +18,34 @@ import threading
 from jupyter_server.base.handlers import JupyterHandler
 from tornado import web
 
+from course_lib.checks import validate
+
 #: The URL of the progress, under the server's base URL (the lab extension asks it).
 PROGRESS_URL = "course-lib/validate-progress"
 
 
 @dataclasses.dataclass
 class Step:
-    """Where one validation is: ``cell`` of ``cells`` code cells (0 before the first), and the
-    first line of the cell that runs."""
+    """Where one validation is: ``cell`` of ``cells`` code cells (0 before the first), the first
+    line of the cell that runs, and what it does when that takes long (:func:`doing`)."""
 
     cell: int
     cells: int
     line: str = ""
+    doing: str = ""
 
     def as_json(self) -> dict:
-        return {"running": True, "cell": self.cell, "cells": self.cells, "line": self.line}
+        return {"running": True, "cell": self.cell, "cells": self.cells, "line": self.line, "doing": self.doing}
+
+
+def doing(cell) -> str:
+    """What a cell that may run long does, in the words the button shows; "" for any other cell
+    (a build took 35-67 s, and "cell 11 of 14" all along said nothing of it)."""
+    if validate.build_cell(cell):
+        return "building the workspace (colcon)"
+    if validate.graded_cell(cell):
+        return "running the graded checks"
+    return ""
 
 
 def code_cells(notebook) -> list:
@@ -60,7 +74,8 @@ class ValidateProgress:
                 step = self._steps.get(path)
                 if step is not None:
                     lines = cell.source.strip().splitlines()
-                    self._steps[path] = Step(min(step.cell + 1, step.cells), step.cells, lines[0] if lines else "")
+                    self._steps[path] = Step(min(step.cell + 1, step.cells), step.cells, lines[0] if lines else "",
+                                             doing(cell))
 
         return on_cell_execute
 

@@ -1,7 +1,8 @@
 /* The student lab's Validate progress (course_lib/notebook/student_lab/validate_progress.py is the server
  * side): while nbgrader's Validate runs an assignment, its button says what runs, once a second:
  * "Validating: starting the kernel", "Validating: cell 7 of 23", "Validating: reading the results",
- * and its tooltip the first line of that cell.
+ * and its tooltip the first line of that cell. A cell that may run long says what it does first:
+ * "Validating: building the workspace (colcon), cell 11 of 14".
  *
  * Written by hand as the module-federation container JupyterLab loads for an extension (an object
  * with get and init in window._JUPYTERLAB): the plugin imports no JupyterLab module, so it needs
@@ -20,8 +21,9 @@
 
   function said(step) {
     if (step.cell === 0) return "Validating: starting the kernel";
-    if (step.cell >= step.cells) return `Validating: cell ${step.cells} of ${step.cells}, then the results`;
-    return `Validating: cell ${step.cell} of ${step.cells}`;
+    const where = step.doing ? `${step.doing}, cell ${step.cell}` : `cell ${step.cell}`;
+    if (step.cell >= step.cells) return `Validating: ${where} of ${step.cells}, then the results`;
+    return `Validating: ${where} of ${step.cells}`;
   }
 
   const followed = new WeakSet();
