@@ -48,6 +48,9 @@ def domain():
     """A reserved ROS domain; yields the environment of a ros2 command in it. Its daemon ends with
     the reservation; the test checks that it did."""
     with rosenv.reserve_domain_id() as reservation:
+        # A daemon of the id's last reservation ends once it sees this one's token (even in the
+        # same worker, which gets the same id again at once): none adopts a new reservation.
+        assert wait_until(lambda: not daemon_pids(reservation.domain_id)), "a daemon outlived its reservation"
         yield rosenv.ros_environment(domain_id=reservation.domain_id)
         domain_id = reservation.domain_id
     assert wait_until(lambda: not daemon_pids(domain_id)), "the daemon outlived its domain's reservation"

@@ -24,6 +24,7 @@ import shlex
 import shutil
 import sys
 import tempfile
+import time
 from pathlib import Path
 
 from course_lib import contract
@@ -306,6 +307,24 @@ class DomainReservation:
         return f"DomainReservation({self.domain_id})"
 
 
+def reservation_token(domain_id: int) -> str | None:
+    """The token of the current reservation of `domain_id` (reserve_domain_id), None when nobody
+    holds it."""
+    path = reservation_dir() / f"{domain_id}.lock"
+    try:
+        with open(path) as handle:
+            try:
+                fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except OSError as error:
+                if error.errno in (errno.EAGAIN, errno.EACCES):
+                    return handle.read().strip() or None
+                raise
+            fcntl.flock(handle, fcntl.LOCK_UN)
+            return None
+    except FileNotFoundError:
+        return None
+
+
 def reservation_dir() -> Path:
     """The folder of this user's domain reservations (one lock file per reserved domain id)."""
     path = Path(tempfile.gettempdir()) / f"course_lib-domains-{os.getuid()}"
@@ -331,6 +350,12 @@ def reserve_domain_id(candidates=RESERVABLE_DOMAIN_IDS) -> DomainReservation:
             if error.errno in (errno.EAGAIN, errno.EACCES):
                 continue
             raise
+        # Each reservation writes a token of its own into the file: what outlives one reservation
+        # (a ros2 daemon) tells it from the next one of the same id (reservation_token).
+        handle.seek(0)
+        handle.truncate()
+        handle.write(f"{os.getpid()} {time.monotonic_ns()}\n")
+        handle.flush()
         return DomainReservation(domain_id, handle)
     raise RuntimeError(f"All ROS domain ids {candidates.start}-{candidates.stop - 1} are reserved by "
                        f"other processes (locks in {lock_dir}); wait for other test or grading runs to end")

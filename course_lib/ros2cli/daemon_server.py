@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import errno
 import fcntl
 import json
 import os
@@ -163,6 +162,7 @@ class Lifelines:
 
     def cut(self) -> str | None:
         """Why the daemon should end now, or None."""
+        from course_lib.ros import rosenv
         from course_lib.supervision import process_tree
 
         now = time.monotonic()
@@ -179,34 +179,21 @@ class Lifelines:
                 alive = False
             if not alive:
                 return f"its owner, process {self.owner}, has ended"
-        if self.reservation is not None and not _held(self.reservation):
+        if self.reservation is not None and rosenv.reservation_token(self.reservation[0]) != self.reservation[1]:
             return "the reservation of its ROS domain has ended"
         return None
 
 
-def _reservation_file() -> str | None:
-    """The lock file of this domain's reservation (rosenv.reserve_domain_id), if someone holds it."""
+def _reservation_file() -> tuple[int, str] | None:
+    """This domain and the token of its reservation (rosenv.reserve_domain_id), if someone holds it:
+    the daemon ends when that reservation does, even when the same id is reserved again at once."""
     from course_lib.ros import rosenv
 
     domain = int(os.environ.get("ROS_DOMAIN_ID", "0") or 0)
     if domain not in rosenv.RESERVABLE_DOMAIN_IDS:
         return None
-    path = rosenv.reservation_dir() / f"{domain}.lock"
-    return str(path) if path.exists() and _held(str(path)) else None
-
-
-def _held(path: str) -> bool:
-    """Whether some process holds the flock on ``path`` (taken and let go at once to tell)."""
-    try:
-        with open(path, "a+") as handle:
-            try:
-                fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
-            except OSError as error:
-                return error.errno in (errno.EAGAIN, errno.EACCES)
-            fcntl.flock(handle, fcntl.LOCK_UN)
-            return False
-    except OSError:
-        return False
+    token = rosenv.reservation_token(domain)
+    return (domain, token) if token else None
 
 
 # --- serving --------------------------------------------------------------------------------
