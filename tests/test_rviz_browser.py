@@ -1,6 +1,7 @@
 """The notebook's RViz in JupyterLab in headless Chromium: a marker at a known pose, a scan of a
 known wall and a TF frame land at the expected pixels of the canvas, with the camera fixed; a click
-with Publish Point and a drag with 2D Goal Pose publish the point and pose under the mouse.
+with Publish Point and a drag with 2D Goal Pose publish the point and pose under the mouse; after a
+kernel restart and a re-run cell there is one view, one node with one subscription, still drawing.
 
 The notebook's kernel publishes (a node in its own session, 5 Hz) a scan of a wall 2 m ahead of
 the laser, the laser 1 m along x of odom (as geometry_msgs/TransformStamped on /rviz_test_tf:
@@ -180,6 +181,65 @@ def test_a_click_publishes_the_point_and_a_drag_the_goal_pose_under_the_mouse(sh
     assert np.allclose([point.point.x, point.point.y, point.point.z], [1.5, -1.0, 0.0], atol=0.03)
     assert np.allclose([goal.pose.position.x, goal.pose.position.y], [-1.0, -1.0], atol=0.03)
     assert np.allclose([goal.pose.orientation.z, goal.pose.orientation.w], [0.5 ** 0.5] * 2, atol=0.01)
+
+
+RESTART_JS = "() => window.jupyterapp.shell.currentWidget.sessionContext.session.kernel.restart()"
+RUN_VIEW_CELL_JS = """() => { const panel = window.jupyterapp.shell.currentWidget;
+  panel.content.activeCellIndex = 1; return window.jupyterapp.commands.execute('notebook:run-cell'); }"""
+VIEW_PROMPT_JS = """(n) => { const prompts = [...document.querySelectorAll('.jp-NotebookPanel:not(.lm-mod-hidden)'
+  + ' .jp-CodeCell .jp-InputArea-prompt')].map(p => p.textContent);
+  return prompts[1] === `[${n}]:` && !prompts.some(p => p.includes('*')); }"""
+# The one view on the page has shown `after` drawings or more, the newest it received.
+DRAWING_JS = """(after) => { const views = document.querySelectorAll('.rviz-view');
+  if (views.length !== 1) return null;
+  const el = views[0], seq = Number(el.dataset.seq || 0);
+  return seq >= after && el.dataset.seq === el.dataset.received ? seq : null; }"""
+
+
+@pytest.mark.timeout(400)
+def test_the_view_keeps_drawing_after_a_kernel_restart_and_a_re_run_cell_with_one_node(shown):
+    """Restart the kernel, run all, run the view's cell again: one view on the page, one node
+    _rviz_rviz in the ROS graph with one subscription to /scan, and a new marker drawn at its pixels."""
+    from course_lib.ros import session
+
+    page, _ = shown
+    page.evaluate(RESTART_JS)
+    run = run_notebook(page, "rviz.ipynb", len(NOTEBOOK_CELLS), 240)
+    assert run.problems() == [], run.problems()
+    page.evaluate(RUN_VIEW_CELL_JS)
+    page.wait_for_function(VIEW_PROMPT_JS, arg=3, timeout=60_000, polling=100)
+    session.start()
+    node = session.tool_node()
+
+    def views_in_graph():
+        nodes = [name for name, _ in node.get_node_names_and_namespaces() if name == "_rviz_rviz"]
+        scans = [info for info in node.get_subscriptions_info_by_topic("/scan") if info.node_name == "_rviz_rviz"]
+        return len(nodes), len(scans)
+    # The restarted kernel's participant may take a moment to leave the graph.
+    session.wait_for(lambda: views_in_graph() == (1, 1), timeout=60)
+    assert views_in_graph() == (1, 1), "(nodes _rviz_rviz, their subscriptions to /scan)"
+    # A new message reaches the new view: a green cube at (2, -2), from this process.
+    from visualization_msgs.msg import Marker
+
+    publisher = node.create_publisher(Marker, "/visualization_marker", 10)
+    cube = Marker(type=Marker.CUBE, ns="restart", id=1)
+    cube.header.frame_id = "odom"
+    cube.pose.position.x, cube.pose.position.y, cube.pose.orientation.w = 2.0, -2.0, 1.0
+    cube.scale.x = cube.scale.y = cube.scale.z = 0.6
+    cube.color.g, cube.color.a = 1.0, 1.0
+    try:
+        def drawn():  # again until it arrives: the view's subscription may not have matched yet
+            publisher.publish(cube)
+            return page.evaluate(DRAWING_JS, 1) is not None and page.locator(".rviz-display").filter(
+                has_text="restart: 1").count() == 1
+        assert session.wait_for(drawn, timeout=60, poll=0.2), page.locator(".rviz-display").all_inner_texts()
+    finally:
+        node.destroy_publisher(publisher)
+    shot = page.screenshot(clip=canvas_box(page))
+    picture = cv2.cvtColor(cv2.imdecode(np.frombuffer(shot, np.uint8), cv2.IMREAD_COLOR), cv2.COLOR_BGR2RGB)
+    r, g, b = colours_near(picture, 2.0, -2.0).mean(axis=0)
+    assert g > 120 and r < 60 and b < 60, (r, g, b)
+    assert page.locator(".rviz-display").filter(has_text="points of 720 beams").count() == 1
 
 
 def _target() -> Path:

@@ -45,7 +45,7 @@ BUNDLE_FIX = "run `make setup` in the course folder (it bundles three.js from np
 #: Drawings in flight (sent, not yet shown) at most; and how long a missing answer holds the next one.
 #: One in flight ties the rate to the round trip (kernel, server, browser's next frame, back: 50-80 ms
 #: on a loaded machine, 12.6 drawings/s of a 20 Hz scan with its transforms); three keep it at the
-#: scans' rate, and the browser merges what arrives between two of its frames (newest per layer).
+#: scans' rate; the browser shows one per animation frame, merging beyond two waiting (newest per layer).
 MAX_IN_FLIGHT = 3
 STALL_SECONDS = 1.0
 LIMITED_SECONDS = 10.0

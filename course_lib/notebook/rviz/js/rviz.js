@@ -15,6 +15,7 @@ import { mergeGeometries } from "three/addons/utils/BufferGeometryUtils.js";
 // Colours are used as the messages give them (0-255 per channel on screen), as RViz shows them.
 THREE.ColorManagement.enabled = false;
 
+const MAX_WAITING = 2; // drawings received and not yet on screen, at most (see render's `waiting`)
 const BACKGROUND = 0x303030; // RViz's background, (48, 48, 48)
 const LEVEL_COLORS = { ok: "#2e7d32", warn: "#b26a00", error: "#c62828" };
 
@@ -38,6 +39,22 @@ function typedArray(ref, buffers) {
   return ref.dtype === "uint8" ? new Uint8Array(bytes) : new Float32Array(bytes);
 }
 
+// Materials are shared and kept, never disposed with a layer: three.js deletes a shader program
+// when its last material is disposed, and compiling it again for the next drawing (SwiftShader,
+// headless Chromium) blocked the page for 50-120 ms about 8 times a second, while the kernel's
+// messages queued behind it and reached the view in bursts. Keys are few: a kind, a point size,
+// an opacity in 1/255 steps, a text.
+const materials = new Map();
+
+function sharedMaterial(key, make) {
+  let material = materials.get(key);
+  if (!material) {
+    material = make();
+    materials.set(key, material);
+  }
+  return material;
+}
+
 // A frame's name is drawn again with every transform: its texture is made once and kept.
 const textTextures = new Map();
 
@@ -48,7 +65,7 @@ function textSprite(text, color, height) {
     texture = textTexture(text, color);
     textTextures.set(key, texture);
   }
-  const sprite = new THREE.Sprite(new THREE.SpriteMaterial({ map: texture, depthTest: false }));
+  const sprite = new THREE.Sprite(sharedMaterial(`sprite|${key}`, () => new THREE.SpriteMaterial({ map: texture, depthTest: false })));
   sprite.scale.set((height * texture.image.width) / texture.image.height, height, 1);
   return sprite;
 }
@@ -129,10 +146,13 @@ class Scene {
       for (const object of group.children)
         if (object.isPoints) {
           const metres = object.userData.size;
-          object.material.sizeAttenuation = !this.pixelsPerMetre;
+          const attenuation = !this.pixelsPerMetre;
+          if (object.material.sizeAttenuation !== attenuation) { // a define of its program: compiled again
+            object.material.sizeAttenuation = attenuation;
+            object.material.needsUpdate = true;
+          }
           object.material.size = this.pixelsPerMetre
             ? Math.max(2, metres * this.pixelsPerMetre * this.camera.zoom) : metres;
-          object.material.needsUpdate = true;
         }
     this.dirty = true;
   }
@@ -145,16 +165,18 @@ class Scene {
       geometry.setAttribute("position", new THREE.BufferAttribute(typedArray(item.positions, buffers), 3));
       geometry.setAttribute("color", new THREE.BufferAttribute(colors, 4, true));
       if (item.type === "lines")
-        return [new THREE.LineSegments(geometry, new THREE.LineBasicMaterial({ vertexColors: true, transparent }))];
-      const points = new THREE.Points(geometry, new THREE.PointsMaterial({ vertexColors: true, transparent }));
+        return [new THREE.LineSegments(geometry, sharedMaterial(`lines|${transparent}`,
+          () => new THREE.LineBasicMaterial({ vertexColors: true, transparent })))];
+      const points = new THREE.Points(geometry, sharedMaterial(`points|${item.size}|${transparent}`,
+        () => new THREE.PointsMaterial({ vertexColors: true, transparent })));
       points.userData.size = item.size;
       return [points];
     }
     if (item.type === "shapes") {
       const matrices = typedArray(item.matrices, buffers);
       const count = matrices.length / 16;
-      const opacity = colors.filter((_, index) => index % 4 === 3).reduce((a, b) => a + b, 0) / count / 255;
-      const material = new THREE.MeshLambertMaterial({ transparent: opacity < 1, opacity });
+      const opacity = Math.round(colors.filter((_, index) => index % 4 === 3).reduce((a, b) => a + b, 0) / count) / 255;
+      const material = sharedMaterial(`shapes|${opacity}`, () => new THREE.MeshLambertMaterial({ transparent: opacity < 1, opacity }));
       const mesh = new THREE.InstancedMesh(this.shapes[item.shape], material, count);
       const matrix = new THREE.Matrix4(), color = new THREE.Color();
       for (let i = 0; i < count; i++) {
@@ -179,8 +201,7 @@ class Scene {
     const old = this.layers.get(name);
     if (old) {
       this.scene.remove(old);
-      old.traverse((object) => {
-        if (object.material) object.material.dispose(); // text textures stay in textTextures
+      old.traverse((object) => { // materials (and text textures) are shared and stay
         if (object.geometry && !Object.values(this.shapes).includes(object.geometry)) object.geometry.dispose();
       });
     }
@@ -338,16 +359,22 @@ function render({ model, el }) {
   scene.setCamera(model.get("camera"));
   el.insertBefore(toolBar(model, scene), el.firstChild);
   useTools(model, scene);
-  // The layers not on screen yet, each the newest drawing of it: a layer drawn again before the next
-  // frame replaces its older drawing (nothing queues), and a layer only the older message had stays.
-  let pending = new Map();
-  let pendingSeq = 0;
+  // The drawings not on screen yet, oldest first, one shown per animation frame: the kernel sends
+  // them evenly, but a busy page or server hands them over in bunches, and a bunch merged into one
+  // frame showed 12-17 frames/s of a 20 Hz scan. Beyond MAX_WAITING the oldest two merge (per
+  // layer the newer drawing wins; a layer only the older had stays): a lagging page skips, never queues.
+  const waiting = [];
   let running = true;
 
   model.on("msg:custom", (content, buffers) => {
     if (content.kind !== "layers") return;
-    for (const [name, items] of Object.entries(content.layers)) pending.set(name, { items, buffers });
-    pendingSeq = content.seq;
+    const layers = new Map(Object.entries(content.layers).map(([name, items]) => [name, { items, buffers }]));
+    waiting.push({ seq: content.seq, layers });
+    while (waiting.length > MAX_WAITING) {
+      const [older, newer] = waiting.splice(0, 2);
+      for (const [name, layer] of newer.layers) older.layers.set(name, layer);
+      waiting.unshift({ seq: newer.seq, layers: older.layers });
+    }
     el.dataset.received = String(content.seq);
   });
   model.on("change:camera", () => {
@@ -363,15 +390,15 @@ function render({ model, el }) {
   function frame() {
     if (!running) return;
     if (scene.controls.autoRotate) scene.controls.update(); // a spinning orbit: a frame each time
-    if (pending.size) {
-      for (const [name, { items, buffers }] of pending) scene.setLayer(name, items, buffers);
-      pending = new Map();
+    if (waiting.length) {
+      const { seq, layers } = waiting.shift();
+      for (const [name, { items, buffers }] of layers) scene.setLayer(name, items, buffers);
       scene.pointSizes();
       scene.render();
-      el.dataset.seq = String(pendingSeq);
+      el.dataset.seq = String(seq);
       el.dataset.frames = String(scene.frames);
       el.dataset.renderMs = scene.renderMs.toFixed(2);
-      model.send({ kind: "drawn", seq: pendingSeq, frames: scene.frames, render_ms: scene.renderMs });
+      model.send({ kind: "drawn", seq, frames: scene.frames, render_ms: scene.renderMs });
     } else if (scene.dirty) {
       scene.render();
       el.dataset.frames = String(scene.frames);
