@@ -22,6 +22,8 @@ import sys
 import time
 from pathlib import Path
 
+from autograder import untrusted
+
 #: Bumped when the way interface packages are built changes: older cache entries are then unused.
 CACHE_VERSION = "1"
 
@@ -32,9 +34,9 @@ def content_key(folder: Path, underlay_keys=()) -> str:
     for key in underlay_keys:
         digest.update(key.encode() + b"\0")
     for path in sorted(p for p in folder.rglob("*") if p.is_file() or p.is_symlink()):
-        # A student's link is named, never followed (root reads these files).
-        content = b"link " + os.readlink(path).encode() if path.is_symlink() else path.read_bytes()
-        digest.update(str(path.relative_to(folder)).encode() + b"\0" + content + b"\0")
+        kind, content = untrusted.read_entry(path)  # a student's link is named, never followed
+        digest.update(str(path.relative_to(folder)).encode() + b"\0" + (b"link " if kind == "link" else b"")
+                      + content + b"\0")
     return digest.hexdigest()[:32]
 
 
@@ -99,10 +101,9 @@ def workspace_key(src: Path, interface_keys=()) -> str:
         if any(part in ("__pycache__", ".ipynb_checkpoints") for part in relative.parts):
             continue
         digest.update(str(relative).encode() + b"\0")
-        if path.is_symlink():
-            digest.update(b"link " + os.readlink(path).encode() + b"\0")
-        elif path.suffix != ".py" or path.name == "setup.py":
-            digest.update(path.read_bytes() + b"\0")
+        if path.is_symlink() or path.suffix != ".py" or path.name == "setup.py":
+            kind, content = untrusted.read_entry(path)
+            digest.update((b"link " if kind == "link" else b"") + content + b"\0")
     return digest.hexdigest()[:32]
 
 

@@ -179,3 +179,25 @@ def _too_large(relative: str, walk: _Walk) -> None:
     megabytes = walk.limits.max_bytes / 1e6
     raise Refused(f"Your submission holds more than {megabytes:g} MB (at {shown(relative)}), so it was not taken: "
                   "leave out large files (recordings, builds, data sets) and submit again.")
+
+
+def read_entry(path) -> tuple[str, bytes]:
+    """What a file a student's code may still change is, read without following it or blocking:
+    ("link", its target), ("file", its bytes) or ("other", b"") for a FIFO, socket or device. For
+    the digests root takes of a workspace the student's kernel wrote (a link swapped in, or a FIFO
+    made, between a look and the read is caught by what was opened)."""
+    try:
+        opened = os.open(path, _OPEN)
+    except OSError as error:
+        if error.errno == errno.ELOOP:
+            return "link", os.readlink(path).encode()
+        if error.errno == errno.ENXIO:  # a socket
+            return "other", b""
+        raise
+    try:
+        if not stat.S_ISREG(os.fstat(opened).st_mode):
+            return "other", b""
+        with os.fdopen(os.dup(opened), "rb") as handle:
+            return "file", handle.read()
+    finally:
+        os.close(opened)

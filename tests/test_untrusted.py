@@ -102,3 +102,15 @@ def test_checking_alone_copies_nothing(tmp_path):
     before = sorted(tmp_path.iterdir())
     untrusted.copy_tree(source, None, ignore=IGNORE)
     assert sorted(tmp_path.iterdir()) == before
+
+
+def test_an_entry_is_read_as_what_it_is_without_following_or_blocking(tmp_path):
+    """read_entry (the digests of a kernel-written workspace): a link by its target, a file by its
+    bytes, a FIFO as 'other' without blocking."""
+    (tmp_path / "secret").write_text("root's")
+    (tmp_path / "file").write_text("mine")
+    (tmp_path / "link").symlink_to(tmp_path / "secret")
+    os.mkfifo(tmp_path / "fifo")
+    assert untrusted.read_entry(tmp_path / "file") == ("file", b"mine")
+    assert untrusted.read_entry(tmp_path / "link") == ("link", str(tmp_path / "secret").encode())
+    assert untrusted.read_entry(tmp_path / "fifo") == ("other", b"")
