@@ -49,6 +49,9 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def main(argv=None) -> int:
+    from autograder import nbgrader_cli
+
+    nbgrader_cli.import_without_server_extensions()  # the commands use nbgrader's steps, never its server
     parser = _parser()
     args = parser.parse_args(argv)
     try:

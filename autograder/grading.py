@@ -10,12 +10,13 @@ One submission is graded by autograder.pipeline; its result is recorded by autog
 
 from __future__ import annotations
 
+import contextlib
 import sys
 import threading
 import time
 from concurrent.futures import ThreadPoolExecutor
 
-from autograder import config, gradebook, store
+from autograder import config, fork_server, gradebook, store
 from autograder.pipeline import grade_submission
 from autograder.release import assignments_in, prepare_course, release
 from autograder.result import GradeResult
@@ -87,7 +88,8 @@ def grade(course_dir, assignment: str | None = None, workers: int = 1, force: bo
             bar.update(result)
         return result
 
-    with ThreadPoolExecutor(max_workers=max(1, workers)) as pool:
+    with fork_server.serving() if todo else contextlib.nullcontext(), \
+            ThreadPoolExecutor(max_workers=max(1, workers)) as pool:
         for sub, result in zip(todo, pool.map(work, todo), strict=True):
             results[sub.key] = result
     ordered = [results[s.key] for s in subs]

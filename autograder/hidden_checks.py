@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import json
 import os
-import sys
 from pathlib import Path
 
+from autograder import fork_server
 from autograder.result import GradeResult
 from autograder.sandbox import run_sandboxed
 from autograder.submissions import Submission
@@ -57,8 +57,8 @@ def run_checks(sub: Submission, names: list[str], out: Path, workdir: Path, doma
 
     checks = registry.checks_of(sub.assignment)
     out.mkdir(mode=0o700)
-    command = [sys.executable, "-m", "autograder.hidden_checks_process", sub.assignment, *names,
-               "--workdir", str(workdir), "--out", str(out)]
+    command = fork_server.program("autograder.hidden_checks_process", [sub.assignment, *names, "--workdir",
+                                                                        str(workdir), "--out", str(out)], env)
     wall = sum(checks[name].timeout + 30 for name in names)
     env = {**env, contract.CHECK_SEED_ENV: None, contract.SEED_ENV: os.environ.get(contract.SEED_ENV)}
     if seconds is not None:

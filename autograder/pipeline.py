@@ -41,7 +41,7 @@ import sys
 import time
 from pathlib import Path
 
-from autograder import config, early_checks, gradebook, intake, kernel, packages, work_folders
+from autograder import config, early_checks, fork_server, gradebook, intake, kernel, packages, work_folders
 from autograder.hidden_checks import apply_verdicts, grade_outside, graded_checks
 from autograder.nbgrader_cli import env_for_tools
 from autograder.outputs import keep_autograded, keep_log, scrub_paths
@@ -72,6 +72,9 @@ KEPT_FOR_CHECKS = 20.0
 #: one-core machine, where overlapping them gains nothing.
 #: Largest file a submission may write (MB).
 FILE_MB = 256
+#: The program that runs the notebook in the sandbox (nbgrader's autograde), through the grader's
+#: fork server when it has one (autograder.fork_server).
+RUN_NOTEBOOK = "autograder.sandboxed_autograde"
 #: Base of the per-worker uids (root only): uid = KERNEL_UID_BASE + reserved ROS domain id.
 KERNEL_UID_BASE = 61000
 #: The early build and checks run as the worker's uid + EARLY_UID_OFFSET: the kernel, which runs
@@ -201,11 +204,10 @@ def start_early_checks(g: Grading) -> None:
 
 
 def run_notebook(g: Grading) -> None:
-    """``nbgrader autograde`` in the sandbox, within the notebook's limits."""
+    """``nbgrader autograde`` in the sandbox (autograder.sandboxed_autograde), within the notebook's limits."""
     from course_lib.ros import processes
 
-    command = [sys.executable, "-m", "nbgrader", "autograde", g.sub.assignment, "--student", g.sub.student,
-               "--force", f"--CourseDirectory.root={g.root}"]
+    command = fork_server.program(RUN_NOTEBOOK, [str(g.root), g.sub.assignment, g.sub.student], g.env)
     g.notebook_seconds = round(min(NOTEBOOK_TIMEOUT, g.seconds_left(keep=KEPT_FOR_CHECKS)), 1)
     limits = processes.Limits(wall_seconds=g.notebook_seconds, memory_mb=contract.MEMORY_MB, file_size_mb=FILE_MB,
                               grace_seconds=2.0)

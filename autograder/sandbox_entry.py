@@ -159,7 +159,8 @@ def run_in_pid_namespace(command: list) -> int:
     if status is not None and os.WIFEXITED(status):
         return os.WEXITSTATUS(status)
     number = os.WTERMSIG(status) if status is not None else signal.SIGKILL  # no status: init was killed
-    signal.signal(number, signal.SIG_DFL)
+    if number not in (signal.SIGKILL, signal.SIGSTOP):  # those two have no handler to reset
+        signal.signal(number, signal.SIG_DFL)
     os.kill(os.getpid(), number)
     return 128 + number  # not reached
 

@@ -45,7 +45,7 @@ sys.path[:0] = [str(ROOT), str(ROOT / "tests"), str(ROOT / "benchmarks")]
 import zoo  # noqa: E402 (tests/zoo builds submissions from the reference solutions)
 from bench_suite_cpu import TICKS, _program  # noqa: E402
 
-from autograder import grading, release, sandbox  # noqa: E402
+from autograder import fork_server, grading, release, sandbox  # noqa: E402
 from course_lib import contract  # noqa: E402
 from course_lib.checks import assignments  # noqa: E402
 from course_lib.supervision import process_tree  # noqa: E402
@@ -55,14 +55,17 @@ GRADER = "grader main thread"
 KERNEL, CHILDREN = "kernel: start + cells", "cells' child processes"
 COLCON = "colcon build, or the copied build's setup scripts"
 SUPERVISORS = "supervisors (one per sandboxed command and per node)"
+NOTEBOOK, CHECKS = "autograder.sandboxed_autograde", "autograder.hidden_checks_process"
+AUTOGRADE = "nbgrader's autograde (its own Python, or forked from the fork server)"
+FORK_SERVER = "fork server: its imports, once, and a handler per run (autograder.fork_server)"
 NOT_SAMPLED = "not sampled (short-lived processes, tails after the last sample, tick rounding)"
 THREADS = ("grader, its worker thread (the steps: staging, reading scores, outputs, the result's gradebook)",
            "grader, the early run's thread (the build copied from the cache, then waiting for the checks)",
            "grader, its other threads and those that ended")
 ROWS = [f"{GRADER}: start (imports, course checks)", f"{GRADER}: while sandboxed processes run",
         f"{GRADER}: after (outputs, gradebook, report, grades.csv)", *THREADS,
-        "sandbox entry (unshare, outer + pid-1 init)", "nbgrader CLI: start (until its kernel starts)",
-        "nbgrader CLI: while the kernel runs", "nbgrader CLI: after (gradebook, graded notebook)",
+        "sandbox entry (unshare, outer + pid-1 init)", FORK_SERVER, f"{AUTOGRADE}: start (until its kernel starts)",
+        f"{AUTOGRADE}: while the kernel runs", f"{AUTOGRADE}: after (gradebook, graded notebook)",
         KERNEL, CHILDREN, COLCON, "checks process", SUPERVISORS, NOT_SAMPLED]
 BUSY = "the machine's busy CPU-s meanwhile (every process, the sampler's own included)"
 FEEDBACK = "feedback command (python -m autograder feedback), whole tree"
@@ -105,12 +108,14 @@ class TreeSampler:
             return COLCON
         if name in ("unshare", "python sandbox_entry.py"):
             return "sandbox entry (unshare, outer + pid-1 init)"
-        if name == "python -m nbgrader":
+        if name in ("python -m nbgrader", "python -m autograder.sandboxed_autograde", fork_server.run_name(NOTEBOOK)):
             return "nbgrader"
+        if name in ("fork-server", "fork-handler"):
+            return FORK_SERVER
         if name == "python -m autograder.kernel" or (name.startswith("python -c") and
                                                      "ipykernel" in " ".join(process_tree.command_line(pid))):
             return KERNEL
-        if name == "python -m autograder.hidden_checks_process":
+        if name in ("python -m autograder.hidden_checks_process", fork_server.run_name(CHECKS)):
             return "checks process"
         if name == "python supervisor.py":
             return SUPERVISORS
@@ -120,9 +125,9 @@ class TreeSampler:
 
     def _add(self, row: str, ticks: int) -> None:
         if row == "nbgrader":
-            row = ("nbgrader CLI: start (until its kernel starts)" if not self.kernel_seen else
-                   "nbgrader CLI: while the kernel runs" if self.kernel_alive else
-                   "nbgrader CLI: after (gradebook, graded notebook)")
+            row = (f"{AUTOGRADE}: start (until its kernel starts)" if not self.kernel_seen else
+                   f"{AUTOGRADE}: while the kernel runs" if self.kernel_alive else
+                   f"{AUTOGRADE}: after (gradebook, graded notebook)")
         self.rows[row] += ticks
 
     def sample(self) -> None:

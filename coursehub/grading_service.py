@@ -46,6 +46,8 @@ BATCH_SECONDS = 2.0
 #: Seconds between two publications of the rules for the students' servers (the due dates change
 #: in the gradebook, which is not read every second).
 PUBLISH_SECONDS = 30.0
+#: At a stop, how long the gradings' runs still going may take to end before they are killed.
+STOP_SECONDS = 5.0
 
 
 def _log(text: str) -> None:
@@ -243,7 +245,7 @@ def main(argv=None) -> int:
 
     from tornado import ioloop
 
-    from autograder import work_folders
+    from autograder import fork_server, work_folders
     from coursehub import grading_status
 
     course = course_settings.load(args.hub_dir)
@@ -258,19 +260,21 @@ def main(argv=None) -> int:
     service = Service(course, workers=max(1, workers), rules_file=course.submit_rules)
     # The hub stops its services with SIGINT, then SIGTERM: either ends the loop below.
     signal.signal(signal.SIGTERM, signal.default_int_handler)
-    try:
-        service.start()
-        prefix = os.environ.get("JUPYTERHUB_SERVICE_PREFIX", f"/{course_settings.GRADING_PAGE}")
-        grading_status.application(service.queue, prefix).listen(course.grading_port, "127.0.0.1")
-        _log(f"grading {', '.join(service.rules()) or 'nothing yet (c.GradeOnSubmit.assignments)'} on submission "
-             f"with {service.workers} worker(s); status at {prefix} (127.0.0.1:{course.grading_port})")
-        ioloop.IOLoop.current().start()
-    except KeyboardInterrupt:
-        pass
-    service.stopping.set()
-    # The gradings cut short (queued again at the next start) leave no work folder: the process
-    # becomes their remover when its worker threads hold any (autograder.work_folders).
-    work_folders.end_gradings()
+    # Before the service's threads: the gradings' sandboxed programs are forked from it.
+    with fork_server.serving(wait=STOP_SECONDS):
+        try:
+            service.start()
+            prefix = os.environ.get("JUPYTERHUB_SERVICE_PREFIX", f"/{course_settings.GRADING_PAGE}")
+            grading_status.application(service.queue, prefix).listen(course.grading_port, "127.0.0.1")
+            _log(f"grading {', '.join(service.rules()) or 'nothing yet (c.GradeOnSubmit.assignments)'} on "
+                 f"submission with {service.workers} worker(s); status at {prefix} (127.0.0.1:{course.grading_port})")
+            ioloop.IOLoop.current().start()
+        except KeyboardInterrupt:
+            pass
+        service.stopping.set()
+        # The gradings cut short (queued again at the next start) leave no work folder: the process
+        # becomes their remover when its worker threads hold any (autograder.work_folders).
+        work_folders.end_gradings()
     return 0
 
 

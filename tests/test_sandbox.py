@@ -108,6 +108,14 @@ def test_interpreter_below_a_closed_folder_is_reachable_for_another_uid_and_noth
 
 
 @needs_namespaces
+def test_a_command_killed_by_sigkill_is_reported_killed(tmp_path):
+    """The sandbox ends as its command ended, also for SIGKILL (which has no handler to reset)."""
+    proc = sandbox.run_sandboxed([sys.executable, "-c", "import os; os.kill(os.getpid(), 9)"], [], "killed", None,
+                                 {}, tmp_path, processes.Limits(wall_seconds=60))
+    assert proc.returncode == -signal.SIGKILL and "Traceback" not in proc.log, (proc.describe_exit(), proc.log)
+
+
+@needs_namespaces
 def test_a_limit_holds_inside_the_sandbox(tmp_path):
     """run_sandboxed applies the Limits to the sandboxed command: memory beyond memory_mb fails."""
     code = "bytearray(512 * 1024 * 1024)"
