@@ -292,8 +292,9 @@ def _run(request: dict, fds: list[int], limits: dict) -> None:
         os.umask(request["umask"])
         os.environ.clear()
         os.environ.update(request["env"])
-        python_path = [p for p in request["env"].get("PYTHONPATH", "").split(os.pathsep) if p]
-        sys.path[:] = python_path + [p for p in sys.path if p and p not in python_path]
+        # As ``python -m`` has it: the working folder, then PYTHONPATH, then the rest.
+        first = [request["cwd"], *(p for p in request["env"].get("PYTHONPATH", "").split(os.pathsep) if p)]
+        sys.path[:] = first + [p for p in sys.path if p and p not in first]
         for name in [name for name in sys.modules if name == "autograder" or name.startswith("autograder.")]:
             del sys.modules[name]
         importlib.invalidate_caches()
