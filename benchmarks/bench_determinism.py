@@ -1,12 +1,15 @@
 """Whether the autograder gives every submission the same score on an idle machine and on a busy
 one, round after round, and how long each grading takes under both loads.
 
-Not a test: it takes minutes and loads the machine. It releases the three assignments into a
-scratch course, hands in a fixed set of submissions (the reference solutions and zoo edits of them:
-slow, half-answering, stuck at import, looping or sleeping in crop_pictures), grades the reference
-of each assignment once to build and keep its packages (not counted), then grades every submission
-again --rounds times on the idle machine and --rounds times with two CPU-burning processes per core
-beside the grader (started here, killed at the end, also on Ctrl-C or an error).
+Not a test: it takes minutes and loads the machine. It releases the assignments into a scratch
+course, hands in a fixed set of submissions (the reference solutions and zoo edits of them: slow,
+half-answering, stuck at import, looping or sleeping in crop_pictures; pillar's typical mistakes,
+tests/zoo/pillar.py, and a pillar node that goes silent, which drive the simulated robot in
+lock-step), grades the reference of each
+chosen submission's assignment once to build and keep its packages (not counted), then grades
+every submission again --rounds times on the idle machine and --rounds times with two
+CPU-burning processes per core beside the grader (started here, killed at the end, also on Ctrl-C
+or an error).
 
     .venv/bin/python benchmarks/bench_determinism.py [--rounds 2] [--only NAME ...] [--workers 1]
 
@@ -34,6 +37,7 @@ sys.path[:0] = [str(ROOT), str(ROOT / "tests")]  # the grader runs from the repo
 import zoo  # noqa: E402 (tests/zoo builds submissions from the reference solutions)
 from zoo.brightness import CALLBACK  # noqa: E402
 from zoo.brightness import entries as brightness_entries  # noqa: E402
+from zoo.pillar import entries as pillar_entries  # noqa: E402
 
 from autograder import grading, release, sandbox  # noqa: E402
 from course_lib.checks import assignments  # noqa: E402
@@ -41,6 +45,10 @@ from course_lib.checks import assignments  # noqa: E402
 ASSIGNMENTS = list(assignments.ASSIGNMENTS)
 #: The first statement of crop_pictures in the catdog_warp reference (readmarker/crop.py).
 CROP_START = "    frame = _check_frame(frame_bgr)\n"
+#: A pillar node that stops answering after 2 simulated seconds: the lock-step drive ends at the
+#: wall-clock backstop (course_lib.checks.lock_step), and the score must not depend on the load.
+GOES_SILENT = ("        self.cmd_pub.publish(twist)\n",
+               "        if scan.header.stamp.sec < 2:\n            self.cmd_pub.publish(twist)\n")
 EVERY_OTHER = ("        self.n = getattr(self, 'n', 0) + 1\n        if self.n % 2 == 0:\n"
                + CALLBACK.replace("        ", "            ", 1))
 
@@ -58,6 +66,9 @@ def submissions(course: Path) -> dict[str, tuple[str, list]]:
         "import_loop": ("brightness", zoo_edits["import_loop"]),
         "crop_never_returns": ("catdog_warp", [(CROP_START, "    while True:\n        pass\n" + CROP_START)]),
         "crop_sleeps": ("catdog_warp", [(CROP_START, "    import time; time.sleep(10**6)\n" + CROP_START)]),
+        "pillar_reference": ("pillar", []),
+        "pillar_goes_silent": ("pillar", [GOES_SILENT]),
+        **{name: ("pillar", entry["edits"]) for name, entry in pillar_entries(str(course)).items() if entry["edits"]},
     }
 
 
@@ -98,7 +109,7 @@ def main(argv=None) -> int:
         if unknown:
             parser.error(f"no submission named {', '.join(unknown)}; the names: {', '.join(chosen)}")
         chosen = {name: chosen[name] for name in args.only or chosen}
-        for assignment in ASSIGNMENTS:  # the message packages and workspace builds every round reuses
+        for assignment in sorted({assignment for assignment, _ in chosen.values()}):  # the builds every round reuses
             zoo.submit(course, "warmup", assignment)
         grading.grade(course, student="warmup", progress=False)
         shutil.rmtree(course / "submitted" / "warmup")

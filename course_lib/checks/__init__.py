@@ -1,7 +1,7 @@
 """The assignments' checks, shared by the students' self-checks and the grader.
 
 - ``course_lib.checks.assignments.<assignment>``: one file per assignment (``brightness``, ``pubsub``,
-  ``catdog_warp``, ``services_actions``, ``quiz``: every file of that folder), holding its spec, its
+  ``catdog_warp``, ``services_actions``, ``quiz``, ``pillar``: every file of that folder), holding its spec, its
   notebook's words and its checks. A notebook imports one as ``from course_lib.checks import
   brightness as checks`` (this package finds the name there) and calls ``checks.selfcheck("values")``.
 - ``spec`` (what an assignment's spec is), ``registry`` (what a check is), ``runner`` (how it runs:
@@ -10,6 +10,8 @@
   ``student_processes`` (the student's code in another process, one per module serving many calls),
   ``probe`` (the checker's ROS node), ``result`` (the verdict).
 - ``brightness_throughput``: the brightness node's throughput, judged against a yardstick node;
+  ``lock_step``: the simulated robot as the pillar checks drive it, waiting on the controller's
+  processor time;
   ``multiple_choice`` and ``quiz_questions``: the quiz's questions.
 - ``answers``: where a check's expected answers come from: the grader's answer key when graded
   (instructor side: the folder the grader hands over, contract.ANSWER_KEYS_ENV), answers

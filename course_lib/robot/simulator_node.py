@@ -18,8 +18,12 @@ Two ways to run (parameter ``lock_step``):
   advances one tick; it starts once /scan has a subscriber and /cmd_vel a publisher, and pauses
   while either is missing. A controller that answers each scan with one /cmd_vel (and runs on
   simulated time, ``use_sim_time``) then sees the same scans, and drives the same way, however
-  busy the machine: as fast as the slowest of the two keeps up. A scan nobody answers within
-  ``reply_timeout`` wall seconds is passed over with a warning (a backstop, not a pace).
+  busy the machine: as fast as the slowest of the two keeps up. What happens to a scan that waits
+  for its answer is up to ``on_unanswered``: here a scan nobody answers within ``reply_timeout``
+  wall seconds is passed over with a warning and counted (``passed_over``; a backstop, not a
+  pace: a wall-clock timeout depends on the machine's load). The checks judge by the controller's
+  processor time instead and never pass a scan over (course_lib.checks.lock_step): when the
+  controller is to blame they ``halt`` the simulation for good, with the reason.
 """
 
 from __future__ import annotations
@@ -70,6 +74,10 @@ class RobotSimulator(Node):
         noise = self.declare_parameter("noise", Laser.noise).value
         self.sim = Simulation(world, seed=seed, laser=Laser(beams=beams, noise=noise))
         self.clock_offset = 0.0  # simulated seconds before the last reset
+        self.scans = 0  # scans published
+        self.passed_over = 0  # lock-step: scans nobody answered, stepped over (on_unanswered)
+        self.halted: str | None = None  # lock-step: why the simulation stopped for good (halt)
+        self.last_scan: LaserScan | None = None
 
         self.clock_pub = self.create_publisher(ClockMessage, "/clock", 10)
         self.tf_pub = self.create_publisher(TFMessage, "/tf", 100)
@@ -110,7 +118,7 @@ class RobotSimulator(Node):
         except ValueError as error:
             self.get_logger().error(f"Refused /cmd_vel: {error}. The robot stops.")
             self.sim.command(0.0, 0.0)
-        if self.lock_step and self.awaiting_reply_since is not None:
+        if self.lock_step and self.awaiting_reply_since is not None and self.halted is None:
             self.tick()
 
     def on_reset(self, request, response):
@@ -132,7 +140,9 @@ class RobotSimulator(Node):
         self.publish_state()
 
     def on_lock_step_timer(self) -> None:
-        """Lock-step: start (or pause) with the graph; pass over a scan nobody answers."""
+        """Lock-step: start (or pause) with the graph; ask on_unanswered about a scan that waits."""
+        if self.halted is not None:
+            return
         connected = self.scan_pub.get_subscription_count() > 0 and self.cmd_sub.get_publisher_count() > 0
         if self.awaiting_reply_since is None:
             if connected:
@@ -140,10 +150,23 @@ class RobotSimulator(Node):
                 self.awaiting_reply_since = time.monotonic()
         elif not connected:
             self.awaiting_reply_since = None
-        elif time.monotonic() - self.awaiting_reply_since > self.reply_timeout:
-            self.get_logger().warning(f"No /cmd_vel within {self.reply_timeout:g} s of the scan at "
-                                      f"t={self.now:.2f} s: going on without it")
+        else:
+            self.on_unanswered(time.monotonic() - self.awaiting_reply_since)
+
+    def on_unanswered(self, waited: float) -> None:
+        """Lock-step: the last scan has waited `waited` wall seconds for its /cmd_vel (called about
+        every 0.1 s). Here: after ``reply_timeout`` s, pass it over with a warning and step on."""
+        if waited > self.reply_timeout:
+            self.passed_over += 1
+            self.get_logger().warning(f"No /cmd_vel within {self.reply_timeout:g} s of the scan at t={self.now:.2f} s: "
+                                      f"going on without it ({self.passed_over} scans passed over so far)")
             self.tick()
+
+    def halt(self, reason: str) -> None:
+        """Lock-step: stop simulating for good (no more scans; /cmd_vel is ignored), saying why."""
+        self.halted, self.awaiting_reply_since = reason, None
+        self.timer.cancel()
+        self.get_logger().error(f"Simulation halted at t={self.now:.2f} s: {reason}")
 
     def tick(self) -> None:
         """Lock-step: advance one tick and publish what the robot senses there."""
@@ -165,7 +188,9 @@ class RobotSimulator(Node):
         q.x, q.y, q.z, q.w = yaw_quaternion(yaw)
         self.tf_pub.publish(TFMessage(transforms=[moved]))
         self.odom_pub.publish(self.odometry(moved, linear, angular))
-        self.scan_pub.publish(self.laser_scan(now))
+        self.last_scan = self.laser_scan(now)
+        self.scans += 1
+        self.scan_pub.publish(self.last_scan)
 
     def odometry(self, moved: TransformStamped, linear: float, angular: float) -> Odometry:
         odom = Odometry()

@@ -4,8 +4,9 @@ node driving the simulated robot to the pillar).
 The contract is the notebook's introduction (PILLAR_INTRO). The drives run in lock-step with the
 course's simulator (course_lib.robot.simulator_node) in the check's own process, on a fresh seed:
 the simulation knows the truth (where the pillar stands, where the robot is, whether it touches),
-waits for each scan's /cmd_vel, and counts in simulated seconds, so the verdict does not depend
-on how busy the machine is.
+waits for each scan's /cmd_vel as long as the node computes (course_lib.checks.lock_step: bounded
+by its processor time, never passed over), and counts in simulated seconds, so the verdict does
+not depend on how busy the machine is.
 """
 
 from __future__ import annotations
@@ -52,12 +53,14 @@ a parameter file; and a launch file that starts it with the simulated robot.
    (`share/pillar/config`, `share/pillar/launch`): `ros2 launch pillar pillar.launch.xml`.
 
 The grader builds your workspace and runs `ros2 run pillar pillar_node --ros-args --params-file
-<your installed pillar.yaml>` against the simulator in lock-step (it waits for each scan's answer),
-with pillars placed by seeds you have not seen: the markers must be within 0.15 m of the pillar,
-and the robot must come to a stop within 0.5 m of it (the laser's distance to its surface)
-without touching it, within 25 simulated seconds, never commanding more than the file's maximum
-speeds. Then it runs your node with other values (another scan topic, other gains, speed limits
-and stop distance, given with `-p` after your file) and sees whether the robot follows them.
+<your installed pillar.yaml>` against the simulator in lock-step (it waits for each scan's answer
+however busy the machine; the drive ends where your node spends 2 s of processor time on one scan,
+or 30 s waiting, without answering it), with pillars placed by seeds you have not seen: the markers
+must be within 0.15 m of the pillar, and the robot must come to a stop within 0.5 m of it (the
+laser's distance to its surface) without touching it, within 25 simulated seconds, never
+commanding more than the file's maximum speeds. Then it runs your node with other values
+(another scan topic, other gains, speed limits and stop distance, given with `-p` after your file)
+and sees whether the robot follows them.
 
 A pitfall: a numpy `float32` put into a Twist field is sent as a tiny garbage number (about
 5e-315): convert with `float(...)`.
@@ -127,11 +130,14 @@ def _seed_with_bearing(rng, left: bool) -> int:
 
 def _nearest(ranges, angle_min: float, increment: float):
     """The scan's smallest finite range and its angle (what find_pillar must give), or None."""
-    finite = [(value, beam) for beam, value in enumerate(ranges.tolist()) if math.isfinite(value)]
-    if not finite:
+    import numpy as np
+
+    values = np.asarray(ranges, dtype=np.float64)
+    finite = np.flatnonzero(np.isfinite(values))
+    if finite.size == 0:
         return None
-    value, beam = min(finite)
-    return value, angle_min + beam * increment
+    beam = int(finite[np.argmin(values[finite])])  # the first of equal ranges, as min() of (value, beam)
+    return float(values[beam]), angle_min + beam * increment
 
 
 def _returned(outcome):
@@ -222,6 +228,7 @@ class _Record:
         self.pillar = (0.0, 0.0)
         self.scan_topics: list[str] = []
         self.publishes_cmd_vel = False
+        self.failure: str | None = None  # why the simulation halted early (lock_step.JudgedSimulator)
 
     def tick(self, sim) -> None:
         from course_lib.robot import husky
@@ -239,14 +246,15 @@ class _Record:
         return all(abs(speed) < STILL_SPEED for speed in recent)
 
 
-def _simulator(context, seed: int, scan_topic: str, record: _Record):
-    """The course's simulator in lock-step, its scan on `scan_topic`, recording into `record`."""
+def _simulator(context, proc, seed: int, scan_topic: str, record: _Record):
+    """The course's simulator in lock-step, judging the node's process `proc`, its scan on
+    `scan_topic`, recording into `record`."""
     import numpy as np
     from rclpy.parameter import Parameter
 
-    from course_lib.robot.simulator_node import RobotSimulator
+    from course_lib.checks.lock_step import JudgedSimulator
 
-    class GradedSimulator(RobotSimulator):
+    class GradedSimulator(JudgedSimulator):
         def laser_scan(self, now):
             scan = super().laser_scan(now)
             record.scan = (np.frombuffer(scan.ranges, dtype=np.float32), scan.angle_min, scan.angle_increment)
@@ -261,9 +269,12 @@ def _simulator(context, seed: int, scan_topic: str, record: _Record):
                 record.commands.append((msg.linear.x, msg.angular.z, _nearest(*record.scan)))
             super().on_cmd_vel(msg)
 
-    overrides = [Parameter(name, value=value) for name, value in
-                 {"world": "pillar", "seed": seed, "lock_step": True, "reply_timeout": scaled(5.0)}.items()]
-    sim = GradedSimulator(context=context, parameter_overrides=overrides,
+        def fail(self, reason):
+            record.failure = reason
+            super().fail(reason)
+
+    overrides = [Parameter(name, value=value) for name, value in {"world": "pillar", "seed": seed}.items()]
+    sim = GradedSimulator(proc, context=context, parameter_overrides=overrides,
                           cli_args=["--ros-args", "-r", f"scan:={scan_topic}"])
     record.pillar = sim.sim.pillar
     return sim
@@ -283,7 +294,7 @@ def _drive(ctx: Context, seed: int, parameters: dict | None = None) -> _Record |
     record = _Record()
     scan_topic = parameters.get("scan_topic", "/scan")
     with ctx.probe() as probe:
-        sim = _simulator(probe.context, seed, scan_topic, record)
+        sim = _simulator(probe.context, proc, seed, scan_topic, record)
         probe.executor.add_node(sim)
         probe.node.create_subscription(Marker, MARKER_TOPIC, lambda m: record.markers.append(
             (m.header.frame_id, m.pose.position.x, m.pose.position.y)), 100)
@@ -305,7 +316,7 @@ def _drive(ctx: Context, seed: int, parameters: dict | None = None) -> _Record |
             if scan_topic not in record.scan_topics or not record.publishes_cmd_vel:
                 return record
             ctx.waiting_on(f"the robot to stop (simulated time {TIME_LIMIT:g} s at most)")
-            probe.spin_until(lambda: not proc.running() or record.stopped() or (
+            probe.spin_until(lambda: not proc.running() or record.failure or record.stopped() or (
                 record.ticks and record.ticks[-1][0] >= TIME_LIMIT), min(scaled(60.0), ctx.remaining() - 5.0))
             if packages.node_ended(ctx, proc, NODE, "drove to the pillar"):
                 return None
@@ -357,6 +368,8 @@ def _stop_words(record: _Record) -> tuple[bool, str]:
     if record.stopped():
         return True, f"stopped at {time:.1f} simulated s with its laser {gap:.2f} m from the pillar"
     words = f"had not stopped after {time:.1f} simulated s (the laser {gap:.2f} m from the pillar)"
+    if record.failure:
+        words += f"; the drive ended there: {record.failure.replace('the controller', NODE, 1)}"
     tiny = [c for c in record.commands if 0 < abs(c[0]) < 1e-300 or 0 < abs(c[1]) < 1e-300]
     if tiny:
         words += (f"; /cmd_vel carried {tiny[0][0]:.3g}, {tiny[0][1]:.3g}: a numpy float32 put into a Twist is "
