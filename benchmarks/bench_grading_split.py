@@ -45,7 +45,8 @@ sys.path[:0] = [str(ROOT), str(ROOT / "tests"), str(ROOT / "benchmarks")]
 import zoo  # noqa: E402 (tests/zoo builds submissions from the reference solutions)
 from bench_suite_cpu import TICKS, _program  # noqa: E402
 
-from autograder import grading, release, sandbox  # noqa: E402
+from autograder.sandbox import namespaces  # noqa: E402
+from autograder.term import grade, release  # noqa: E402
 from course_lib import contract  # noqa: E402
 from course_lib.checks import assignments  # noqa: E402
 from course_lib.supervision import process_tree  # noqa: E402
@@ -107,10 +108,10 @@ class TreeSampler:
             return "sandbox entry (unshare, outer + pid-1 init)"
         if name == "python -m nbgrader":
             return "nbgrader"
-        if name == "python -m autograder.kernel" or (name.startswith("python -c") and
+        if name == "python -m autograder.sandbox.kernel" or (name.startswith("python -c") and
                                                      "ipykernel" in " ".join(process_tree.command_line(pid))):
             return KERNEL
-        if name == "python -m autograder.hidden_checks_process":
+        if name == "python -m autograder.grading.hidden_checks_process":
             return "checks process"
         if name == "python supervisor.py":
             return SUPERVISORS
@@ -168,7 +169,7 @@ class TreeSampler:
 
     def _grader(self, delta: int) -> None:
         """The grader's process: its main thread by phase, its other threads by the order they
-        started in (autograder.grading's worker, then autograder.early_checks' thread), and the
+        started in (autograder.term.grade's worker, then autograder.grading.early_checks' thread), and the
         time of threads that ended since the last sample."""
         try:
             threads = _thread_ticks(self.root)
@@ -248,7 +249,7 @@ def floor(course: Path, assignment: str, scratch: Path, env: dict, period: float
     kernels = scratch / "jupyter" / "kernels" / "python3"
     kernels.mkdir(parents=True, exist_ok=True)
     (kernels / "kernel.json").write_text(json.dumps({
-        "argv": [sys.executable, "-m", "autograder.kernel", "{connection_file}"], "language": "python",
+        "argv": [sys.executable, "-m", "autograder.sandbox.kernel", "{connection_file}"], "language": "python",
         "display_name": "Python 3 (the grader's launcher)"}))
     env = {**env, "JUPYTER_PATH": str(scratch / "jupyter"), "COURSE_LIB_GRADING": "1",
            contract.CHECKS_OUTSIDE_ENV: "1"}
@@ -278,7 +279,7 @@ def main(argv=None) -> int:
         release.release(course, chosen)
         for assignment in chosen:
             zoo.submit(course, "student0", assignment)
-        warm = grading.grade(course, progress=False, force=True)  # the caches every grading below reuses
+        warm = grade.grade(course, progress=False, force=True)  # the caches every grading below reuses
         scores = {r.assignment: f"{r.score:g}/{r.max_score:g}" for r in warm}
         cli = [sys.executable, "-m", "autograder"]
         for assignment in chosen:
@@ -304,7 +305,7 @@ def _driver(split: dict) -> float:
 
 def report(chosen, measured, floors, nodes, scores, loads) -> None:
     print(f"{platform.node()}: Python {platform.python_version()}, {os.cpu_count()} cores, isolation "
-          f"{sandbox.isolation()}; CPU-seconds sampled from /proc (each process's own utime+stime)\n")
+          f"{namespaces.isolation()}; CPU-seconds sampled from /proc (each process's own utime+stime)\n")
     rows = [r for r in ROWS if any(measured[a][0].get(r, 0) for a in chosen)]
     rows += sorted({r for a in chosen for r in measured[a][0] if r not in ROWS and r not in (FEEDBACK, BUSY)})
     print("| CPU-s | " + " | ".join(chosen) + " |\n|---|" + "---:|" * len(chosen))

@@ -243,9 +243,11 @@ def test_every_course_lib_module_the_lessons_and_guides_name_exists():
 
 # --- every fact once --------------------------------------------------------------------------------
 
-#: The modules whose ``Path(__file__).resolve().parent.parent`` is the folder that holds *their* copy of
-#: autograder (under grading, the grader's private staged copy: autograder.staging), not the repository.
-STAGED_ROOTS = {"autograder/config.py", "autograder/nbgrader_cli.py", "autograder/outputs.py", "autograder/sandbox.py"}
+#: The modules whose ``Path(__file__).resolve().parent.parent`` (``.parents[2]`` one folder deeper) is the folder
+#: that holds *their* copy of autograder (under grading, the grader's private staged copy:
+#: autograder.grading.staging), not the repository.
+STAGED_ROOTS = {"autograder/config.py", "autograder/nbgrader_cli.py", "autograder/grading/outputs.py",
+                "autograder/sandbox/namespaces.py"}
 
 
 def test_every_fact_is_spelled_out_once():
@@ -257,9 +259,10 @@ def test_every_fact_is_spelled_out_once():
     facts = {f'"{value}"': "course_lib/contract.py" for name, value in vars(contract).items() if name.endswith("_ENV")}
     facts.update({'"ros2_ws"': "course_lib/contract.py", '"assignments" / "source"': "course_lib/contract.py",
                   '"/srv/ros2cv-hub"': "coursehub/course.py", '"COURSEHUB_HUB_DIR"': "coursehub/course.py"})
-    # autograder/sandbox_entry.py runs with ``python -I -S`` and imports nothing of the course (contract.py says so).
-    allowed = {"autograder/sandbox_entry.py": {f'"{contract.EXPOSE_ENV}"', f'"{contract.BLOCKED_ENV}"',
-                                               f'"{contract.STAGE_ENV}"'}}
+    # autograder/sandbox/sandbox_entry.py runs with ``python -I -S`` and imports nothing of the course (contract.py
+    # says so).
+    allowed = {"autograder/sandbox/sandbox_entry.py": {f'"{contract.EXPOSE_ENV}"', f'"{contract.BLOCKED_ENV}"',
+                                                       f'"{contract.STAGE_ENV}"'}}
     root = re.compile(r"Path\(__file__\)\.resolve\(\)\.(parent\.parent|parents\[[12]\])")
     again = []
     for path in course_sources() + [ROOT / "assignments" / "build.py"]:
