@@ -160,6 +160,44 @@ def test_course_lib_packages_depend_on_each_other_in_one_direction():
         assert folded[shared] <= {"course_lib.contract"}, (shared, folded[shared])
 
 
+def autograder_index() -> list[str]:
+    """The files autograder/__init__.py's index names (``- ``term/grade.py``: ...``), in its order."""
+    import autograder
+
+    return re.findall(r"^- ``([\w/<>]+\.py)``:", autograder.__doc__, re.M)
+
+
+def test_the_autograder_index_names_each_module_once():
+    """autograder/__init__.py's index has one line for every module of the grader and none for a module
+    that does not exist; ``answers/<assignment>.py`` stands for the answer keys."""
+    named = autograder_index()
+    assert "term/grade.py" in named and "config.py" in named
+    assert len(named) == len(set(named)), [name for name in named if named.count(name) > 1]
+    files = set()
+    for path in (ROOT / "autograder").rglob("*.py"):
+        name = path.relative_to(ROOT / "autograder").as_posix()
+        if path.name != "__init__.py":
+            files.add("answers/<assignment>.py" if name.startswith("answers/") else name)
+    assert sorted(files - set(named)) == [], "name these modules in autograder/__init__.py's index"
+    assert sorted(set(named) - files) == [], "autograder/__init__.py's index names modules that do not exist"
+
+
+def test_autograder_groups_import_only_what_the_index_lists_above_them():
+    """The grader's groups by job (sandbox/, results/, builds/, grading/, term/, ...) and its top modules
+    import each other in one direction, the order of autograder/__init__.py's index: the sandbox needs
+    no result, a submission's grading runs no term command."""
+    def part(name):
+        return "autograder." + name.split("/")[0].removesuffix(".py")
+    order = list(dict.fromkeys(part(name) for name in autograder_index()))
+    assert order.index("autograder.sandbox") < order.index("autograder.grading") < order.index("autograder.term")
+    folded = package_imports(module_imports(), "autograder")
+    assert "autograder.sandbox" in folded["autograder.grading"]
+    assert set(folded) <= set(order), f"name these in autograder/__init__.py's index: {set(folded) - set(order)}"
+    upward = {group: above for group, imported in folded.items()
+              if (above := sorted(other for other in imported if order.index(other) > order.index(group)))}
+    assert not upward, f"these import what the index lists below them: {upward}"
+
+
 # --- each file does one job ----------------------------------------------------------------------
 
 def course_sources():
