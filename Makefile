@@ -96,7 +96,7 @@ ALLOW_ROOT := $(if $(filter 0,$(shell id -u)),--allow-root)
 # A student alone fetches the assignments in Nbgrader > Assignment List from the lab's own exchange
 # (.lab/, git-ignored), where the course's grader releases them, again when their source changed
 # (course_lib/notebook/student_lab/exchange.py); `python -m autograder grade-lab` grades what they
-# submitted there and releases its feedback for Fetch Feedback (autograder/lab_grading.py).
+# submitted there and releases its feedback for Fetch Feedback (autograder/term/lab_grading.py).
 lab: setup
 	$(PY) -m autograder release-lab
 	@echo "Graded feedback on an assignment: Submit it in Nbgrader > Assignment List, run" \

@@ -103,7 +103,7 @@ from {module} import {names}
 def package_cells(packages: list[str], plain_ros: str) -> list:
     """The cells that write the packages: the folders, then one %%writefile cell per file (a
     solution cell when the file has solution regions), then the build."""
-    from autograder.reference import package_files  # build() puts the repository on the path
+    from autograder.builds.reference import package_files  # build() puts the repository on the path
 
     files = [item for package in packages for item in package_files(package)]
     folders = sorted({str(PurePosixPath(path).parent) for path, _ in files})

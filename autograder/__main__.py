@@ -63,15 +63,15 @@ def main(argv=None) -> int:
 
 def _run(parser, args) -> int:
     if args.command == "record-answers":
-        from autograder import record
+        from autograder.term import record_answers
 
-        for path in record.record_answers(args.assignments or None):
+        for path in record_answers.record_answers(args.assignments or None):
             print(path)
         return 0
-    from autograder import grading, release
+    from autograder.term import grade, release
 
     if args.command == "roster":
-        from autograder import roster
+        from autograder.term import roster
 
         release.prepare_course(args.course_dir)
         count, ignored = roster.import_roster(args.course_dir, args.roster)
@@ -84,36 +84,36 @@ def _run(parser, args) -> int:
         print(f"Released for Nbgrader > Assignment List: {', '.join(released)}" if released
               else "The assignments in Nbgrader > Assignment List are up to date")
     elif args.command == "grade-lab":
-        from autograder import lab_grading
+        from autograder.term import lab_grading
 
         results = lab_grading.grade_lab(*([args.lab_root] if args.lab_root else []), assignments=args.assignment)
         print("\n".join(map(lab_grading.summary, results)) or "Nothing submitted yet: press Submit in "
               "Nbgrader > Assignment List first")
     elif args.command == "collect":
-        from autograder import collect
+        from autograder.term import collect
 
         print("\n".join(collect.collect(args.course_dir, args.assignment, args.archives)))
     elif args.command == "grade":
         if args.workers < 1:
             parser.error("--workers must be at least 1")
-        from autograder import work_folders
+        from autograder.grading import work_folders
 
         swept = work_folders.sweep()  # what the gradings of a killed grade run (or service) left
         if swept:
             print(f"Removed {len(swept)} work folder(s) of gradings cut short", file=sys.stderr)
-        results = grading.grade(args.course_dir, args.assignment, workers=args.workers, force=args.force,
+        results = grade.grade(args.course_dir, args.assignment, workers=args.workers, force=args.force,
                                 student=args.student)
         failed = [r for r in results if r.status == "failed"]
         course = Path(args.course_dir)
         print(f"{len(results)} submissions, {len(failed)} not graded; report in {course / 'grading_report.csv'}, "
               f"final scores for the LMS in {course / 'grades.csv'}")
     elif args.command == "feedback":
-        from autograder import feedback
+        from autograder.term import feedback
 
         for path in feedback.write_feedback(args.course_dir, args.assignment, args.student):
             print(path)
     else:
-        from autograder import export
+        from autograder.term import export
 
         print(export.export(args.course_dir))
     return 0

@@ -37,27 +37,27 @@ def apply(c, root: str | Path | None = None) -> None:
     c.LimitOutput.max_lines = 400
     # nbgrader's own autograde (CLI, formgrader button) would run the hidden checks in the
     # student's kernel, outside the sandbox: it refuses and names the course's grader.
-    c.Autograde.exporter_class = "autograder.guard.GraderOnlyExporter"
+    c.Autograde.exporter_class = "autograder.sandbox.guard.GraderOnlyExporter"
     # The notebook's run stops an ordinary cell by its processor time, or once it idles, instead of
-    # at its wall-clock timeout, which grows with the load (autograder.cell_watch).
+    # at its wall-clock timeout, which grows with the load (autograder.sandbox.cell_watch).
     c.Autograde.autograde_preprocessors = watched_preprocessors()
     # `nbgrader export` and `python -m autograder export` write one file, in one format.
-    c.ExportApp.plugin_class = "autograder.export.CourseCsvExport"
+    c.ExportApp.plugin_class = "autograder.term.export.CourseCsvExport"
     if root is not None:
         c.ExportPlugin.to = str(Path(root).resolve() / "grades.csv")
     # Late penalties per assignment (c.LatePenalty.per_day in the course's nbgrader_config.py).
-    c.AssignLatePenalties.plugin_class = "autograder.late.LatePenalty"
+    c.AssignLatePenalties.plugin_class = "autograder.term.late.LatePenalty"
     # `nbgrader zip_collect`: the file names and times of an LMS download.
-    c.ZipCollectApp.collector_plugin = "autograder.collect.LmsFileNames"
+    c.ZipCollectApp.collector_plugin = "autograder.term.collect.LmsFileNames"
     quiet_add_submission()
 
 
 def watched_preprocessors() -> list:
-    """nbgrader's autograde preprocessors, its Execute replaced by autograder.cell_watch's."""
+    """nbgrader's autograde preprocessors, its Execute replaced by autograder.sandbox.cell_watch's."""
     from nbgrader.converters import Autograde
     from nbgrader.preprocessors import Execute
 
-    from autograder.cell_watch import WatchedExecute
+    from autograder.sandbox.cell_watch import WatchedExecute
 
     steps = Autograde.class_traits()["autograde_preprocessors"].default()
     return [WatchedExecute if step is Execute else step for step in steps]
@@ -204,7 +204,7 @@ SETTINGS_EXAMPLE = '''\
 # c.GradeOnSubmit.workers = 1
 # The time zone of the submission times in your LMS's file names (python -m autograder collect):
 # c.LmsFileNames.timezone = "Europe/Berlin"
-# The file names of your LMS's download, when they differ from autograder.collect.LMS_FILE_NAME
+# The file names of your LMS's download, when they differ from autograder.term.collect.LMS_FILE_NAME
 # (a regular expression with the groups student_id, file_id and, to keep the submission time, timestamp):
 # c.FileNameCollectorPlugin.named_regexp = r"..."
 '''

@@ -12,7 +12,7 @@ import os
 import sys
 from pathlib import Path
 
-from autograder import gradebook
+from autograder.results import gradebook
 
 REPO = Path(__file__).resolve().parent.parent
 

@@ -39,7 +39,8 @@ from zoo.brightness import CALLBACK  # noqa: E402
 from zoo.brightness import entries as brightness_entries  # noqa: E402
 from zoo.pillar import entries as pillar_entries  # noqa: E402
 
-from autograder import grading, release, sandbox  # noqa: E402
+from autograder.sandbox import namespaces  # noqa: E402
+from autograder.term import grade, release  # noqa: E402
 from course_lib.checks import assignments  # noqa: E402
 
 ASSIGNMENTS = list(assignments.ASSIGNMENTS)
@@ -75,7 +76,7 @@ def submissions(course: Path) -> dict[str, tuple[str, list]]:
 def graded_round(course: Path, names: list[str], workers: int) -> dict:
     """Grade everything again: name -> (score, max score, seconds), and the load averages around it."""
     load_before = os.getloadavg()[0]
-    results = grading.grade(course, workers=workers, force=True, progress=False)
+    results = grade.grade(course, workers=workers, force=True, progress=False)
     rows = {r.student: (r.score, r.max_score, r.seconds, r.steps) for r in results if r.student in names}
     return {"rows": rows, "load": (load_before, os.getloadavg()[0])}
 
@@ -111,7 +112,7 @@ def main(argv=None) -> int:
         chosen = {name: chosen[name] for name in args.only or chosen}
         for assignment in sorted({assignment for assignment, _ in chosen.values()}):  # the builds every round reuses
             zoo.submit(course, "warmup", assignment)
-        grading.grade(course, student="warmup", progress=False)
+        grade.grade(course, student="warmup", progress=False)
         shutil.rmtree(course / "submitted" / "warmup")
         for name, (assignment, edits) in chosen.items():
             zoo.submit(course, name, assignment, edits)
@@ -130,7 +131,7 @@ def main(argv=None) -> int:
 def report(args, argv: list[str], names: list[str], rounds: dict, hog_count: int) -> int:
     print(f"Command: `{' '.join(['.venv/bin/python benchmarks/bench_determinism.py', *argv])}`")
     print(f"Python {platform.python_version()}, {platform.machine()}, {os.cpu_count()} cores, isolation "
-          f"{sandbox.isolation()}, {args.workers} worker(s); loaded: {hog_count} busy processes beside the grader\n")
+          f"{namespaces.isolation()}, {args.workers} worker(s); loaded: {hog_count} busy processes beside the grader\n")
     columns = [(load, index) for load in ("idle", "loaded") for index in range(args.rounds)]
     header = "".join(f" {load} {index + 1} |" for load, index in columns)
     rule = "---:|" * len(columns)

@@ -8,7 +8,7 @@ the real nbgrader CLI, everything graded again each time: with one worker and no
 each assignment's first submission builds its message package and its workspace); with one
 worker, the message packages kept, every workspace built by colcon and the steps one after another
 (AUTOGRADER_EARLY_CHECKS=0 and AUTOGRADER_REUSE_BUILDS=0: "sequential", the grader before
-autograder.early_checks); the same with the build and checks overlapping the notebook's run
+autograder.grading.early_checks); the same with the build and checks overlapping the notebook's run
 ("built"); the same with the build of an identical workspace copied ("early", the default: a class
 whose package.xml, setup.py and setup.cfg are the release's builds once); and with --workers
 workers.
@@ -40,12 +40,15 @@ sys.path[:0] = [str(ROOT), str(ROOT / "tests")]  # the grader runs from the repo
 
 import zoo  # noqa: E402 (tests/zoo builds submissions from the reference solutions)
 
-from autograder import build_caches, grading, pipeline, release, sandbox  # noqa: E402
+from autograder.builds import caches  # noqa: E402
+from autograder.grading import pipeline  # noqa: E402
+from autograder.sandbox import namespaces  # noqa: E402
+from autograder.term import grade, release  # noqa: E402
 from course_lib import contract  # noqa: E402
 from course_lib.checks import assignments  # noqa: E402
 
 ASSIGNMENTS = list(assignments.ASSIGNMENTS)
-#: The steps shown on their own (autograder.pipeline.STEPS); the others are summed as "other".
+#: The steps shown on their own (autograder.grading.pipeline.STEPS); the others are summed as "other".
 SHOWN_STEPS = ["run_notebook", "early_build_and_checks", "build_workspace", "run_hidden_checks"]
 
 
@@ -53,7 +56,7 @@ def timed_grade(course: Path, workers: int, early: bool = True, reuse: bool = Tr
     os.environ[contract.EARLY_CHECKS_ENV] = "1" if early else "0"
     os.environ[contract.REUSE_BUILDS_ENV] = "1" if reuse else "0"
     started = time.monotonic()
-    results = grading.grade(course, workers=workers, force=True, progress=False)
+    results = grade.grade(course, workers=workers, force=True, progress=False)
     return time.monotonic() - started, results
 
 
@@ -68,12 +71,12 @@ def main(argv=None) -> int:
         for index in range(args.students):
             for assignment in ASSIGNMENTS:
                 zoo.submit(course, f"student{index}", assignment)
-        shutil.rmtree(build_caches.cache_of(course).root, ignore_errors=True)
-        shutil.rmtree(build_caches.builds_of(course).root, ignore_errors=True)
+        shutil.rmtree(caches.cache_of(course).root, ignore_errors=True)
+        shutil.rmtree(caches.builds_of(course).root, ignore_errors=True)
         runs = {"cold": timed_grade(course, 1), "sequential": timed_grade(course, 1, early=False, reuse=False),
                 "built": timed_grade(course, 1, reuse=False), "early": timed_grade(course, 1),
                 "workers": timed_grade(course, args.workers)}
-    print(f"{platform.node()}: {os.cpu_count()} CPUs, isolation {sandbox.isolation()}, "
+    print(f"{platform.node()}: {os.cpu_count()} CPUs, isolation {namespaces.isolation()}, "
           f"{args.students} reference submissions per assignment\n")
     columns = {"cold": "mean, cold", "sequential": "cached, sequential", "built": "cached, early, built",
                "early": "cached, early", "workers": f"early, {args.workers} workers"}

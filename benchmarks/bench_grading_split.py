@@ -45,7 +45,9 @@ sys.path[:0] = [str(ROOT), str(ROOT / "tests"), str(ROOT / "benchmarks")]
 import zoo  # noqa: E402 (tests/zoo builds submissions from the reference solutions)
 from bench_suite_cpu import TICKS, _program  # noqa: E402
 
-from autograder import fork_server, grading, release, sandbox  # noqa: E402
+from autograder.grading import fork_server  # noqa: E402
+from autograder.sandbox import namespaces  # noqa: E402
+from autograder.term import grade, release  # noqa: E402
 from course_lib import contract  # noqa: E402
 from course_lib.checks import assignments  # noqa: E402
 from course_lib.supervision import process_tree  # noqa: E402
@@ -55,9 +57,9 @@ GRADER = "grader main thread"
 KERNEL, CHILDREN = "kernel: start + cells", "cells' child processes"
 COLCON = "colcon build, or the copied build's setup scripts"
 SUPERVISORS = "supervisors (one per sandboxed command and per node)"
-NOTEBOOK, CHECKS = "autograder.sandboxed_autograde", "autograder.hidden_checks_process"
+NOTEBOOK, CHECKS = "autograder.grading.sandboxed_autograde", "autograder.grading.hidden_checks_process"
 AUTOGRADE = "nbgrader's autograde (its own Python, or forked from the fork server)"
-FORK_SERVER = "fork server: its imports, once, and a handler per run (autograder.fork_server)"
+FORK_SERVER = "fork server: its imports, once, and a handler per run (autograder.grading.fork_server)"
 NOT_SAMPLED = "not sampled (short-lived processes, tails after the last sample, tick rounding)"
 THREADS = ("grader, its worker thread (the steps: staging, reading scores, outputs, the result's gradebook)",
            "grader, the early run's thread (the build copied from the cache, then waiting for the checks)",
@@ -108,14 +110,14 @@ class TreeSampler:
             return COLCON
         if name in ("unshare", "python sandbox_entry.py"):
             return "sandbox entry (unshare, outer + pid-1 init)"
-        if name in ("python -m nbgrader", "python -m autograder.sandboxed_autograde", fork_server.run_name(NOTEBOOK)):
+        if name in ("python -m nbgrader", f"python -m {NOTEBOOK}", fork_server.run_name(NOTEBOOK)):
             return "nbgrader"
         if name in ("fork-server", "fork-handler"):
             return FORK_SERVER
-        if name == "python -m autograder.kernel" or (name.startswith("python -c") and
+        if name == "python -m autograder.sandbox.kernel" or (name.startswith("python -c") and
                                                      "ipykernel" in " ".join(process_tree.command_line(pid))):
             return KERNEL
-        if name in ("python -m autograder.hidden_checks_process", fork_server.run_name(CHECKS)):
+        if name in (f"python -m {CHECKS}", fork_server.run_name(CHECKS)):
             return "checks process"
         if name == "python supervisor.py":
             return SUPERVISORS
@@ -173,7 +175,7 @@ class TreeSampler:
 
     def _grader(self, delta: int) -> None:
         """The grader's process: its main thread by phase, its other threads by the order they
-        started in (autograder.grading's worker, then autograder.early_checks' thread), and the
+        started in (autograder.term.grade's worker, then autograder.grading.early_checks' thread), and the
         time of threads that ended since the last sample."""
         try:
             threads = _thread_ticks(self.root)
@@ -253,7 +255,7 @@ def floor(course: Path, assignment: str, scratch: Path, env: dict, period: float
     kernels = scratch / "jupyter" / "kernels" / "python3"
     kernels.mkdir(parents=True, exist_ok=True)
     (kernels / "kernel.json").write_text(json.dumps({
-        "argv": [sys.executable, "-m", "autograder.kernel", "{connection_file}"], "language": "python",
+        "argv": [sys.executable, "-m", "autograder.sandbox.kernel", "{connection_file}"], "language": "python",
         "display_name": "Python 3 (the grader's launcher)"}))
     env = {**env, "JUPYTER_PATH": str(scratch / "jupyter"), "COURSE_LIB_GRADING": "1",
            contract.CHECKS_OUTSIDE_ENV: "1"}
@@ -283,7 +285,7 @@ def main(argv=None) -> int:
         release.release(course, chosen)
         for assignment in chosen:
             zoo.submit(course, "student0", assignment)
-        warm = grading.grade(course, progress=False, force=True)  # the caches every grading below reuses
+        warm = grade.grade(course, progress=False, force=True)  # the caches every grading below reuses
         scores = {r.assignment: f"{r.score:g}/{r.max_score:g}" for r in warm}
         cli = [sys.executable, "-m", "autograder"]
         for assignment in chosen:
@@ -309,7 +311,7 @@ def _driver(split: dict) -> float:
 
 def report(chosen, measured, floors, nodes, scores, loads) -> None:
     print(f"{platform.node()}: Python {platform.python_version()}, {os.cpu_count()} cores, isolation "
-          f"{sandbox.isolation()}; CPU-seconds sampled from /proc (each process's own utime+stime)\n")
+          f"{namespaces.isolation()}; CPU-seconds sampled from /proc (each process's own utime+stime)\n")
     rows = [r for r in ROWS if any(measured[a][0].get(r, 0) for a in chosen)]
     rows += sorted({r for a in chosen for r in measured[a][0] if r not in ROWS and r not in (FEEDBACK, BUSY)})
     print("| CPU-s | " + " | ".join(chosen) + " |\n|---|" + "---:|" * len(chosen))

@@ -1,4 +1,4 @@
-"""Start-up time of one sandboxed process: the grader's sandbox (autograder.sandbox: unshare, then
+"""Start-up time of one sandboxed process: the grader's sandbox (autograder.sandbox.namespaces: unshare, then
 its own Python entry doing the mounts) against bubblewrap making the same sandbox, and against
 no sandbox; measured interleaved in one run.
 
@@ -25,7 +25,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from autograder import sandbox  # noqa: E402
+from autograder.sandbox import namespaces  # noqa: E402
 
 PROBE = """
 import os, socket, sys
@@ -37,7 +37,7 @@ print("interfaces", sorted(name for _, name in socket.if_nameindex()), "| hidden
 
 
 def bubblewrap_command(command: list[str], hide: list[Path], env: dict) -> list[str]:
-    """The sandbox of autograder.sandbox made by bubblewrap (for comparison only)."""
+    """The sandbox of autograder.sandbox.namespaces made by bubblewrap (for comparison only)."""
     args = ["bwrap", "--dev-bind", "/", "/", "--unshare-net",
             "--perms", "0777", "--size", str(2 << 30), "--tmpfs", "/dev/shm"]
     if env.get("AUTOGRADER_EXPOSE"):
@@ -53,7 +53,7 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", type=int, default=40, help="runs of each way and command (default 40)")
     args = parser.parse_args()
-    mode = sandbox.isolation()
+    mode = namespaces.isolation()
     with tempfile.TemporaryDirectory(prefix="bench-sandbox-") as scratch:
         hidden = Path(scratch) / "course"
         hidden.mkdir()
@@ -61,10 +61,10 @@ def main() -> int:
         (Path(scratch) / "stage").mkdir()
         env = dict(os.environ)
         if mode == "root":
-            env.update(sandbox.interpreter_exposure(), AUTOGRADER_STAGE=str(Path(scratch) / "stage"))
-        hide = [hidden, *sandbox.HIDDEN_FROM_STUDENTS]
+            env.update(namespaces.interpreter_exposure(), AUTOGRADER_STAGE=str(Path(scratch) / "stage"))
+        hide = [hidden, *namespaces.HIDDEN_FROM_STUDENTS]
         ways = {"no sandbox": lambda command: command,
-                "autograder.sandbox (unshare)": lambda command: sandbox.sandbox_command(command, hide)}
+                "autograder.sandbox.namespaces (unshare)": lambda command: namespaces.sandbox_command(command, hide)}
         if shutil.which("bwrap"):
             ways["bubblewrap"] = lambda command: bubblewrap_command(command, hide, env)
         views = {}

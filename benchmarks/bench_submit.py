@@ -39,8 +39,8 @@ import nbformat  # noqa: E402
 import zoo  # noqa: E402 (tests/zoo builds submissions from the reference solutions)
 from zoo.brightness import SUM  # noqa: E402
 
-from autograder import release  # noqa: E402
 from autograder.config import COURSE_ID  # noqa: E402
+from autograder.term import release  # noqa: E402
 from coursehub.grading_service import Service  # noqa: E402
 
 ASSIGNMENT = "brightness"

@@ -67,9 +67,9 @@ ANSWERS_ENV = "AUTOGRADER_ANSWERS"
 ANSWER_KEYS_ENV = "AUTOGRADER_ANSWER_KEYS"
 #: The file the answers are written to while recording them (``python -m autograder record-answers``).
 RECORD_ANSWERS_ENV = "AUTOGRADER_RECORD_TO"
-#: The JSON report of the grader's build of the submission's workspace (autograder.packages).
+#: The JSON report of the grader's build of the submission's workspace (autograder.builds.workspace_build).
 BUILD_REPORT_ENV = "AUTOGRADER_BUILD_REPORT"
-#: "0" turns off the checks that start while the notebook still runs (autograder.pipeline).
+#: "0" turns off the checks that start while the notebook still runs (autograder.grading.pipeline).
 EARLY_CHECKS_ENV = "AUTOGRADER_EARLY_CHECKS"
 #: "0" builds every submission's packages, even where an identical build could be reused.
 REUSE_BUILDS_ENV = "AUTOGRADER_REUSE_BUILDS"
@@ -79,11 +79,11 @@ REUSE_BUILDS_ENV = "AUTOGRADER_REUSE_BUILDS"
 #: The uid the student's processes run as (when the grader runs as root), and its process limit.
 STUDENT_UID_ENV = "AUTOGRADER_STUDENT_UID"
 STUDENT_NPROC_ENV = "AUTOGRADER_STUDENT_NPROC"
-#: The same for the grading kernel (autograder.kernel), and the folder of its private /tmp.
+#: The same for the grading kernel (autograder.sandbox.kernel), and the folder of its private /tmp.
 KERNEL_UID_ENV = "AUTOGRADER_KERNEL_UID"
 KERNEL_NPROC_ENV = "AUTOGRADER_KERNEL_NPROC"
 KERNEL_TMP_ENV = "AUTOGRADER_KERNEL_TMP"
-#: The sandbox's view of the interpreter (autograder.sandbox). autograder/sandbox_entry.py runs
+#: The sandbox's view of the interpreter (autograder.sandbox.namespaces). autograder/sandbox/sandbox_entry.py runs
 #: with ``python -I -S`` and imports nothing of the course: it spells these three itself.
 EXPOSE_ENV = "AUTOGRADER_EXPOSE"
 BLOCKED_ENV = "AUTOGRADER_BLOCKED"

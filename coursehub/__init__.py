@@ -10,7 +10,8 @@ shared-memory namespace per student (instructor side; runs from this repository,
 - ``jupyterhub_config``: the hub's configuration, read from course.json;
 - ``instructor``: the instructor's steps (release, collect, grade, feedback) as commands;
 - ``grading_service``: the hub's service that grades each submission minutes after Submit, with
-  ``inbound`` (the exchange's submissions), ``grading_job`` (one submission; the feedback),
-  ``grading_status`` (the students' page) and ``limited_submit`` (Submit past the attempts refused);
+  ``inbound`` (the exchange's submissions), ``submit_queue`` (their durable queue), ``grading_job`` (one
+  submission; the feedback), ``grading_status`` (the students' page) and ``limited_submit`` (Submit past the
+  attempts refused);
 - ``__main__``: ``python -m coursehub create-course|start|release|collect|grade|feedback|remove-course``.
 """

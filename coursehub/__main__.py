@@ -20,7 +20,8 @@ def create_course(roster_csv: Path, instructor_name: str, hub_dir: Path, group: 
                   port: int, hub_port: int, ip: str) -> course_settings.Course:
     """Accounts, exchange, settings and the instructor's nbgrader course from a roster; run again
     with a longer roster to add students (nobody is removed, no password changes)."""
-    from autograder import config, release, roster
+    from autograder import config
+    from autograder.term import release, roster
 
     students = [row["id"] for row in roster.read_roster(roster_csv)[0]]
     for name in [instructor_name, group, *students]:

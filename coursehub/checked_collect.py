@@ -65,7 +65,7 @@ class CheckedCollect(ExchangeCollect):
 
     def refusal(self, path: Path) -> str | None:
         """Why the submission folder `path` is not collected, or None."""
-        from autograder import untrusted
+        from autograder.sandbox import untrusted
         from coursehub import inbound
 
         parsed = inbound.parse_name(path.name)
@@ -85,7 +85,7 @@ class CheckedCollect(ExchangeCollect):
 
     def do_copy(self, src, dest, log=None):
         """Copy a submission (checked in init_src) without following anything out of it."""
-        from autograder import untrusted
+        from autograder.sandbox import untrusted
         from coursehub import inbound
 
         try:

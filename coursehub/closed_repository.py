@@ -1,5 +1,5 @@
 """The repository's folders that students must not read, closed to the course's group on the real
-filesystem with POSIX ACL entries (their servers hide them too, autograder.sandbox; but a student
+filesystem with POSIX ACL entries (their servers hide them too, autograder.sandbox.namespaces; but a student
 has a password and a shell, and so an ssh login): :func:`close_to_students` when a course is
 created and its hub starts, :func:`reopen_to_students` when it is removed.
 """
@@ -18,9 +18,9 @@ from pathlib import Path
 
 def closed_folders() -> list[Path]:
     """The repository's folders no student may read: those their servers hide
-    (autograder.sandbox.HIDDEN_FROM_STUDENTS: solutions, answer keys, hidden tests), the git history
+    (autograder.sandbox.namespaces.HIDDEN_FROM_STUDENTS: solutions, answer keys, hidden tests), the git history
     (the same, committed), and those made_later()."""
-    from autograder.sandbox import HIDDEN_FROM_STUDENTS, REPO
+    from autograder.sandbox.namespaces import HIDDEN_FROM_STUDENTS, REPO
 
     return [*HIDDEN_FROM_STUDENTS, REPO / ".git", *made_later()]
 
@@ -28,7 +28,7 @@ def closed_folders() -> list[Path]:
 def made_later() -> list[Path]:
     """The closed folders that no clone has until something writes there: `make lab`'s course and
     exchange (.lab/: the source notebooks), the tests' screenshots (artifacts/: a validated solution)."""
-    from autograder.sandbox import REPO
+    from autograder.sandbox.namespaces import REPO
 
     return [REPO / ".lab", REPO / "artifacts"]
 
@@ -45,7 +45,7 @@ def close_to_students(course) -> list[str]:
     Returns:
         What could not be closed, each with why (a filesystem without ACLs); empty when all were.
     """
-    from autograder.sandbox import REPO
+    from autograder.sandbox.namespaces import REPO
 
     owner = os.stat(REPO)
     for folder in made_later():
@@ -66,7 +66,7 @@ _USER_OBJ, _USER, _GROUP_OBJ, _GROUP, _MASK, _OTHER = 0x01, 0x02, 0x04, 0x08, 0x
 
 
 def _set_course_entries(course, close: bool) -> list[str]:
-    from autograder.sandbox import REPO
+    from autograder.sandbox.namespaces import REPO
 
     ids = []
     with contextlib.suppress(KeyError):

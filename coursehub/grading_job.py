@@ -5,7 +5,7 @@ graded (root; coursehub.grading_service runs these in its threads).
   result: the one recorded for these very files (the service was stopped after recording it),
   else that of a submission with the same content graded before (the same work handed in
   again, or by another student: graded once), else a grading in the grader's sandbox
-  (autograder.pipeline). The result goes into the gradebook and the grader's records as the
+  (autograder.grading.pipeline). The result goes into the gradebook and the grader's records as the
   instructor's grade run writes them, so that run later finds it and grades nothing again.
 - :func:`release`: the feedback of graded submissions of one assignment (nbgrader's
   generate_feedback, in this process) released into the exchange as ``nbgrader release_feedback``
@@ -22,17 +22,20 @@ import shutil
 from datetime import datetime, timezone
 from pathlib import Path
 
-from autograder import config, export, report, store, untrusted
-from autograder.submissions import PER_SUBMISSION_FILES, Submission, submission_digest
-from autograder.submit_queue import Row, SubmitQueue
+from autograder import config
+from autograder.results import report, store
+from autograder.results.submissions import PER_SUBMISSION_FILES, Submission, submission_digest
+from autograder.sandbox import untrusted
+from autograder.term import export
 from coursehub import inbound
 from coursehub.accounts import chown_tree
+from coursehub.submit_queue import Row, SubmitQueue
 
 
 def grade(course, queue: SubmitQueue, row: Row, uid: int | None, one_at_a_time=None) -> None:
     """Collect, grade (or reuse a grading of the same content) and record one claimed row of the
     student whose uid is `uid` (None: no longer on the roster); a submission that is not taken
-    (autograder.untrusted) is refused with its reason.
+    (autograder.sandbox.untrusted) is refused with its reason.
     `one_at_a_time(content)`: a lock held from looking for a grading of the same content to
     recording this one (workers given the same files grade them once); None: no other worker."""
     course_dir = course.course_dir
@@ -53,7 +56,7 @@ def grade(course, queue: SubmitQueue, row: Row, uid: int | None, one_at_a_time=N
 
 
 def _grade_collected(course, queue: SubmitQueue, row: Row, sub: Submission, content: str) -> None:
-    from autograder.pipeline import grade_submission
+    from autograder.grading.pipeline import grade_submission
     from course_lib.ros import rosenv
 
     course_dir = course.course_dir
@@ -115,7 +118,7 @@ def release(course, assignment: str, rows: list[Row], hide_reasons: bool) -> dic
     are released: one row's failure holds up no other)."""
     import traceback
 
-    from autograder import feedback
+    from autograder.term import feedback
 
     course_dir = course.course_dir
     failures = {}  # student -> error
@@ -171,7 +174,7 @@ def duedate(course_dir: Path, assignment: str) -> datetime | None:
     """The assignment's due date in the gradebook (naive UTC), or None."""
     from nbgrader.api import MissingEntry
 
-    from autograder import gradebook
+    from autograder.results import gradebook
 
     with gradebook.open_gradebook(course_dir) as gb:
         try:

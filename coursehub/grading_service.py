@@ -6,7 +6,7 @@ For the assignments the course's nbgrader_config.py names (``c.GradeOnSubmit.ass
 autograder.config), it
 
 - looks at the exchange's inbound/ every second and queues each new, complete submission
-  (coursehub.inbound; the queue autograder.submit_queue is durable, so a submission that arrives
+  (coursehub.inbound; the queue coursehub.submit_queue is durable, so a submission that arrives
   while the service is down, or one it was grading when killed, is graded when it is back);
 - grades the queue in arrival order, one submission per worker (coursehub.grading_job.grade;
   ``--workers``, else ``c.GradeOnSubmit.workers``, autograder.config), and the same files once:
@@ -32,10 +32,10 @@ import traceback
 from pathlib import Path
 
 from autograder import config
-from autograder.release import assignments_in
-from autograder.submit_queue import SubmitQueue
+from autograder.term.release import assignments_in
 from coursehub import course as course_settings
 from coursehub import grading_job, inbound, limited_submit
+from coursehub.submit_queue import SubmitQueue
 
 #: Seconds before the feedback that could not be released is tried again, and how many tries a
 #: submission's feedback gets before its row fails.
@@ -72,7 +72,7 @@ class Service:
         self._students, self._roster_read = list(getattr(course, "students", [])), None
 
     def start(self) -> None:
-        from autograder import work_folders
+        from autograder.grading import work_folders
 
         swept = work_folders.sweep()  # what the gradings of a killed service (or grade run) left
         if swept:
@@ -245,7 +245,7 @@ def main(argv=None) -> int:
 
     from tornado import ioloop
 
-    from autograder import fork_server, work_folders
+    from autograder.grading import fork_server, work_folders
     from coursehub import grading_status
 
     course = course_settings.load(args.hub_dir)
@@ -273,7 +273,7 @@ def main(argv=None) -> int:
             pass
         service.stopping.set()
         # The gradings cut short (queued again at the next start) leave no work folder: the process
-        # becomes their remover when its worker threads hold any (autograder.work_folders).
+        # becomes their remover when its worker threads hold any (autograder.grading.work_folders).
         work_folders.end_gradings()
     return 0
 

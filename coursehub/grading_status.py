@@ -11,8 +11,8 @@ from jupyterhub.services.auth import HubOAuthCallbackHandler, HubOAuthenticated
 from jupyterhub.utils import url_path_join
 from tornado import web
 
-from autograder.submit_queue import Row, SubmitQueue
 from course_lib.checks.result import points_text
+from coursehub.submit_queue import Row, SubmitQueue
 
 #: Seconds between two reloads of the page while a submission is still on its way.
 REFRESH_SECONDS = 2

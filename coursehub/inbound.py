@@ -9,7 +9,7 @@ folder mode 0777 last: a folder not yet 0777 is still being written, and is read
 inbound/ is writable by every student (nbgrader's exchange), so nothing in it is trusted: an entry
 is looked at without following links (:func:`look`), counts only for the roster student who owns it
 (the folder's uid is the student's, whatever its name says), and is copied by
-autograder.untrusted (:func:`collect`). What is refused says why to the student who made it.
+autograder.sandbox.untrusted (:func:`collect`). What is refused says why to the student who made it.
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ import stat
 from datetime import datetime
 from pathlib import Path
 
-from autograder import untrusted
+from autograder.sandbox import untrusted
 from course_lib.checks.validate import IGNORE
 
 #: An assignment's name as nbgrader's folders and the course's specs spell it.
@@ -123,7 +123,7 @@ def collect(folder: Path, student: str, assignment: str, uid: int, course: Path)
     does, without following anything out of it; return that folder.
 
     Raises:
-        autograder.untrusted.Refused: the submission is not taken (the message says why).
+        autograder.sandbox.untrusted.Refused: the submission is not taken (the message says why).
     """
     target = Path(course) / "submitted" / student / assignment
     target.parent.mkdir(parents=True, exist_ok=True)

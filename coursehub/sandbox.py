@@ -1,5 +1,5 @@
 """A command as a course user, in namespaces of its own: the grader's sandbox
-(``autograder.sandbox.sandbox_command``) and then ``setpriv`` to the user's uid, groups and home.
+(``autograder.sandbox.namespaces.sandbox_command``) and then ``setpriv`` to the user's uid, groups and home.
 
 The spawner starts every server so; the instructor's commands (``coursehub.instructor``) run so
 too, because the course's interpreter may sit below /root, which only the sandbox makes
@@ -20,18 +20,18 @@ REPO = contract.ROOT
 
 def as_user(course, user: str, command: list[str]) -> list[str]:
     """`command` wrapped so that it runs as `user` in a network, mount and /dev/shm namespace; a
-    student's also has the repository's instructor folders hidden (sandbox.HIDDEN_FROM_STUDENTS)."""
-    from autograder import sandbox
+    student's also has the repository's instructor folders hidden (namespaces.HIDDEN_FROM_STUDENTS)."""
+    from autograder.sandbox import namespaces
 
     account = pwd.getpwnam(user)
-    hide = [] if user == course.instructor else sandbox.HIDDEN_FROM_STUDENTS
+    hide = [] if user == course.instructor else namespaces.HIDDEN_FROM_STUDENTS
     drop = ["setpriv", f"--reuid={account.pw_uid}", f"--regid={account.pw_gid}", "--init-groups", "--"]
-    return sandbox.sandbox_command(drop + command, hide)
+    return namespaces.sandbox_command(drop + command, hide)
 
 
 def user_environment(course, user: str, base: dict) -> dict:
     """`base` completed for a course user's process: home, the course's Python and nbgrader settings."""
-    from autograder import sandbox
+    from autograder.sandbox import namespaces
     from course_lib.notebook import student_lab
 
     account = pwd.getpwnam(user)
@@ -46,7 +46,7 @@ def user_environment(course, user: str, base: dict) -> dict:
         VIRTUAL_ENV=str(Path(sys.executable).parent.parent),
         PATH=os.pathsep.join([bindir] + [p for p in env.get("PATH", os.defpath).split(os.pathsep) if p != bindir]),
     )
-    exposure = sandbox.interpreter_exposure()
+    exposure = namespaces.interpreter_exposure()
     if exposure:  # the interpreter lives below /root: the sandbox puts it back for the user
         (course.run_dir / "stage").mkdir(mode=0o700, parents=True, exist_ok=True)
         env.update(exposure, **{contract.STAGE_ENV: str(course.run_dir / "stage")})

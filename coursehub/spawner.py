@@ -2,7 +2,7 @@
 namespace of its own.
 
 ``IsolatedSpawner`` is JupyterHub's LocalProcessSpawner (a process per user, running as that
-user) whose command is wrapped in the grader's sandbox (``autograder.sandbox.sandbox_command``:
+user) whose command is wrapped in the grader's sandbox (``autograder.sandbox.namespaces.sandbox_command``:
 ``unshare --net --mount``, loopback only, a private tmpfs on /dev/shm, the repository's
 instructor folders hidden under empty mounts for students) and which drops to the user only
 inside it (``setpriv``). A student's kernels, terminals and nodes inherit the namespaces: DDS

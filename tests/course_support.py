@@ -6,7 +6,7 @@ once per test module.
   the others taken out again (their release/ folder and their gradebook entry), which leaves what
   a release of just those assignments leaves.
 - The reference interface packages (a CMake build each, 20-30 s of CPU) are built once into the
-  interface cache of tests and benchmarks (autograder.build_caches.local_cache) and copied into each
+  interface cache of tests and benchmarks (autograder.builds.caches.local_cache) and copied into each
   course's own cache (COURSE_DIR/autograder/.interface-cache), where the grader finds them as if
   an earlier submission had built them: a submission with the reference .msg files then builds
   only its own packages. Courses of the same test run share nothing else.
@@ -48,10 +48,10 @@ def locked(path: Path):
 
 
 def released_course(tmp_path_factory, course: Path, assignments: list[str]) -> Path:
-    """COURSE as `autograder.release.release(course, assignments)` leaves it (no due dates)."""
+    """COURSE as `autograder.term.release.release(course, assignments)` leaves it (no due dates)."""
     from nbgrader.api import Gradebook
 
-    from autograder import release
+    from autograder.term import release
 
     unknown = set(assignments) - set(ASSIGNMENTS)
     assert not unknown, f"course_support releases {ASSIGNMENTS}, not {sorted(unknown)}"
@@ -79,7 +79,7 @@ def seed_lab_exchange(tmp_path_factory, lab_root: Path) -> None:
     """The lab served from lab_root (``make lab``) with every assignment released into its own
     exchange, from this run's shared release, unless it already is: ``make lab``'s release-lab
     then finds nothing to do (its own release is tested in tests/test_browser_validate.py)."""
-    from autograder import release
+    from autograder.term import release
     from course_lib.notebook.student_lab.exchange import local_course, local_exchange
 
     course, exchange = local_course(lab_root), local_exchange(lab_root)
@@ -91,17 +91,17 @@ def seed_lab_exchange(tmp_path_factory, lab_root: Path) -> None:
 
 def seed_interface_cache(tmp_path_factory, course: Path, assignments: list[str]) -> None:
     """Put the assignments' reference interface packages, built once, into COURSE's interface cache."""
-    from autograder import build_caches, packages
-    from autograder.reference import REFERENCE_SRC
+    from autograder.builds import caches, workspace_build
+    from autograder.builds.reference import REFERENCE_SRC
 
-    cache, target = build_caches.local_cache(), build_caches.cache_of(course)
+    cache, target = caches.local_cache(), caches.cache_of(course)
     for assignment in assignments:
         reference_interface_installs(tmp_path_factory, assignment)
     for assignment in assignments:
         for name in specs.spec(assignment).packages:
             folder = REFERENCE_SRC / name
-            if packages.is_interface_package(folder):
-                key = build_caches.content_key(folder)
+            if workspace_build.is_interface_package(folder):
+                key = caches.content_key(folder)
                 if not target.entry(key).exists():
                     shutil.copytree(cache.entry(key), target.entry(key), symlinks=True)
 
@@ -109,8 +109,8 @@ def seed_interface_cache(tmp_path_factory, course: Path, assignments: list[str])
 def reference_interface_installs(tmp_path_factory, assignment: str) -> list[Path]:
     """The install folders of the assignment's reference interface packages, built once into the
     interface cache of tests and benchmarks (the first worker that needs them builds them)."""
-    from autograder import build_caches, packages
+    from autograder.builds import caches, workspace_build
 
     shared = shared_folder(tmp_path_factory)
     with locked(shared / "interface-cache.lock"):
-        return packages.reference_interfaces(assignment, build_caches.local_cache(), shared / "interface-scratch")
+        return workspace_build.reference_interfaces(assignment, caches.local_cache(), shared / "interface-scratch")

@@ -33,8 +33,9 @@ def graded_course(root, duedate, students=("alice",)) -> HubCourse:
     record and the autograded notebook, whose check printed VERDICT (secret: secret_of)."""
     import pwd
 
-    from autograder import config, gradebook, store
-    from autograder.result import GradeResult
+    from autograder import config
+    from autograder.results import gradebook, store
+    from autograder.results.grade_result import GradeResult
 
     course = root / "course"
     course.mkdir()

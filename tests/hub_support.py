@@ -312,8 +312,8 @@ def grading_service(hub: Hub, timeout: float = 120) -> psutil.Process:
 
 
 def sandboxed(process: psutil.Process) -> list[psutil.Process]:
-    """The processes below `process` that run in the grader's sandbox (autograder/sandbox_entry.py)."""
-    from autograder.sandbox import ENTRY
+    """The processes below `process` that run in the grader's sandbox (autograder/sandbox/sandbox_entry.py)."""
+    from autograder.sandbox.namespaces import ENTRY
 
     try:
         below = process.children(recursive=True)
@@ -359,9 +359,9 @@ STUDENT_NEEDS = ("{hub}/jupyter/nbgrader_config.py", "{hub}/run/hub.sock", "{hub
 
 def closed_folders() -> list[Path]:
     """The repository's folders no student may open on the real filesystem: at least the instructor's
-    folders their servers hide (autograder.sandbox.HIDDEN_FROM_STUDENTS), the git history and `make
+    folders their servers hide (autograder.sandbox.namespaces.HIDDEN_FROM_STUDENTS), the git history and `make
     lab`'s course, and whatever else coursehub closes."""
-    from autograder.sandbox import HIDDEN_FROM_STUDENTS
+    from autograder.sandbox.namespaces import HIDDEN_FROM_STUDENTS
     from coursehub import closed_repository
 
     closed = {*HIDDEN_FROM_STUDENTS, REPO / ".git", REPO / ".lab", *closed_repository.closed_folders()}
@@ -467,9 +467,9 @@ def wait_until(condition, timeout: float = 60) -> None:
 
 
 def work_folders_of(processes: list[psutil.Process]) -> set[Path]:
-    """The grading work folders (autograder.work_folders) the sandboxed `processes` run in, read
+    """The grading work folders (autograder.grading.work_folders) the sandboxed `processes` run in, read
     from their command lines (nbgrader's --CourseDirectory.root=<work folder>/course)."""
-    from autograder import work_folders
+    from autograder.grading import work_folders
 
     found = set()
     for process in processes:

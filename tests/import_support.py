@@ -4,7 +4,7 @@ Every xdist worker collects every test module, so a module-level import is paid 
 nbgrader's plugins and nbconvert cost 0.5-1.5 CPU-s each. A test module that needs such a module
 declares a fixture for it instead::
 
-    collect = module_fixture("autograder.collect")
+    collect = module_fixture("autograder.term.collect")
 
     def test_something(collect):
         collect.collect(...)

@@ -11,7 +11,8 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from autograder import packages, reference, sandbox  # noqa: E402
+from autograder.builds import reference, workspace_build  # noqa: E402
+from autograder.sandbox import namespaces  # noqa: E402
 from course_lib import contract
 from course_lib.checks import (  # noqa: E402
     assignments,  # noqa: E402
@@ -82,9 +83,9 @@ def test_cell_timeouts_give_graded_cells_longer_and_grow_with_the_load_factor(mo
 
 def test_sandbox_hides_directories_and_keeps_the_command():
     """As root the command runs under unshare with a network and mount namespace."""
-    command = sandbox.sandbox_command(["python", "-V"], [Path("/somewhere/course")])
+    command = namespaces.sandbox_command(["python", "-V"], [Path("/somewhere/course")])
     assert command[-3:] == ["--", "python", "-V"]
-    if sandbox.isolation() == "root":
+    if namespaces.isolation() == "root":
         assert command[:3] == ["unshare", "--net", "--mount"] and "/somewhere/course" in command
 
 
@@ -93,8 +94,8 @@ def _module_dir(tmp_path: Path, assignment: str, edits=(), monkeypatch=None) -> 
     the grader builds them (interface packages from a cache), and the checks told so."""
     reference.write_reference_workspace(assignment, tmp_path, edits)
     if monkeypatch is not None:
-        packages.build_here(assignment, tmp_path)
-        monkeypatch.setenv(contract.BUILD_REPORT_ENV, str(packages.report_path(tmp_path)))
+        workspace_build.build_here(assignment, tmp_path)
+        monkeypatch.setenv(contract.BUILD_REPORT_ENV, str(workspace_build.report_path(tmp_path)))
     return tmp_path
 
 

@@ -18,8 +18,8 @@ import zoo  # noqa: E402
 from test_autograder import ASSIGNMENTS, CATDOG_CHECK, CATDOG_MISTAKES, FULL_RUN  # noqa: E402
 from zoo.quiz import answered  # noqa: E402
 
-from autograder import grading  # noqa: E402
 from autograder.answers import quiz as quiz_key  # noqa: E402
+from autograder.term import grade  # noqa: E402
 
 #: Typical mistakes that go through the whole pipeline (nbgrader, grader, feedback page), as
 #: (edits, the check it costs, a phrase of the verdict); the other typical mistakes are run through
@@ -39,7 +39,7 @@ QUIZ_WRONG = ("q8", "a")
 FULL_RUN_REFERENCES = ["catdog_warp"]
 
 #: A last cell that rewrites the node module with Python instead of %%writefile: the grader
-#: cannot predict it (autograder.notebook_writes), so the early build and checks must not count.
+#: cannot predict it (autograder.builds.notebook_writes), so the early build and checks must not count.
 REWRITING_CELL = """from pathlib import Path
 node = Path("ros2_ws/src/brightness/brightness/brightness_node.py")
 node.write_text(node.read_text() + "\\n\\ndef average_brightness(image):\\n    return 0\\n")
@@ -66,13 +66,13 @@ def course(tmp_path_factory):
         zoo.submit(course, "mistaken", assignment, edits)
     submit_rewriting(course, "rewriting")
     zoo.submit(course, "mistaken", "quiz", [answered(dict([QUIZ_WRONG]))])
-    results = grading.grade(course, workers=2, progress=False)
+    results = grade.grade(course, workers=2, progress=False)
     return course, {(r.student, r.assignment): r for r in results}
 
 
 @pytest.fixture(scope="module")
 def feedback_pages(course):
-    from autograder import feedback
+    from autograder.term import feedback
 
     root, _ = course
     return root, feedback.write_feedback(root)
@@ -82,7 +82,7 @@ def feedback_pages(course):
 @pytest.mark.timeout(900)
 def test_release_has_stubs_and_no_solutions_or_hidden_tests(course):
     """release/ holds the notebooks with stubs: no solution code, no hidden tests; a question's
-    answer cell holds `q3 = None`, the others nbgrader's raise (autograder.release)."""
+    answer cell holds `q3 = None`, the others nbgrader's raise (autograder.term.release)."""
     from course_lib.checks.assignments import ASSIGNMENTS as SPECS
 
     root, _ = course

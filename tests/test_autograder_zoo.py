@@ -48,7 +48,7 @@ def _hashes(folder: Path) -> dict[str, str]:
 
 @pytest.fixture(scope="module")
 def graded(tmp_path_factory):
-    from autograder import grading
+    from autograder.term import grade
 
     course = course_support.released_course(tmp_path_factory, tmp_path_factory.mktemp("zoo_course"),
                                             ["brightness", "pubsub", "services_actions", "pillar"])
@@ -64,7 +64,7 @@ def graded(tmp_path_factory):
         zoo.submit(course, student, "pillar", entry["edits"])
     before = _hashes(course / "submitted")
     started = time.monotonic()
-    results = grading.grade(course, workers=2, progress=False)
+    results = grade.grade(course, workers=2, progress=False)
     seconds = time.monotonic() - started
     yield {"course": course, "entries": entries, "results": {r.student: r for r in results},
            "before": before, "seconds": seconds}
@@ -113,7 +113,7 @@ def test_package_submission_gets_its_scores_with_its_reasons_on_the_feedback_pag
     """A mistake in a package (a message field, a missing <depend>, a wrong entry point, a build
     error, a service or action server that does not keep the contract) costs the points of the
     checks it breaks, and the student's feedback page names it; the reference gets every point."""
-    from autograder import feedback
+    from autograder.term import feedback
 
     entry = dict(PACKAGE_ZOOS)[assignment].entries(str(graded["course"]))[student]
     result = graded["results"][student]
@@ -159,7 +159,7 @@ def test_no_process_of_a_grading_uid_survives(graded):
     domain is free, a grading run of a parallel test may reserve it and run its kernel under the
     same uid (which failed this test in a suite run). So each domain is reserved, once its other
     user is done with it, while its uids are looked at."""
-    from autograder.pipeline import EARLY_UID_OFFSET, KERNEL_UID_BASE
+    from autograder.grading.pipeline import EARLY_UID_OFFSET, KERNEL_UID_BASE
 
     uids = {r.kernel_uid for r in graded["results"].values() if r.kernel_uid is not None}
     if os.geteuid() == 0:
@@ -208,9 +208,9 @@ def test_grading_report_lists_every_submission(graded):
 
 def test_second_run_reuses_unchanged_grades(graded):
     """A second grade run grades nothing again and reports the same scores."""
-    from autograder import grading
+    from autograder.term import grade
 
-    again = grading.grade(graded["course"], workers=2, progress=False)
+    again = grade.grade(graded["course"], workers=2, progress=False)
     assert all(r.from_cache for r in again)
     assert {r.student: r.status for r in again} == {s: r.status for s, r in graded["results"].items()}
     assert {r.student: r.score for r in again} == {s: r.score for s, r in graded["results"].items()}

@@ -71,7 +71,7 @@ def lab_root(tmp_path_factory):
 def course(lab_root):
     """The lab's own course folder, brightness released from it into the lab's exchange, as `make
     lab` releases the assignments (python -m autograder release-lab)."""
-    from autograder import release
+    from autograder.term import release
     from course_lib.notebook.student_lab.exchange import local_course
 
     assert release.release_for_lab(lab_root, [ASSIGNMENT]) == [ASSIGNMENT]
@@ -185,7 +185,7 @@ def test_validate_on_a_lesson_points_at_its_self_checks_at_once_and_leaves_no_ke
 def test_make_lab_releases_into_the_labs_exchange_once_per_source(course, lab_root):
     """An assignment released from its unchanged source is not released again (`make lab` starts at
     once the second time); the release is in the exchange the lab's nbgrader_config.py names."""
-    from autograder import release
+    from autograder.term import release
     from course_lib.contract import COURSE_ID
     from course_lib.notebook.student_lab.exchange import local_exchange
 

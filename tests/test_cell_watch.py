@@ -1,12 +1,12 @@
 """The grader's notebook run stops an ordinary cell by processor time or once it idles
-(autograder.cell_watch), in a real kernel; a graded test cell keeps its own timeout."""
+(autograder.sandbox.cell_watch), in a real kernel; a graded test cell keeps its own timeout."""
 
 import time
 
 import nbformat
 import pytest
 
-from autograder.cell_watch import WatchedExecute
+from autograder.sandbox.cell_watch import WatchedExecute
 
 pytestmark = pytest.mark.slow
 

@@ -12,9 +12,10 @@ import pytest
 from import_support import module_fixture
 from traitlets.config import Config
 
-from autograder import config, nbgrader_cli, roster
+from autograder import config, nbgrader_cli
+from autograder.term import roster
 
-collect = module_fixture("autograder.collect")  # it imports nbgrader
+collect = module_fixture("autograder.term.collect")  # it imports nbgrader
 
 
 @pytest.mark.parametrize("zone, hour", [("UTC", 9), ("Europe/Berlin", 8)])

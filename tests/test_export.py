@@ -9,9 +9,10 @@ import datetime
 import pytest
 from import_support import module_fixture
 
-from autograder import config, gradebook
+from autograder import config
+from autograder.results import gradebook
 
-export = module_fixture("autograder.export")  # it imports nbgrader
+export = module_fixture("autograder.term.export")  # it imports nbgrader
 
 
 @pytest.fixture(scope="module")

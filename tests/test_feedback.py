@@ -6,8 +6,9 @@ from __future__ import annotations
 import dataclasses
 import json
 
-from autograder import feedback, store
-from autograder.result import GradeResult
+from autograder.results import store
+from autograder.results.grade_result import GradeResult
+from autograder.term import feedback
 
 
 def _recorded(course, student, assignment, **fields):

@@ -1,4 +1,4 @@
-"""The grader's fork server (autograder.fork_server), run for real: a program it runs for a client in
+"""The grader's fork server (autograder.grading.fork_server), run for real: a program it runs for a client in
 the sandbox is where the client is (its namespaces, limits, folder, environment and streams), ends
 as the client reports, and ends with the client; other uids are not served. Gradings through it:
 test_autograder_pipeline and the zoo."""
@@ -13,7 +13,8 @@ from pathlib import Path
 
 import pytest
 
-from autograder import fork_server, sandbox
+from autograder.grading import fork_server
+from autograder.sandbox import namespaces as sandbox
 from course_lib.ros import processes
 
 REPO = Path(__file__).resolve().parents[1]
@@ -147,5 +148,14 @@ def test_another_uid_cannot_reach_the_socket(server):
 def test_program_falls_back_to_a_python_of_its_own_without_a_server():
     """No server serving this process: the program starts as ``python -m``."""
     assert fork_server.current() is None
-    assert fork_server.program("autograder.sandboxed_autograde", ["a"], {"PYTHONPATH": str(REPO)}) == [
-        sys.executable, "-m", "autograder.sandboxed_autograde", "a"]
+    assert fork_server.program("autograder.grading.sandboxed_autograde", ["a"], {"PYTHONPATH": str(REPO)}) == [
+        sys.executable, "-m", "autograder.grading.sandboxed_autograde", "a"]
+
+
+def test_program_goes_through_the_server_while_one_serves():
+    """Serving: the grader's programs start as the client, found in the sandbox's grader copy."""
+    with fork_server.serving() as server:
+        command = fork_server.program(fork_server.PROGRAMS[0], ["a"], {"PYTHONPATH": f"/nowhere:{REPO}"})
+    assert command == [sys.executable, "-I", "-S", str(REPO / fork_server.CLIENT_IN_PACKAGE), server.socket_path,
+                       fork_server.PROGRAMS[0], "a"]
+    assert not server.alive()

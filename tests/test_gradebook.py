@@ -11,7 +11,8 @@ import sys
 
 import pytest
 
-from autograder import config, gradebook
+from autograder import config
+from autograder.results import gradebook
 
 SCORES = {("hw", "check_a"): 3.0, ("hw", "check_b"): 1.5}
 
@@ -131,7 +132,7 @@ def test_no_sqlalchemy_warning_when_a_submission_is_created(course):
     """Creating a submission prints no SQLAlchemy warning (nbgrader's add_submission autoflushes)."""
     # Not the course's configuration: it also filters that warning where nbgrader itself raises it.
     code = ("import sys, warnings; from pathlib import Path; from sqlalchemy.exc import SAWarning; "
-            "from traitlets.config import Config; from autograder import gradebook; "
+            "from traitlets.config import Config; from autograder.results import gradebook; "
             "warnings.simplefilter('error', SAWarning); "
             "gradebook.record(Path(sys.argv[1]), 'alice', 'hw', {}, None, Config())")
     done = subprocess.run([sys.executable, "-c", code, str(course)], capture_output=True, text=True, timeout=120)
@@ -161,8 +162,8 @@ def test_a_new_gradebook_is_stamped_with_the_revision_alembic_heads_names(tmp_pa
 def test_the_feedback_page_reads_every_score_from_the_gradebook(course):
     """The feedback index reads the record grades.csv is made from: a manual score given in the
     formgrader shows in its check's line and in the total, not the grader's earlier score."""
-    from autograder import feedback
-    from autograder.result import GradeResult
+    from autograder.results.grade_result import GradeResult
+    from autograder.term import feedback
 
     _record(course)
     with gradebook.open_gradebook(course) as gb:

@@ -6,7 +6,7 @@ from __future__ import annotations
 from feedback_support import graded_course, secret_of
 from import_support import module_fixture
 
-from autograder.submit_queue import Row
+from coursehub.submit_queue import Row
 
 grading_job = module_fixture("coursehub.grading_job")  # imports nbgrader
 

@@ -14,14 +14,14 @@ from import_support import module_fixture
 from autograder import config
 from course_lib import contract
 
-guard = module_fixture("autograder.guard")  # it imports nbconvert
+guard = module_fixture("autograder.sandbox.guard")  # it imports nbconvert
 
 
 @pytest.fixture(scope="module")
 def course(tmp_path_factory):
     """pubsub released, and alice's submission graded (as the grader leaves it: an autograded
     notebook and her scores in the gradebook)."""
-    from autograder import gradebook
+    from autograder.results import gradebook
 
     root = course_support.released_course(tmp_path_factory, tmp_path_factory.mktemp("course"), ["pubsub"])
     for folder in ("submitted", "autograded"):

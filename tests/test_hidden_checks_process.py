@@ -1,4 +1,4 @@
-"""The grader's run of a submission's hidden checks (autograder/hidden_checks_process.py): the
+"""The grader's run of a submission's hidden checks (autograder/grading/hidden_checks_process.py): the
 time of all checks together (AUTOGRADER_CHECKS_SECONDS) bounds each call, and a check cut short
 says what it was waiting on."""
 
@@ -10,8 +10,8 @@ import subprocess
 import sys
 import time
 
-from autograder import hidden_checks_process
-from autograder.hidden_checks_process import _Run
+from autograder.grading import hidden_checks_process
+from autograder.grading.hidden_checks_process import _Run
 from course_lib import contract
 from course_lib.checks.runner import child_pythonpath
 from course_lib.checks.student_server import StudentServers
@@ -27,7 +27,7 @@ def test_a_hung_call_costs_at_most_the_checks_time_and_is_named(tmp_path):
     out = tmp_path / "out"
     out.mkdir()
     env = {**os.environ, contract.CHECKS_SECONDS_ENV: "8", "PYTHONPATH": child_pythonpath()}
-    subprocess.run([sys.executable, "-m", "autograder.hidden_checks_process", "brightness", "values",
+    subprocess.run([sys.executable, "-m", "autograder.grading.hidden_checks_process", "brightness", "values",
                     "--workdir", str(tmp_path), "--out", str(out)], env=env, cwd=out, timeout=60, check=True)
     result = json.loads((out / "values.json").read_text())
     messages = [item["message"] for item in result["items"]]

@@ -93,10 +93,10 @@ def _grade_all(service) -> None:
 
 
 def test_hostile_entries_are_refused_with_reasons_and_the_next_good_one_is_graded(course, tmp_path):
-    from autograder.submit_queue import SubmitQueue
     from coursehub import grading_status
     from coursehub.accounts import as_user
     from coursehub.grading_service import Service
+    from coursehub.submit_queue import SubmitQueue
 
     ann, bob = course.students
     solution = course.course_dir / "source" / ASSIGNMENT / f"{ASSIGNMENT}.ipynb"

@@ -390,8 +390,8 @@ def test_submissions_at_once_are_each_graded_once_across_a_kill_of_the_service(h
     run."""
     from nbgrader.utils import notebook_hash
 
-    from autograder import store
     from autograder.config import COURSE_ID
+    from autograder.results import store
 
     alice = hub.students[0]
     like = hub.course_dir / "submitted" / alice / ASSIGNMENT

@@ -89,7 +89,7 @@ def test_a_refused_entry_is_set_aside_under_the_queues_name_for_it(tmp_path):
 
 def test_the_collect_class_loads_on_a_students_server_where_autograder_is_hidden():
     """Every server loads nbgrader's exchange classes from the hub's settings; a student's hides
-    autograder/ (autograder.sandbox.HIDDEN_FROM_STUDENTS), so coursehub.checked_collect must import
+    autograder/ (autograder.sandbox.namespaces.HIDDEN_FROM_STUDENTS), so coursehub.checked_collect must import
     without it."""
     import subprocess
     import sys

@@ -7,7 +7,7 @@ import shlex
 
 import nbformat
 
-from autograder import intake
+from autograder.grading import intake
 
 EMPTY_NOTEBOOK = nbformat.writes(nbformat.v4.new_notebook())
 

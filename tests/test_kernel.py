@@ -1,10 +1,10 @@
-"""Does the kernel of a graded notebook (autograder.kernel) run code, without the debugger?"""
+"""Does the kernel of a graded notebook (autograder.sandbox.kernel) run code, without the debugger?"""
 
 import json
 import sys
 
-from autograder import kernel
 from autograder.nbgrader_cli import env_for_tools
+from autograder.sandbox import kernel
 
 
 def test_the_graded_kernel_runs_code_and_offers_no_debugger(tmp_path, monkeypatch):
@@ -16,7 +16,7 @@ def test_the_graded_kernel_runs_code_and_offers_no_debugger(tmp_path, monkeypatc
     spec = tmp_path / "jupyter" / "kernels" / "graded"
     spec.mkdir(parents=True)
     (spec / "kernel.json").write_text(json.dumps({
-        "argv": [sys.executable, "-m", "autograder.kernel", "{connection_file}"], "language": "python",
+        "argv": [sys.executable, "-m", "autograder.sandbox.kernel", "{connection_file}"], "language": "python",
         "display_name": "graded"}))
     monkeypatch.setenv("JUPYTER_PATH", str(tmp_path / "jupyter"))
     monkeypatch.delenv("AUTOGRADER_KERNEL_UID", raising=False)  # the launcher's part as root: test_autograder_pipeline

@@ -1,4 +1,4 @@
-"""Graded feedback for a student alone (autograder/lab_grading.py, ``python -m autograder grade-lab``):
+"""Graded feedback for a student alone (autograder/term/lab_grading.py, ``python -m autograder grade-lab``):
 the quiz is released into a lab's own exchange as `make lab` releases it, fetched, answered (one
 answer wrong) and submitted with the real nbgrader CLI under the lab's nbgrader_config.py; grade-lab
 grades the submission with the course's grader and releases its feedback, and nbgrader's
@@ -19,8 +19,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from zoo.quiz import answered  # noqa: E402
 
 from autograder import __main__ as cli  # noqa: E402
-from autograder import lab_grading, nbgrader_cli, release  # noqa: E402
+from autograder import nbgrader_cli  # noqa: E402
 from autograder.answers import quiz as key  # noqa: E402
+from autograder.term import lab_grading, release  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 WRONG = ("q3", "b")

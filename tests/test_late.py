@@ -7,7 +7,7 @@ import pytest
 from import_support import module_fixture
 from traitlets.config import Config
 
-late = module_fixture("autograder.late")  # it imports nbgrader
+late = module_fixture("autograder.term.late")  # it imports nbgrader
 DAY = 24 * 3600.0
 
 

@@ -1,4 +1,4 @@
-"""autograder.notebook_writes: the files a notebook writes, predicted without running it, and the
+"""autograder.builds.notebook_writes: the files a notebook writes, predicted without running it, and the
 digest that tells whether a run wrote exactly those."""
 
 from __future__ import annotations
@@ -8,7 +8,7 @@ import os
 import nbformat
 import pytest
 
-from autograder.notebook_writes import folder_digest, predicted_writes
+from autograder.builds.notebook_writes import folder_digest, predicted_writes
 
 CELLS = [
     "!mkdir -p ws/src/pkg/pkg ws/src/pkg/resource\n!touch ws/src/pkg/pkg/__init__.py ws/src/pkg/resource/pkg",

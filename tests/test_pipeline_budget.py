@@ -1,4 +1,4 @@
-"""autograder.pipeline's budget: one submission's grading is bounded, a notebook stopped at its
+"""autograder.grading.pipeline's budget: one submission's grading is bounded, a notebook stopped at its
 share says how long it was given (issue #14), and nothing of the student's outlives it."""
 
 from __future__ import annotations
@@ -13,9 +13,10 @@ import types
 
 import pytest
 
-from autograder import pipeline, report
-from autograder.result import GradeResult
-from autograder.submissions import Submission
+from autograder.grading import pipeline
+from autograder.results import report
+from autograder.results.grade_result import GradeResult
+from autograder.results.submissions import Submission
 from course_lib import contract
 from course_lib.ros import processes
 
@@ -78,7 +79,7 @@ def test_the_checks_limits_grow_with_the_load_factor_the_grader_passes_on(monkey
 
 
 def test_the_grader_tells_the_checks_its_load_factor(tmp_path):
-    from autograder.submissions import Submission
+    from autograder.results.submissions import Submission
 
     sub = Submission("s", "brightness", tmp_path)
     g = pipeline.Grading(sub, tmp_path, 0, GradeResult("s", "brightness", ""), tmp_path, budget=150.0)
@@ -90,7 +91,8 @@ def test_an_early_run_still_going_at_the_deadline_is_waited_for_not_dropped(tmp_
     """On a machine busier than the budget allows for, the notebook can end while the early build
     and checks are past the grading's deadline: their verdicts are waited for (their steps bound
     themselves), not dropped for a build and checks again with a second left."""
-    from autograder import early_checks, hidden_checks, notebook_writes
+    from autograder.builds import notebook_writes
+    from autograder.grading import early_checks, hidden_checks
 
     building = threading.Event()
 

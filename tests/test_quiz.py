@@ -12,8 +12,8 @@ import os
 import pytest
 from quiz_support import gives_away
 
-from autograder import record
 from autograder.answers import quiz as key
+from autograder.term import record_answers
 from course_lib import contract
 from course_lib.checks import answers, assignments, check_process, registry
 from course_lib.checks import quiz as checks
@@ -118,7 +118,7 @@ def test_the_key_is_never_recorded_for_students():
     """A quiz's recorded answers would be its key: its spec says "secret", record-answers skips it,
     and a self-check that asked for an answer would find none."""
     assert assignments.spec("quiz").answers == "secret"
-    assert "quiz" not in record.assignments_with_keys()
+    assert "quiz" not in record_answers.assignments_with_keys()
     assert not answers.recorded_path("quiz").exists()
     with pytest.raises(answers.MissingAnswer):
         answers.AnswerKey("quiz", "selfcheck").expected("explain", "q1", "b")

@@ -6,7 +6,7 @@
 - readmarker.marker_reader.MarkerReader in this process over real Fast DDS (its message package
   catdog_interfaces built first): mono8/rgb8 input, bad messages skipped;
 - slow: a real `colcon build` of the catdog_warp packages into a temporary workspace (as the
-  grader builds them: autograder.packages, interface packages from a cache), then the installed
+  grader builds them: autograder.builds.workspace_build, interface packages from a cache), then the installed
   executables run as processes (like `ros2 run`) in a reserved ROS domain;
 - every assignment's reference packages build, and their solution regions are marked.
 """
@@ -305,11 +305,11 @@ def test_packages_have_the_ament_python_layout():
 def built_ws(tmp_path_factory):
     """The catdog_warp packages (sources only) in a temporary workspace, built as the grader builds
     them (the interface package from a cache), once."""
-    from autograder import packages, reference
+    from autograder.builds import reference, workspace_build
 
     folder = tmp_path_factory.mktemp("reference")
     ws = reference.write_reference_workspace("catdog_warp", folder)
-    report = packages.build_here("catdog_warp", folder)
+    report = workspace_build.build_here("catdog_warp", folder)
     assert report.ok, report.reason
     return ws
 
@@ -420,7 +420,7 @@ def test_built_nodes_stop_cleanly_on_ctrl_c(pipeline):
 def test_the_source_notebook_writes_exactly_the_reference_packages(tmp_path, assignment):
     """The source notebook's cells write exactly the files of the assignment's reference packages
     (markers removed), and its solution cells are the files with solution regions."""
-    from autograder import reference
+    from autograder.builds import reference
 
     files = reference.reference_files(assignment)
     assert set(assignments.spec(assignment).packages) == {name.split("/")[2] for name in files}

@@ -7,8 +7,8 @@ import csv
 import dataclasses
 import json
 
-from autograder import report, store
-from autograder.result import GradeResult
+from autograder.results import report, store
+from autograder.results.grade_result import GradeResult
 
 
 def _recorded(course, student, assignment, score, **fields):

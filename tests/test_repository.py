@@ -160,6 +160,44 @@ def test_course_lib_packages_depend_on_each_other_in_one_direction():
         assert folded[shared] <= {"course_lib.contract"}, (shared, folded[shared])
 
 
+def autograder_index() -> list[str]:
+    """The files autograder/__init__.py's index names (``- ``term/grade.py``: ...``), in its order."""
+    import autograder
+
+    return re.findall(r"^- ``([\w/<>]+\.py)``:", autograder.__doc__, re.M)
+
+
+def test_the_autograder_index_names_each_module_once():
+    """autograder/__init__.py's index has one line for every module of the grader and none for a module
+    that does not exist; ``answers/<assignment>.py`` stands for the answer keys."""
+    named = autograder_index()
+    assert "term/grade.py" in named and "config.py" in named
+    assert len(named) == len(set(named)), [name for name in named if named.count(name) > 1]
+    files = set()
+    for path in (ROOT / "autograder").rglob("*.py"):
+        name = path.relative_to(ROOT / "autograder").as_posix()
+        if path.name != "__init__.py":
+            files.add("answers/<assignment>.py" if name.startswith("answers/") else name)
+    assert sorted(files - set(named)) == [], "name these modules in autograder/__init__.py's index"
+    assert sorted(set(named) - files) == [], "autograder/__init__.py's index names modules that do not exist"
+
+
+def test_autograder_groups_import_only_what_the_index_lists_above_them():
+    """The grader's groups by job (sandbox/, results/, builds/, grading/, term/, ...) and its top modules
+    import each other in one direction, the order of autograder/__init__.py's index: the sandbox needs
+    no result, a submission's grading runs no term command."""
+    def part(name):
+        return "autograder." + name.split("/")[0].removesuffix(".py")
+    order = list(dict.fromkeys(part(name) for name in autograder_index()))
+    assert order.index("autograder.sandbox") < order.index("autograder.grading") < order.index("autograder.term")
+    folded = package_imports(module_imports(), "autograder")
+    assert "autograder.sandbox" in folded["autograder.grading"]
+    assert set(folded) <= set(order), f"name these in autograder/__init__.py's index: {set(folded) - set(order)}"
+    upward = {group: above for group, imported in folded.items()
+              if (above := sorted(other for other in imported if order.index(other) > order.index(group)))}
+    assert not upward, f"these import what the index lists below them: {upward}"
+
+
 # --- each file does one job ----------------------------------------------------------------------
 
 def course_sources():
@@ -243,9 +281,11 @@ def test_every_course_lib_module_the_lessons_and_guides_name_exists():
 
 # --- every fact once --------------------------------------------------------------------------------
 
-#: The modules whose ``Path(__file__).resolve().parent.parent`` is the folder that holds *their* copy of
-#: autograder (under grading, the grader's private staged copy: autograder.staging), not the repository.
-STAGED_ROOTS = {"autograder/config.py", "autograder/nbgrader_cli.py", "autograder/outputs.py", "autograder/sandbox.py"}
+#: The modules whose ``Path(__file__).resolve().parent.parent`` (``.parents[2]`` one folder deeper) is the folder
+#: that holds *their* copy of autograder (under grading, the grader's private staged copy:
+#: autograder.grading.staging), not the repository.
+STAGED_ROOTS = {"autograder/config.py", "autograder/nbgrader_cli.py", "autograder/grading/outputs.py",
+                "autograder/sandbox/namespaces.py"}
 
 
 def test_every_fact_is_spelled_out_once():
@@ -257,9 +297,10 @@ def test_every_fact_is_spelled_out_once():
     facts = {f'"{value}"': "course_lib/contract.py" for name, value in vars(contract).items() if name.endswith("_ENV")}
     facts.update({'"ros2_ws"': "course_lib/contract.py", '"assignments" / "source"': "course_lib/contract.py",
                   '"/srv/ros2cv-hub"': "coursehub/course.py", '"COURSEHUB_HUB_DIR"': "coursehub/course.py"})
-    # autograder/sandbox_entry.py runs with ``python -I -S`` and imports nothing of the course (contract.py says so).
-    allowed = {"autograder/sandbox_entry.py": {f'"{contract.EXPOSE_ENV}"', f'"{contract.BLOCKED_ENV}"',
-                                               f'"{contract.STAGE_ENV}"'}}
+    # autograder/sandbox/sandbox_entry.py runs with ``python -I -S`` and imports nothing of the course (contract.py
+    # says so).
+    allowed = {"autograder/sandbox/sandbox_entry.py": {f'"{contract.EXPOSE_ENV}"', f'"{contract.BLOCKED_ENV}"',
+                                                       f'"{contract.STAGE_ENV}"'}}
     root = re.compile(r"Path\(__file__\)\.resolve\(\)\.(parent\.parent|parents\[[12]\])")
     again = []
     for path in course_sources() + [ROOT / "assignments" / "build.py"]:

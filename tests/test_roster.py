@@ -5,7 +5,9 @@ from __future__ import annotations
 
 import pytest
 
-from autograder import config, gradebook, roster
+from autograder import config
+from autograder.results import gradebook
+from autograder.term import roster
 
 ROSTER = ("id,first_name,last_name,email,Section\n"
           "alice,Alice,Ang,alice@example.org,A\n"

@@ -1,4 +1,4 @@
-"""Tests for autograder.run_as: the grader runs a command as another uid, and only root may."""
+"""Tests for autograder.sandbox.run_as: the grader runs a command as another uid, and only root may."""
 
 import os
 import signal
@@ -7,7 +7,7 @@ import sys
 import pytest
 from process_support import processes_with, wait_until
 
-from autograder import run_as
+from autograder.sandbox import run_as
 from course_lib.ros.processes import NodeProcess
 
 needs_root = pytest.mark.skipif(os.geteuid() != 0, reason="dropping to another user needs root")

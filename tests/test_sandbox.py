@@ -1,4 +1,4 @@
-"""The grader's sandbox (autograder.sandbox), run for real: what a sandboxed process can and
+"""The grader's sandbox (autograder.sandbox.namespaces), run for real: what a sandboxed process can and
 cannot see, without a notebook or nbgrader (the grading runs cover those end to end)."""
 
 from __future__ import annotations
@@ -11,11 +11,11 @@ from pathlib import Path
 
 import pytest
 
-from autograder import sandbox
+from autograder.sandbox import namespaces
 from course_lib.ros import processes
 from course_lib.supervision import process_tree
 
-needs_namespaces = pytest.mark.skipif(sandbox.isolation() == "none",
+needs_namespaces = pytest.mark.skipif(namespaces.isolation() == "none",
                                       reason="no namespaces here (not root, no user namespaces): "
                                              "the sandbox runs commands unwrapped")
 needs_root = pytest.mark.skipif(os.geteuid() != 0, reason="per-uid isolation needs root")
@@ -23,7 +23,7 @@ needs_root = pytest.mark.skipif(os.geteuid() != 0, reason="per-uid isolation nee
 
 def _inside(code: str, hide=(), env=None) -> subprocess.CompletedProcess:
     """Run Python `code` in the sandbox with `hide` hidden; its output and exit code."""
-    command = sandbox.sandbox_command([sys.executable, "-c", code], [Path(p) for p in hide])
+    command = namespaces.sandbox_command([sys.executable, "-c", code], [Path(p) for p in hide])
     return subprocess.run(command, capture_output=True, text=True, timeout=60, env={**os.environ, **(env or {})})
 
 
@@ -62,8 +62,8 @@ def test_hidden_folders_look_empty_and_others_stay(tmp_path):
 @needs_namespaces
 def test_the_repository_instructor_folders_are_hidden():
     """HIDDEN_FROM_STUDENTS (reference solutions, the grader, the tests) are empty inside."""
-    folders = [str(p) for p in sandbox.HIDDEN_FROM_STUDENTS]
-    done = _inside(f"import os\nprint([os.listdir(p) for p in {folders!r}])", hide=sandbox.HIDDEN_FROM_STUDENTS)
+    folders = [str(p) for p in namespaces.HIDDEN_FROM_STUDENTS]
+    done = _inside(f"import os\nprint([os.listdir(p) for p in {folders!r}])", hide=namespaces.HIDDEN_FROM_STUDENTS)
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip() == str([[] for _ in folders])
     assert any(Path(__file__).parent.iterdir())  # still there outside
@@ -90,13 +90,13 @@ def test_dev_shm_is_private_and_writable_by_anyone(tmp_path):
 def test_interpreter_below_a_closed_folder_is_reachable_for_another_uid_and_nothing_else(tmp_path):
     """With the interpreter exposed (interpreter_exposure), a student's uid runs it inside the sandbox,
     and the closed folder holds nothing but the path to the interpreter."""
-    exposure = sandbox.interpreter_exposure()
+    exposure = namespaces.interpreter_exposure()
     if not exposure:
         pytest.skip(f"this interpreter ({sys.base_prefix}) is reachable for every uid already")
     stage = tmp_path / "stage"
     stage.mkdir()
     blocked = exposure["AUTOGRADER_BLOCKED"]
-    command = sandbox.sandbox_command(
+    command = namespaces.sandbox_command(
         ["setpriv", "--reuid=61999", "--regid=61999", "--clear-groups", "--", sys.executable, "-I", "-c",
          f"import os, sys; print(os.getuid(), os.listdir({blocked!r}) == "
          f"[{Path(sys.base_prefix).relative_to(blocked).parts[0]!r}])"],
@@ -110,7 +110,7 @@ def test_interpreter_below_a_closed_folder_is_reachable_for_another_uid_and_noth
 @needs_namespaces
 def test_a_command_killed_by_sigkill_is_reported_killed(tmp_path):
     """The sandbox ends as its command ended, also for SIGKILL (which has no handler to reset)."""
-    proc = sandbox.run_sandboxed([sys.executable, "-c", "import os; os.kill(os.getpid(), 9)"], [], "killed", None,
+    proc = namespaces.run_sandboxed([sys.executable, "-c", "import os; os.kill(os.getpid(), 9)"], [], "killed", None,
                                  {}, tmp_path, processes.Limits(wall_seconds=60))
     assert proc.returncode == -signal.SIGKILL and "Traceback" not in proc.log, (proc.describe_exit(), proc.log)
 
@@ -119,7 +119,7 @@ def test_a_command_killed_by_sigkill_is_reported_killed(tmp_path):
 def test_a_limit_holds_inside_the_sandbox(tmp_path):
     """run_sandboxed applies the Limits to the sandboxed command: memory beyond memory_mb fails."""
     code = "bytearray(512 * 1024 * 1024)"
-    proc = sandbox.run_sandboxed([sys.executable, "-c", code], [], "memory hog", None, {}, tmp_path,
+    proc = namespaces.run_sandboxed([sys.executable, "-c", code], [], "memory hog", None, {}, tmp_path,
                                  processes.Limits(memory_mb=256, wall_seconds=60))
     assert proc.returncode != 0 and "MemoryError" in proc.log, proc.log
 
@@ -169,7 +169,7 @@ def test_a_stop_reaches_the_command_once_and_its_signal_comes_through():
             "print('got', got, flush=True)\n"
             "signal.signal(signal.SIGTERM, signal.SIG_DFL)\n"
             "import os; os.kill(os.getpid(), signal.SIGTERM)\n")
-    command = sandbox.sandbox_command([sys.executable, "-c", code], [])
+    command = namespaces.sandbox_command([sys.executable, "-c", code], [])
     proc = subprocess.Popen(command, stdout=subprocess.PIPE, text=True, start_new_session=True)
     try:
         assert proc.stdout.readline() == "ready\n"

@@ -1,4 +1,4 @@
-"""The notebook's run in the sandbox (autograder.sandboxed_autograde) says and exits what
+"""The notebook's run in the sandbox (autograder.grading.sandboxed_autograde) says and exits what
 ``nbgrader autograde`` says and exits, and imports nbgrader's steps without its server extensions
 (autograder.nbgrader_cli.import_without_server_extensions). Gradings through it: test_autograder_pipeline."""
 
@@ -24,7 +24,7 @@ def test_a_missing_submission_gets_nbgraders_words_and_exit_code(tmp_path):
     config.write_config(tmp_path)
     cli = subprocess.run([sys.executable, "-m", "nbgrader", "autograde", "ps1", "--student", "bob", "--force",
                           f"--CourseDirectory.root={tmp_path}"], cwd=tmp_path, env=ENV, capture_output=True, text=True)
-    ours = subprocess.run([sys.executable, "-m", "autograder.sandboxed_autograde", str(tmp_path), "ps1", "bob"],
+    ours = subprocess.run([sys.executable, "-m", "autograder.grading.sandboxed_autograde", str(tmp_path), "ps1", "bob"],
                           cwd=tmp_path, env=ENV, capture_output=True, text=True)
     assert cli.returncode == ours.returncode == 1
     assert f"[AutogradeApp | ERROR] No notebooks were matched by '{tmp_path}/submitted/bob/ps1'" in ours.stderr

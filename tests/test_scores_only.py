@@ -1,4 +1,4 @@
-"""Feedback before the due date with scores only (autograder.scores_only, coursehub.grading_job):
+"""Feedback before the due date with scores only (autograder.term.scores_only, coursehub.grading_job):
 the checks' verdicts are left out, the student's own cells are not, and only while the rules say so;
 seen on the page the grading service releases into the exchange, which the student fetches."""
 
@@ -13,10 +13,10 @@ from feedback_support import VERDICT, graded_course
 from import_support import module_fixture
 
 from autograder.config import SubmitRules
-from autograder.submit_queue import Row
+from coursehub.submit_queue import Row
 
 # Each imports nbconvert or nbgrader.
-scores_only_module = module_fixture("autograder.scores_only")
+scores_only_module = module_fixture("autograder.term.scores_only")
 grading_job = module_fixture("coursehub.grading_job")
 
 

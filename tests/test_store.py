@@ -1,4 +1,4 @@
-"""The recorded results (autograder.store): written beside each submission and into the course
+"""The recorded results (autograder.results.store): written beside each submission and into the course
 gradebook, read back for the report and the feedback, and reused while a submission is unchanged."""
 
 from __future__ import annotations
@@ -8,9 +8,10 @@ import shutil
 
 import pytest
 
-from autograder import config, gradebook, store
-from autograder.result import GradeResult
-from autograder.submissions import Submission, submission_digest
+from autograder import config
+from autograder.results import gradebook, store
+from autograder.results.grade_result import GradeResult
+from autograder.results.submissions import Submission, submission_digest
 
 
 @pytest.fixture(scope="module")

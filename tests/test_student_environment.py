@@ -20,7 +20,7 @@ import course_support
 import nbformat
 import pytest
 
-from autograder import reference
+from autograder.builds import reference
 from course_lib import contract
 from course_lib.checks import assignments, registry, runner
 
@@ -173,14 +173,14 @@ def test_untouched_release_earns_nothing(release, tmp_path, monkeypatch, assignm
     """The released stubs, handed in as they are (and built as the grader builds them), score 0 in
     every graded check, and a check that calls a stub says to replace NotImplementedError (the
     quiz's: that no question is answered yet)."""
-    from autograder import packages
+    from autograder.builds import workspace_build
 
     nb = nbformat.read(release / assignment / f"{assignment}.ipynb", as_version=4)
     has_packages = bool(assignments.spec(assignment).packages)
     if has_packages:
         reference.write_files(nb, tmp_path)
-        packages.build_here(assignment, tmp_path)
-        monkeypatch.setenv(contract.BUILD_REPORT_ENV, str(packages.report_path(tmp_path)))
+        workspace_build.build_here(assignment, tmp_path)
+        monkeypatch.setenv(contract.BUILD_REPORT_ENV, str(workspace_build.report_path(tmp_path)))
     verdicts = []
     for name in registry.checks_of(assignment):
         result = runner.execute(assignment, name, 7, workdir=tmp_path, mode="graded")

@@ -1,12 +1,12 @@
-"""Tests for autograder.student_uid: graded as root, the checks' student processes run as the
+"""Tests for autograder.sandbox.student_uid: graded as root, the checks' student processes run as the
 worker's uid, with a HOME of their own, and can reach the check's ROS shared memory."""
 
 import os
 
 import pytest
 
-from autograder import student_uid
-from autograder.student_uid import StudentUid
+from autograder.sandbox import student_uid
+from autograder.sandbox.student_uid import StudentUid
 from course_lib import contract
 from course_lib.checks.student_processes import StudentProcesses
 

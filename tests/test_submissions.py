@@ -1,11 +1,11 @@
-"""What counts as a submission (autograder.submissions) and when its digest changes: the digest
+"""What counts as a submission (autograder.results.submissions) and when its digest changes: the digest
 decides whether an earlier grade is reused, so it must move with everything grading reads."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
-from autograder.submissions import Submission, find_submissions, submission_digest
+from autograder.results.submissions import Submission, find_submissions, submission_digest
 
 
 def _hand_in(course: Path, student: str, assignment: str, text: str = "{}") -> Path:

@@ -1,4 +1,4 @@
-"""The grading service's queue (autograder.submit_queue): arrival order, one row per claim,
+"""The grading service's queue (coursehub.submit_queue): arrival order, one row per claim,
 superseded and refused submissions, and nothing lost when its process dies."""
 
 from __future__ import annotations
@@ -8,7 +8,7 @@ import sys
 import threading
 from datetime import datetime, timedelta
 
-from autograder.submit_queue import SubmitQueue
+from coursehub.submit_queue import SubmitQueue
 
 T0 = datetime(2026, 3, 1, 12, 0)
 
@@ -43,7 +43,7 @@ def test_rows_are_claimed_in_arrival_order_and_each_by_one_worker(tmp_path):
 def test_a_queue_file_of_the_first_version_gets_the_worker_columns(tmp_path):
     import sqlite3
 
-    from autograder.submit_queue import SCHEMA
+    from coursehub.submit_queue import SCHEMA
 
     (tmp_path / "autograder").mkdir()
     old = SCHEMA.replace("changed TEXT NOT NULL,", "changed TEXT NOT NULL").split("\n    worker")[0] + "\n)"
@@ -88,7 +88,7 @@ def test_rows_being_graded_when_the_process_was_killed_are_queued_again(tmp_path
 import os, signal, sys
 sys.path.insert(0, {str(sys.path[0])!r})
 from datetime import datetime
-from autograder.submit_queue import SubmitQueue
+from coursehub.submit_queue import SubmitQueue
 queue = SubmitQueue({str(tmp_path)!r})
 for n in range(3):
     queue.add(f"s{{n}}+a+x", f"s{{n}}", "a", datetime(2026, 3, 1), None, None)

@@ -73,7 +73,8 @@ def _rows(path: Path, key=("student_id", "assignment")) -> dict:
 
 @pytest.fixture(scope="module")
 def term(tmp_path_factory):
-    from autograder import config, store
+    from autograder import config
+    from autograder.results import store
 
     course = tmp_path_factory.mktemp("term") / "course"
     downloads = tmp_path_factory.mktemp("downloads")
@@ -204,15 +205,15 @@ def test_feedback_shows_the_penalty_and_wraps_and_hides_the_graders_paths(term, 
 def test_changed_due_date_changes_the_penalty_on_the_next_grade_run(term):
     """Grading again after the due date moved (nothing re-run: the submissions did not change)
     recomputes the penalty from the new date."""
-    from autograder import grading, late
+    from autograder.term import grade, late
 
     course = term["course"]
     late.set_duedate(course, "pubsub", "2025-03-20 12:00 UTC")
-    again = grading.grade(course, "pubsub", progress=False)
+    again = grade.grade(course, "pubsub", progress=False)
     assert all(r.from_cache for r in again)
     assert float(_rows(course / "grades.csv")["bob", "pubsub"]["late_submission_penalty"]) == 0
     late.set_duedate(course, "pubsub", DUE)
-    grading.grade(course, "pubsub", progress=False)
+    grade.grade(course, "pubsub", progress=False)
     assert float(_rows(course / "grades.csv")["bob", "pubsub"]["late_submission_penalty"]) > 0
 
 

@@ -1,4 +1,4 @@
-"""A student's folder copied without following anything out of it (autograder.untrusted): plain
+"""A student's folder copied without following anything out of it (autograder.sandbox.untrusted): plain
 files and folders are copied; a link, a FIFO, a hard link, another account's file, a name with a
 control character, too many files or too many bytes refuse the whole folder with a reason, in
 about no time, and leave no target behind."""
@@ -9,7 +9,7 @@ import os
 
 import pytest
 
-from autograder import untrusted
+from autograder.sandbox import untrusted
 from course_lib.checks.validate import IGNORE
 
 

@@ -1,4 +1,4 @@
-"""Tests for autograder.work_folders: a grading's work folder outlives no process that made it,
+"""Tests for autograder.grading.work_folders: a grading's work folder outlives no process that made it,
 and a sweep never takes the folder of a grading that still runs."""
 
 import os
@@ -12,14 +12,14 @@ from types import SimpleNamespace
 
 import pytest
 
-from autograder import work_folders
+from autograder.grading import work_folders
 
 REPO = Path(__file__).resolve().parents[1]
 
 #: A grading process: makes its work folder, copies a submission into it, says where, and waits.
 MAKE = """
 import sys
-from autograder import work_folders
+from autograder.grading import work_folders
 
 work = work_folders.make()
 (work / "course").mkdir()
@@ -36,7 +36,7 @@ SERVICE = """
 import atexit, sys, threading, time
 from pathlib import Path
 from types import SimpleNamespace
-from autograder import work_folders
+from autograder.grading import work_folders
 from coursehub import grading_service, grading_status
 
 saw_it_go, grading = Path(sys.argv[1]), sys.argv[2] == "grading"
@@ -181,11 +181,11 @@ def test_the_grading_service_sweeps_when_it_starts(tmp_path, monkeypatch):
 
 def test_autograder_grade_sweeps_when_it_starts(tmp_path, monkeypatch):
     from autograder import __main__ as command
-    from autograder import grading
+    from autograder.term import grade
 
     work = _killed_grading(tmp_path / "tmp")
     monkeypatch.setattr(tempfile, "tempdir", str(tmp_path / "tmp"))
-    monkeypatch.setattr(grading, "grade", lambda *args, **kwargs: [])
+    monkeypatch.setattr(grade, "grade", lambda *args, **kwargs: [])
     assert command.main(["grade", str(tmp_path / "course")]) == 0
     assert not work.exists()
 

@@ -1,4 +1,4 @@
-"""autograder/packages.py's kept workspace builds, with the real colcon: a workspace whose files
+"""autograder/builds/workspace_build.py's kept workspace builds, with the real colcon: a workspace whose files
 are another's but for its modules' contents gets that build, moved to its own folder, and runs
 its own code; any other change, a failed build or AUTOGRADER_REUSE_BUILDS=0 means colcon runs."""
 
@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from autograder import build_caches, packages
+from autograder.builds import caches, workspace_build
 from course_lib import contract
 from course_lib.ros import workspace
 
@@ -55,20 +55,20 @@ def write_workspace(root: Path, author: str, executable: str = "greet", setup_py
 
 
 class CountingColcon:
-    """packages.run_here, counting the colcon runs."""
+    """workspace_build.run_here, counting the colcon runs."""
 
     def __init__(self):
         self.runs = 0
 
     def __call__(self, command, cwd, env, wall_seconds):
         self.runs += 1
-        return packages.run_here(command, cwd, env, wall_seconds)
+        return workspace_build.run_here(command, cwd, env, wall_seconds)
 
 
-def build(root: Path, builds, colcon) -> packages.BuildReport:
+def build(root: Path, builds, colcon) -> workspace_build.BuildReport:
     scratch = root / "scratch"
     scratch.mkdir(exist_ok=True)
-    return packages.build_workspace(root / "ros2_ws", build_caches.InterfaceCache(root.parent / "cache"), scratch,
+    return workspace_build.build_workspace(root / "ros2_ws", caches.InterfaceCache(root.parent / "cache"), scratch,
                                     colcon, builds=builds)
 
 
@@ -95,7 +95,7 @@ def mentions(tree: Path, text: str) -> list[str]:
 
 
 def test_an_identical_workspace_gets_the_build_moved_to_its_folder_and_runs_its_own_module(tmp_path):
-    builds, colcon = build_caches.WorkspaceBuilds(tmp_path / "builds"), CountingColcon()
+    builds, colcon = caches.WorkspaceBuilds(tmp_path / "builds"), CountingColcon()
     write_workspace(tmp_path / "alice", "alice")
     write_workspace(tmp_path / "bob", "bob")
     first = build(tmp_path / "alice", builds, colcon)
@@ -111,7 +111,7 @@ def test_an_identical_workspace_gets_the_build_moved_to_its_folder_and_runs_its_
 
 
 def test_another_setup_py_is_built_by_colcon(tmp_path):
-    builds, colcon = build_caches.WorkspaceBuilds(tmp_path / "builds"), CountingColcon()
+    builds, colcon = caches.WorkspaceBuilds(tmp_path / "builds"), CountingColcon()
     write_workspace(tmp_path / "alice", "alice")
     write_workspace(tmp_path / "carol", "carol", executable="hello")
     assert build(tmp_path / "alice", builds, colcon).ok
@@ -121,7 +121,7 @@ def test_another_setup_py_is_built_by_colcon(tmp_path):
 
 
 def test_a_failed_build_is_not_kept_and_reuse_can_be_switched_off(tmp_path, monkeypatch):
-    builds, colcon = build_caches.WorkspaceBuilds(tmp_path / "builds"), CountingColcon()
+    builds, colcon = caches.WorkspaceBuilds(tmp_path / "builds"), CountingColcon()
     broken = SETUP_PY.replace("name='greeter',", "name='greeter'(,")
     for student in ("dave", "erin"):
         write_workspace(tmp_path / student, student, setup_py=broken)

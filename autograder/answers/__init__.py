@@ -17,7 +17,7 @@ from pathlib import Path
 
 from course_lib import contract
 
-#: This folder. In a grading it is the grader's private copy (autograder.staging), which the
+#: This folder. In a grading it is the grader's private copy (autograder.grading.staging), which the
 #: student's uid cannot enter.
 FOLDER = Path(__file__).resolve().parent
 

@@ -17,7 +17,7 @@ from course_lib.checks.student_server import ProcessorTime, ServerError, Student
 
 #: Processor seconds a student's module may use to import (rclpy, numpy and cv2 take about one),
 #: and the wall-clock backstop for an import that waits instead (a spin() at the top level),
-#: kept well below a grading's time for all checks (autograder.hidden_checks_process).
+#: kept well below a grading's time for all checks (autograder.grading.hidden_checks_process).
 IMPORT_CPU_SECONDS = 10.0
 IMPORT_TIMEOUT = 15.0
 
@@ -33,7 +33,7 @@ CALL_TIMEOUT = 20.0
 NODE_START_CPU_SECONDS = 10.0
 
 #: Set by the grader: how many times the idle machine's time limits a grading gets on this
-#: machine now (its load per core, autograder.pipeline.grading_budget). The wall-clock backstops
+#: machine now (its load per core, autograder.grading.pipeline.grading_budget). The wall-clock backstops
 #: above grow with it: a busy machine gives each process a fraction of a core.
 
 
@@ -45,7 +45,7 @@ def number_from_environment(name: str) -> float | None:
         return None
 
 
-#: At most this many times the idle machine's backstop (autograder.pipeline.MAX_LOAD_FACTOR).
+#: At most this many times the idle machine's backstop (autograder.grading.pipeline.MAX_LOAD_FACTOR).
 MAX_LOAD_FACTOR = 6.0
 
 

@@ -12,7 +12,7 @@ written by the notebook's ``%%writefile`` cells). The checks
 - read package.xml against the imports of the package's Python files (:func:`dependency_items`).
 
 Who builds: in a self-check, the student, with the notebook's build cell (the check says so when
-``install/`` is missing); at grading, the grader (autograder.packages, in its sandbox), which hands
+``install/`` is missing); at grading, the grader (autograder.builds.workspace_build, in its sandbox), which hands
 the checks its report through contract.BUILD_REPORT_ENV. When that build failed, every check that
 needs it fails with the build's own error lines.
 """

@@ -11,8 +11,8 @@ Where things run:
   ROS, a ROS_DOMAIN_ID reserved for the check. A student process that loops, crashes or exits
   costs the points of that check and nothing else.
 
-At grading the course's grader (autograder.grading) runs the hidden checks itself, outside the
-student's kernel (``python -m autograder.hidden_checks_process``): :func:`grade` in the notebook only
+At grading the course's grader (autograder.term.grade) runs the hidden checks itself, outside the
+student's kernel (``python -m autograder.grading.hidden_checks_process``): :func:`grade` in the notebook only
 says so. As root the check stays root and the student's processes run as the grader's worker
 uid (AUTOGRADER_STUDENT_UID), so the student's code can neither fake a check's result nor read
 its seed (passed in the environment, not on the command line).
@@ -73,7 +73,7 @@ def selfcheck(assignment: str, name: str) -> None:
     _display_images(result)
 
 
-#: Set by the course's grader (autograder.grading) for the notebook run: the hidden tests do not
+#: Set by the course's grader (autograder.term.grade) for the notebook run: the hidden tests do not
 #: run in the student's kernel, where the student's code could fake their result; the grader
 #: runs them afterwards in processes of its own (see :func:`grade_outside`) and writes the
 #: verdicts into the graded notebook.

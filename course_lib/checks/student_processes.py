@@ -2,7 +2,7 @@
 
 :class:`StudentProcesses` runs them as the check's own user, bounded in time, memory and file
 size: what a self-check does in the student's notebook. The course's grader, as root, hands the
-check a subclass (autograder.student_uid.StudentUid) that also runs them as the worker's uid, so
+check a subclass (autograder.sandbox.student_uid.StudentUid) that also runs them as the worker's uid, so
 that the student's code can neither read nor signal nor trace the check, nor write its results.
 course_lib never imports the grader: it only calls the methods below.
 """

@@ -8,7 +8,7 @@ return in time ends that process (the next request starts a fresh one), and the 
 called is not called again in this grading: later calls of it answer at once that it hung
 before. Answers given before a hang or crash are kept (each is written as soon as it is done).
 
-In a self-check the servers live as long as the check; at grading (autograder.hidden_checks_process)
+In a self-check the servers live as long as the check; at grading (autograder.grading.hidden_checks_process)
 all checks of a submission share them.
 """
 

@@ -19,7 +19,7 @@ class Limits:
         cpu_seconds: CPU time (RLIMIT_CPU); the child gets SIGXCPU when it is used up.
         max_processes: processes *and threads* of the child's user (RLIMIT_NPROC). Fast DDS
             starts about a dozen threads per node. The kernel does not enforce it for root (the
-            grader, as root, runs the student's code as another uid: autograder.run_as).
+            grader, as root, runs the student's code as another uid: autograder.sandbox.run_as).
         file_size_mb: largest file the child may write (RLIMIT_FSIZE); SIGXFSZ beyond it.
         open_files: open file descriptors (RLIMIT_NOFILE).
         grace_seconds: time between SIGINT and SIGKILL when the wall time runs out.

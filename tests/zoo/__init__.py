@@ -13,7 +13,7 @@ from pathlib import Path
 
 import nbformat
 
-from autograder.reference import solution_source, writefile_cells
+from autograder.builds.reference import solution_source, writefile_cells
 
 
 def filled_notebook(course: Path, assignment: str) -> nbformat.NotebookNode:
@@ -48,7 +48,7 @@ def edited_notebook(course: Path, assignment: str, edits=(), student: str = "") 
 def submit(course: Path, student: str, assignment: str, edits=()) -> Path:
     """Write a zoo submission (see edited_notebook) where nbgrader's collect step puts it: the
     notebook, and the workspace its %%writefile cells wrote, as a student who ran them hands it in."""
-    from autograder.reference import write_files
+    from autograder.builds.reference import write_files
 
     nb = edited_notebook(course, assignment, edits, student)
     target = Path(course) / "submitted" / student / assignment / f"{assignment}.ipynb"

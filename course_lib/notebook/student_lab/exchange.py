@@ -9,7 +9,7 @@ course's grader (``python -m autograder release-lab``). The lab's ``nbgrader_con
 exchange and the course id with :func:`use_local_exchange`; the panel then lists the assignments,
 Fetch copies one to ``<root>/<assignment>/``, and Validate works on it. Submit keeps a copy in
 the exchange, where no instructor collects it: ``python -m autograder grade-lab``
-(autograder/lab_grading.py) grades the latest submission with the course's grader and releases its
+(autograder/term/lab_grading.py) grades the latest submission with the course's grader and releases its
 feedback into this exchange, where Fetch Feedback finds it.
 """
 
