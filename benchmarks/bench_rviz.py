@@ -15,13 +15,22 @@ draws every animation frame as while a student turns it). Over a window: the mes
 subscriber in this process got (the raw rate), the drawings the browser has shown, the frames it
 drew, the kernel's processor time per second and per message received, and one frame's render.
 
+With ``--baseline DIR`` (a folder holding another copy of ``course_lib``, its bundle built), each
+stream runs first with that copy in the notebook's kernel, then with this checkout's (``--rounds``
+times, alternating: the machine's load changes by the minute), and the rows end with the ratios of
+the medians and the goals: the cloud at 20 frames/s or more with 4.5 of its 5 drawings/s
+shown, the still scan at 20 frames/s, and the kernel's time per cloud below the baseline's.
+
     .venv/bin/python benchmarks/bench_rviz.py [--seconds 10] [--updates 500] [--with /tmp/eval/k3d]
+        [--parts b] [--streams cloud] [--baseline /tmp/before] [--rounds 2]
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
+import os
 import signal
 import subprocess
 import sys
@@ -59,10 +68,11 @@ PUBLISHER = textwrap.dedent(f"""
     rng = np.random.default_rng(0)
     xyz = rng.uniform(-3, 3, ({CLOUD_POINTS}, 3))
     fields, data, step = xyz_rgb_cloud_bytes(xyz, rng.integers(0, 256, ({CLOUD_POINTS}, 3)))
+    record = np.frombuffer(data, np.uint8).copy().view(np.dtype({{"names": ["x", "y"], "formats": ["<f4"] * 2,
+                                                                  "offsets": [0, 4], "itemsize": step}}))
     cloud = PointCloud2(height=1, width={CLOUD_POINTS}, point_step=step, row_step=step * {CLOUD_POINTS},
                         fields=[PointField(name=n, offset=o, datatype=t, count=1) for n, o, t in fields])
     cloud.header.frame_id = "laser"
-    cloud.data = array.array("B", data)
     count = [0]
     def tick():
         count[0] += 1
@@ -70,7 +80,10 @@ PUBLISHER = textwrap.dedent(f"""
         t.header.frame_id = "odom"
         t.transform.translation.x, t.transform.rotation.w = 0.1 * math.sin(count[0] / 20), 1.0
         tf.publish(t)
-        if kind == "cloud":
+        if kind == "cloud":  # the points turn about z (a turning sensor's), their colours stay
+            c, s = math.cos(count[0] / 10), math.sin(count[0] / 10)
+            record["x"], record["y"] = c * xyz[:, 0] - s * xyz[:, 1], s * xyz[:, 0] + c * xyz[:, 1]
+            cloud.data = array.array("B", record.tobytes())
             points.publish(cloud)
             return
         msg = LaserScan(angle_min=-math.pi, angle_increment=2 * math.pi / {BEAMS}, range_min=0.1, range_max=10.0)
@@ -173,11 +186,28 @@ view.add("{display}", topic="{topic}")
 view"""
 
 STATE_JS = """() => { const el = document.querySelector('.rviz-view');
-  return {seq: Number(el.dataset.seq || 0), frames: Number(el.dataset.frames || 0),
-          renderMs: Number(el.dataset.renderMs || 0)}; }"""
+  return {seq: Number(el.dataset.seq || 0), received: Number(el.dataset.received || 0),
+          frames: Number(el.dataset.frames || 0), renderMs: Number(el.dataset.renderMs || 0)}; }"""
+#: The goals for this checkout's rows: (stream, measure, at least).
+GOALS = (("scan", "frames", 20.0), ("cloud", "frames", 20.0), ("cloud", "shown", 0.9 * CLOUD_RATE))
 
 
-def in_browser(seconds: float, scenario: str) -> dict:
+@contextlib.contextmanager
+def _environment(**values):
+    """os.environ with these values (None: unset) inside, as it was after."""
+    saved = {name: os.environ.get(name) for name in values}
+    try:
+        for name, value in values.items():
+            os.environ.pop(name, None) if value is None else os.environ.__setitem__(name, value)
+        yield
+    finally:
+        for name, value in saved.items():
+            os.environ.pop(name, None) if value is None else os.environ.__setitem__(name, value)
+
+
+def in_browser(seconds: float, scenario: str, code: Path | None = None) -> dict:
+    """One stream shown in JupyterLab; `code`: a folder whose course_lib the notebook's kernel
+    imports (PYTHONPATH) instead of this checkout's."""
     from browser_notebook import close_notebook, open_notebook, run_notebook, write_notebook
     from browser_support import launched_chromium, running_jupyterlab
 
@@ -200,11 +230,8 @@ def in_browser(seconds: float, scenario: str) -> dict:
             message_yaml.message_class(msg_type), topic,
             lambda msg: arrivals.append(time.monotonic()), qos_profile_sensor_data)
         try:
-            import os
-
-            saved = os.environ.get("ROS_DOMAIN_ID")
-            os.environ["ROS_DOMAIN_ID"] = str(reservation.domain_id)
-            with running_jupyterlab(root, state) as lab, launched_chromium(Path(scratch, "chromium")) as browser:
+            with _environment(ROS_DOMAIN_ID=str(reservation.domain_id), PYTHONPATH=str(code) if code else None), \
+                    running_jupyterlab(root, state) as lab, launched_chromium(Path(scratch, "chromium")) as browser:
                 page = open_notebook(browser, lab, "rviz.ipynb")
                 run_notebook(page, "rviz.ipynb", 1, 240)
                 page.wait_for_function("() => { const c = document.querySelector('.rviz-view');"
@@ -214,10 +241,6 @@ def in_browser(seconds: float, scenario: str) -> dict:
                 page.wait_for_timeout(seconds * 1000)
                 after, cpu1, t1, n1 = page.evaluate(STATE_JS), _cpu(kernel), time.monotonic(), len(arrivals)
                 close_notebook(page, lab, "rviz.ipynb")
-            if saved is None:
-                os.environ.pop("ROS_DOMAIN_ID", None)
-            else:
-                os.environ["ROS_DOMAIN_ID"] = saved
         finally:
             session.tool_node().destroy_subscription(counter)
             publisher.send_signal(signal.SIGINT)
@@ -225,6 +248,7 @@ def in_browser(seconds: float, scenario: str) -> dict:
             session.stop()
     window = t1 - t0
     return {"window": window, "raw": (n1 - n0) / window, "shown": (after["seq"] - before["seq"]) / window,
+            "received": (after["received"] - before["received"]) / window,
             "frames": (after["frames"] - before["frames"]) / window, "kernel_cpu": (cpu1 - cpu0) / window,
             "per_message": (cpu1 - cpu0) / max(1, n1 - n0), "render_ms": after["renderMs"]}
 
@@ -240,7 +264,10 @@ def main(argv=None) -> None:
     parser.add_argument("--updates", type=int, default=500, help="scan updates per way in part (a)")
     parser.add_argument("--with", dest="extra", action="append", default=[],
                         help="a folder to import pythreejs or k3d from (uv pip install --target DIR ...)")
-    parser.add_argument("--parts", default="ab")
+    parser.add_argument("--parts", default="ab", help="a: the kernel's time per scan in this process; b: the browser")
+    parser.add_argument("--streams", default="scan,spinning,cloud", help="part b's streams, of scan,spinning,cloud")
+    parser.add_argument("--rounds", type=int, default=1, help="runs of each stream (each code), alternating")
+    parser.add_argument("--baseline", type=Path, help="a folder with another course_lib to run each stream with first")
     args = parser.parse_args(argv)
     sys.path[2:2] = args.extra
     if "a" in args.parts:
@@ -249,16 +276,55 @@ def main(argv=None) -> None:
         for way, seconds in in_process(args.updates):
             print(f"| {way} | {seconds * 1e3:.2f} ms | {seconds * RATE:.1%} |")
     if "b" in args.parts:
-        print(f"\n(b) JupyterLab in headless Chromium, window {args.seconds:g} s each; the cloud's view spins\n")
-        print("| stream | raw messages/s (a plain subscriber) | drawings shown/s | frames drawn/s | kernel CPU | "
-              "kernel CPU per message | one frame's render |\n|---|---:|---:|---:|---:|---:|---:|")
-        for scenario, label in (("scan", f"{BEAMS}-beam LaserScan at {RATE:g} Hz"),
-                                ("scan, spinning", f"{BEAMS}-beam LaserScan at {RATE:g} Hz, the view spinning"),
-                                ("cloud", f"{CLOUD_POINTS:,}-point PointCloud2 (xyz, rgb) at {CLOUD_RATE:g} Hz")):
-            result = in_browser(args.seconds, scenario)
-            print(f"| {label} | {result['raw']:.1f} | {result['shown']:.1f} | {result['frames']:.1f} | "
-                  f"{result['kernel_cpu']:.1%} of a core | {result['per_message'] * 1e3:.1f} ms | "
-                  f"{result['render_ms']:.1f} ms |", flush=True)
+        browser_part(args)
+
+
+def browser_part(args) -> None:
+    """Part (b)'s table, its ratios to the baseline and the goals."""
+    print(f"\n(b) JupyterLab in headless Chromium, window {args.seconds:g} s each; the cloud's view spins; "
+          f"load average {_load()}\n")
+    print("| stream | code | raw messages/s (a plain subscriber) | drawings received/s | drawings shown/s | "
+          "frames drawn/s | kernel CPU | kernel CPU per message | one frame's render | load average (1 min) |\n"
+          "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|")
+    results = {}
+    streams = {"scan": ("scan", f"{BEAMS}-beam LaserScan at {RATE:g} Hz"),
+               "spinning": ("scan, spinning", f"{BEAMS}-beam LaserScan at {RATE:g} Hz, the view spinning"),
+               "cloud": ("cloud", f"{CLOUD_POINTS:,}-point PointCloud2 (xyz, rgb) at {CLOUD_RATE:g} Hz")}
+    for scenario, label in (streams[name] for name in args.streams.split(",")):
+        for code in (([args.baseline] if args.baseline else []) + [None]) * args.rounds:
+            result = in_browser(args.seconds, scenario, code)
+            results.setdefault((scenario, code), []).append(result)
+            print(f"| {label} | {code or 'this checkout'} | {result['raw']:.1f} | {result['received']:.1f} | "
+                  f"{result['shown']:.1f} | {result['frames']:.1f} | {result['kernel_cpu']:.1%} of a core | "
+                  f"{result['per_message'] * 1e3:.1f} ms | {result['render_ms']:.1f} ms | {os.getloadavg()[0]:.1f} |",
+                  flush=True)
+    print(f"\nload average at the end: {_load()}")
+    if args.baseline:
+        def ratio(scenario, measure):
+            return _median(results[scenario, None], measure) / max(1e-9, _median(results[scenario, args.baseline],
+                                                                               measure))
+        print("\nthis checkout / baseline: " + "; ".join(
+            f"{scenario}: frames {ratio(scenario, 'frames'):.2f}, shown {ratio(scenario, 'shown'):.2f}, "
+            f"kernel per message {ratio(scenario, 'per_message'):.2f}"
+            for scenario in dict.fromkeys(scenario for scenario, _ in results)))
+        if ("cloud", None) in results:
+            kernel = ratio("cloud", "per_message")
+            print(f"goal: cloud kernel CPU per message {kernel:.2f} of the baseline's < 1: "
+                  f"{'met' if kernel < 1 else 'NOT met'}")
+    for scenario, measure, goal in GOALS:
+        if (scenario, None) not in results:
+            continue
+        value = _median(results[scenario, None], measure)
+        print(f"goal: {scenario} {measure} {value:.1f}/s >= {goal:g}/s: {'met' if value >= goal else 'NOT met'}")
+
+
+def _median(rows: list[dict], measure: str) -> float:
+    return float(np.median([row[measure] for row in rows]))
+
+
+def _load() -> str:
+    return ", ".join(f"{value:.1f}" for value in os.getloadavg())
+
 
 if __name__ == "__main__":
     main()

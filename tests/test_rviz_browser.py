@@ -5,7 +5,8 @@ kernel restart and a re-run cell there is one view, one node with one subscripti
 
 The notebook's kernel publishes (a node in its own session, 5 Hz) a scan of a wall 2 m ahead of
 the laser, the laser 1 m along x of odom (as geometry_msgs/TransformStamped on /rviz_test_tf:
-tf2_msgs is not on PyPI yet), and a red cube marker at (-2, 1.5). The view looks straight down
+tf2_msgs is not on PyPI yet), a red cube marker at (-2, 1.5), and a blue PointCloud2 square in the
+laser's frame at (0, -2) (the browser places it by its pose: odom's (1, -2)). The view looks straight down
 (RViz's TopDownOrtho) at 50 pixels per metre on a 640×480 canvas: odom's (x, y) is drawn at
 pixel (320 + 50 x, 240 - 50 y).
 """
@@ -31,8 +32,9 @@ import numpy as np
 from geometry_msgs.msg import TransformStamped
 from rclpy.node import Node
 from rclpy.qos import qos_profile_sensor_data
-from sensor_msgs.msg import LaserScan
+from sensor_msgs.msg import LaserScan, PointCloud2, PointField
 from visualization_msgs.msg import Marker
+from course_lib.notebook.rviz.clouds import xyz_rgb_cloud_bytes
 from course_lib.ros import session
 
 class Scene(Node):
@@ -41,6 +43,12 @@ class Scene(Node):
         self.scan = self.create_publisher(LaserScan, "scan", qos_profile_sensor_data)
         self.marker = self.create_publisher(Marker, "visualization_marker", 10)
         self.tf = self.create_publisher(TransformStamped, "rviz_test_tf", 10)
+        self.points = self.create_publisher(PointCloud2, "points", qos_profile_sensor_data)
+        square = np.stack(np.meshgrid(np.linspace(-0.1, 0.1, 5), np.linspace(-2.1, -1.9, 5), [0.0]), -1).reshape(-1, 3)
+        fields, data, step = xyz_rgb_cloud_bytes(square, np.tile([[0, 0, 255]], (25, 1)))
+        self.cloud = PointCloud2(height=1, width=25, point_step=step, row_step=25 * step, data=data,
+                                 fields=[PointField(name=n, offset=o, datatype=t, count=1) for n, o, t in fields])
+        self.cloud.header.frame_id = "laser"
         self.create_timer(0.2, self.tick)
 
     def tick(self):
@@ -59,6 +67,7 @@ class Scene(Node):
         cube.scale.x = cube.scale.y = cube.scale.z = 0.6
         cube.color.r, cube.color.a = 1.0, 1.0
         self.marker.publish(cube)
+        self.points.publish(self.cloud)
 
 session.start()
 scene = session.add_node(Scene())""",
@@ -68,6 +77,7 @@ view = RViz("odom", transform_topics=["/rviz_test_tf"], seconds=300, size=[{WIDT
 view.add("TF", length=1.0, names=False)
 view.add("LaserScan", topic="/scan", size=0.1)
 view.add("Marker")
+view.add("PointCloud2", topic="/points", size=0.1)
 view""",
 ]
 
@@ -77,7 +87,8 @@ DRAWN_JS = """() => { const lines = [...document.querySelectorAll('.rviz-display
   const el = document.querySelector('.rviz-view');
   return el && Number(el.dataset.seq || 0) >= 1 && el.dataset.seq === el.dataset.received
     && lines.some(l => l.includes('points of 720 beams'))
-    && lines.some(l => l.includes('1 markers (test: 1)')) ? lines : null; }"""
+    && lines.some(l => l.includes('1 markers (test: 1)'))
+    && lines.some(l => l.includes('PointCloud2 (/points): 25 points')) ? lines : null; }"""
 
 
 def pixel(x: float, y: float) -> tuple[int, int]:
@@ -125,7 +136,7 @@ def canvas_box(page) -> dict:
 
 
 @pytest.mark.timeout(400)
-def test_a_marker_a_wall_scan_and_a_tf_frame_are_drawn_at_their_pixels(shown):
+def test_a_marker_a_wall_scan_a_tf_frame_and_a_cloud_are_drawn_at_their_pixels(shown):
     page, statuses = shown
     shot = page.screenshot(path=str(_target()), clip=canvas_box(page))
     picture = cv2.cvtColor(cv2.imdecode(np.frombuffer(shot, np.uint8), cv2.IMREAD_COLOR), cv2.COLOR_BGR2RGB)
@@ -142,6 +153,10 @@ def test_a_marker_a_wall_scan_and_a_tf_frame_are_drawn_at_their_pixels(shown):
     # The laser frame's y axis: green, 1 m long from (1, 0) up to (1, 1).
     green = colours_near(picture, 1.0, 0.5)
     assert any(c[1] > 200 and c[0] < 60 and c[2] < 60 for c in green), green
+    # The cloud's square: blue, 0.2 m wide around the laser frame's (0, -2), odom's (1, -2).
+    r, g, b = colours_near(picture, 1.0, -2.0).mean(axis=0)
+    assert b > 200 and r < 60 and g < 60, (r, g, b)
+    assert all(is_background(c) for c in colours_near(picture, 0.0, -2.0, radius=1))
 
 
 @pytest.mark.timeout(200)

@@ -62,25 +62,40 @@ class Robot(Node):
 
 
 class Browser:
-    """Stands in for rviz.js: takes each drawing the view sends and answers that it was drawn."""
+    """Stands in for rviz.js: takes each drawing the view sends, keeps each layer's newest items
+    with their arrays decoded (a ``same`` array is the one before at its place), and answers that
+    it was drawn."""
 
     def __init__(self, view):
-        self.view, self.messages = view, []
+        self.view, self.messages, self.layers = view, [], {}
         view.widget.send = self.receive
         view._on_browser(view.widget, {"kind": "ready"}, [])
 
     def receive(self, content, buffers):
         self.messages.append((content, buffers))
+        for name, items in content["layers"].items():
+            before = self.layers.get(name, []) + [{}] * len(items)
+            self.layers[name] = [{key: self._array(value, buffers, before[index].get(key))
+                                  if isinstance(value, dict) else value for key, value in item.items()}
+                                 for index, item in enumerate(items)]
         self.view._on_browser(self.view.widget, {"kind": "drawn", "seq": content["seq"], "frames": 1}, [])
+
+    @staticmethod
+    def _array(value, buffers, before):
+        if value.get("same"):
+            assert before is not None, "a `same` array with none before it at its place"
+            return before
+        return np.frombuffer(buffers[value["buffer"]], value["dtype"]).reshape(value["shape"])
 
     def layer(self, name):
         """The newest drawing of a layer: its items with their arrays decoded."""
-        for content, buffers in reversed(self.messages):
-            if name in content["layers"]:
-                return [{key: np.frombuffer(buffers[value["buffer"]], value["dtype"]).reshape(value["shape"])
-                         if isinstance(value, dict) else value for key, value in item.items()}
-                        for item in content["layers"][name]]
-        return None
+        return self.layers.get(name)
+
+
+def drawn_positions(item):
+    """An item's positions in the fixed frame (moved by its pose, when it has one)."""
+    pose = np.asarray(item.get("pose", np.eye(4)))
+    return item["positions"] @ pose[:3, :3].T + pose[:3, 3]
 
 
 @pytest.fixture(scope="module")
@@ -185,7 +200,7 @@ def test_a_point_cloud_is_drawn_in_the_fixed_frame_with_its_colours(robot, view)
     assert wait_until(lambda: publisher.get_subscription_count() >= 1)
     assert wait_until(lambda: publisher.publish(msg) or browser.layer("PointCloud2"))
     (points,) = browser.layer("PointCloud2")
-    assert np.allclose(points["positions"], xyz + [0, 0, 1], atol=1e-6)
+    assert np.allclose(drawn_positions(points), xyz + [0, 0, 1], atol=1e-6)
     assert points["colors"][0].tolist() == [0, 128, 255, 255] and display.status == ("ok", "50000 points")
     robot.destroy_publisher(publisher)
 
@@ -223,6 +238,22 @@ def test_encode_leaves_out_a_layer_drawn_exactly_as_it_was_last_sent():
     scan[0]["positions"] = np.full((1, 3), 2, np.float32)
     content, buffers = rviz_view.encode({"Grid": grid, "Scan": scan}, 2, last)
     assert list(content["layers"]) == ["Scan"] and content["layers"]["Scan"][0]["positions"]["buffer"] == 0
+
+
+def test_encode_sends_an_array_as_it_was_at_its_place_as_same_and_a_new_pose_alone():
+    """A cloud that moved sends its positions and not its unchanged colours; a new transform, its pose."""
+    last, colors = {}, np.full((3, 4), 255, np.uint8)
+    cloud = {"type": "points", "positions": np.zeros((3, 3), np.float32), "colors": colors, "pose": np.eye(4)}
+    rviz_view.encode({"Cloud": [cloud]}, 1, last)
+    moved = dict(cloud, positions=np.ones((3, 3), np.float32), colors=colors.copy())
+    content, buffers = rviz_view.encode({"Cloud": [moved]}, 2, last)
+    (item,) = content["layers"]["Cloud"]
+    assert item["colors"] == {"same": True} and item["positions"]["buffer"] == 0 and len(buffers) == 1
+    turned = dict(moved, pose=np.diag([-1.0, -1.0, 1.0, 1.0]))
+    content, buffers = rviz_view.encode({"Cloud": [turned]}, 3, last)
+    (item,) = content["layers"]["Cloud"]
+    assert item["positions"] == item["colors"] == {"same": True} and buffers == []
+    assert item["pose"][0] == [-1.0, 0.0, 0.0, 0.0]
 
 
 def test_frames_from_tf_and_tf_static_place_the_robot_and_its_laser(robot, view):

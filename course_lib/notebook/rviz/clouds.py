@@ -11,7 +11,6 @@ from __future__ import annotations
 import numpy as np
 
 from course_lib.notebook.rviz.geometry import rainbow
-from course_lib.notebook.rviz.transforms import transform_points
 
 #: sensor_msgs/PointField datatypes as numpy types.
 FIELD_TYPES = {1: "i1", 2: "u1", 3: "i2", 4: "u2", 5: "i4", 6: "u4", 7: "f4", 8: "f8"}
@@ -61,15 +60,47 @@ def cloud_colors(points: np.ndarray) -> np.ndarray:
 
 
 def point_cloud(cloud, fixed_from_cloud: np.ndarray, size: float = 0.02) -> list[dict]:
-    """A sensor_msgs/PointCloud2 as points in the fixed frame; points with a NaN coordinate are left out."""
-    points = cloud_array(cloud.fields, cloud.data, cloud.point_step, cloud.width, cloud.height,
-                         cloud.row_step, cloud.is_bigendian)
-    xyz = np.column_stack([points["x"], points["y"], points["z"]])
-    valid = np.isfinite(xyz).all(axis=1)
-    if not valid.all():
-        points, xyz = points[valid], xyz[valid]
-    return [{"type": "points", "positions": transform_points(fixed_from_cloud, xyz),
-             "colors": cloud_colors(points), "size": float(size)}]
+    """A sensor_msgs/PointCloud2 as points in its own frame, placed by ``pose`` (fixed_from_cloud):
+    the browser moves them, so a new transform sends 16 numbers, not the cloud again. Points with a
+    NaN or infinite coordinate are left out."""
+    xyz, colors = _packed_xyz_rgb(cloud)
+    if xyz is None:
+        points = cloud_array(cloud.fields, cloud.data, cloud.point_step, cloud.width, cloud.height,
+                             cloud.row_step, cloud.is_bigendian)
+        xyz = np.column_stack([points["x"], points["y"], points["z"]]).astype(np.float32)
+        colors = cloud_colors(points)
+    finite = np.isfinite(xyz)
+    if not finite.all():
+        valid = finite.all(axis=1)
+        xyz, colors = xyz[valid], colors[valid]
+    return [{"type": "points", "positions": xyz, "colors": colors, "size": float(size),
+             "pose": np.asarray(fixed_from_cloud, dtype=float)}]
+
+
+def _packed_xyz_rgb(cloud) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """PCL's usual layout (float32 x, y, z side by side, a 4-byte ``rgb`` or ``rgba``, little-endian,
+    rows without padding, all at multiples of 4 bytes) read as 4-byte words, a column at a time:
+    about 4 times quicker than through cloud_array's records. (None, None) for any other layout."""
+    fields = {f.name: f for f in cloud.fields}
+    x, y, z = (fields.get(axis) for axis in "xyz")
+    packed = fields.get("rgb") or fields.get("rgba")
+    if (cloud.is_bigendian or None in (x, y, z, packed) or cloud.point_step % 4
+            or cloud.row_step != cloud.point_step * cloud.width
+            or any(f.datatype != 7 or f.count > 1 for f in (x, y, z)) or x.offset % 4 or packed.offset % 4
+            or (y.offset, z.offset) != (x.offset + 4, x.offset + 8) or packed.datatype not in (6, 7)
+            or max(x.offset + 12, packed.offset + 4) > cloud.point_step):
+        return None, None
+    count, columns = cloud.width * cloud.height, cloud.point_step // 4
+    raw = np.frombuffer(cloud.data, dtype=np.uint8)
+    if raw.size < count * cloud.point_step:
+        return None, None  # cloud_array says what is wrong
+    words = raw[:count * cloud.point_step].view("<u4").reshape(count, columns)
+    xyz = np.empty((count, 3), dtype=np.float32)
+    for axis in range(3):
+        xyz[:, axis] = words[:, x.offset // 4 + axis].view("<f4")
+    # 0x00RRGGBB, bytes B, G, R, 0 in memory: swapped and shifted, 0xFFBBGGRR is the bytes R, G, B, 255.
+    rgba = (words[:, packed.offset // 4].byteswap() >> np.uint32(8)) | np.uint32(0xFF000000)
+    return xyz, rgba.astype("<u4", copy=False).view(np.uint8).reshape(count, 4)
 
 
 def xyz_rgb_cloud_bytes(xyz: np.ndarray, rgb: np.ndarray) -> tuple[list[tuple[str, int, int]], bytes, int]:

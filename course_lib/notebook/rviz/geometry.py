@@ -3,7 +3,9 @@ and texts in the fixed frame. No ROS import and no widget here; every function h
 
 Every drawing is a list of items, each a dict the browser draws with one three.js object:
 
-- ``points``: ``positions`` (N×3 float32), ``colors`` (N×4 uint8 RGBA), ``size`` (metres);
+- ``points``: ``positions`` (N×3 float32), ``colors`` (N×4 uint8 RGBA), ``size`` (metres), and
+  maybe ``pose`` (4×4: the positions' frame in the fixed frame, which the browser applies; a
+  PointCloud2's, so that a new transform does not send the cloud again);
 - ``lines``: segments, ``positions`` (2M×3: start, end, start, end, ...), ``colors`` (2M×4);
 - ``shapes``: ``shape`` ("cube", "sphere", "cylinder", "arrow"), ``matrices`` (K×4×4: each the
   unit shape's pose and scale in the fixed frame), ``colors`` (K×4). The unit cube has side 1, the

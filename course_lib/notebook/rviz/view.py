@@ -76,45 +76,67 @@ def _widget_class():
     return RVizWidget
 
 
-def encode(layers: dict[str, list[dict]], seq: int, last: dict | None = None) -> tuple[dict, list[bytes]]:
-    """The layers' items as one comm message: numbers as JSON, arrays as binary buffers.
+def encode(layers: dict[str, list[dict]], seq: int, last: dict | None = None) -> tuple[dict, list]:
+    """The layers' items as one comm message: numbers as JSON, arrays as binary buffers (the
+    contiguous arrays themselves: the comm copies them once, into its socket).
 
     Args:
-        last: the layers sent before, by name, as this function left them there; a layer drawn
-            exactly as before is left out of the message (the browser keeps showing it).
+        last: the layers sent before, by name, as this function left them there. An array with the
+            bytes of the one sent before at its place (layer, item, key) goes as ``{"same": true}``
+            (the browser keeps it, and its GPU copy: a cloud's unchanged colours travel once), and a
+            layer drawn exactly as before is left out of the message (the browser keeps showing it).
     """
-    buffers: list[bytes] = []
+    buffers: list = []
     out = {}
     for name, items in layers.items():
-        layer_buffers: list[bytes] = []
-        encoded = _encode_items(items, layer_buffers)
+        encoded, arrays = _encode_items(items)
+        before = last.get(name) if last is not None else None
         if last is not None:
-            if last.get(name) == (encoded, layer_buffers):
-                continue
-            last[name] = (encoded, layer_buffers)
-        out[name] = _shift_buffers(encoded, len(buffers))
-        buffers += layer_buffers
+            last[name] = (encoded, arrays)
+        kept = _kept_arrays(before[1], arrays) if before is not None else set()
+        if before is not None and before[0] == encoded and len(kept) == sum(map(len, arrays)):
+            continue
+        layer = []
+        for index, entry in enumerate(encoded):
+            entry = dict(entry)
+            for key, array in arrays[index].items():
+                if (index, key) in kept:
+                    entry[key] = {"same": True}
+                else:
+                    buffers.append(array.reshape(-1).view(np.uint8))  # as bytes: the comm takes len() for a size
+                    entry[key] = dict(entry[key], buffer=len(buffers) - 1)
+            layer.append(entry)
+        out[name] = layer
     return {"kind": "layers", "seq": seq, "layers": out}, buffers
 
 
-def _shift_buffers(encoded: list[dict], by: int) -> list[dict]:
-    return [{key: dict(value, buffer=value["buffer"] + by) if isinstance(value, dict) else value
-             for key, value in entry.items()} for entry in encoded]
-
-
-def _encode_items(items: list[dict], buffers: list[bytes]) -> list[dict]:
-    encoded = []
+def _encode_items(items: list[dict]) -> tuple[list[dict], list[dict]]:
+    """The items as JSON (each array as its dtype and shape), and each item's arrays by key."""
+    encoded, arrays = [], []
     for item in items:
-        entry = {}
+        entry, item_arrays = {}, {}
         for key, value in item.items():
             if key in ARRAYS:
-                array = np.ascontiguousarray(value)
-                buffers.append(array.tobytes())
-                entry[key] = {"buffer": len(buffers) - 1, "dtype": str(array.dtype), "shape": list(array.shape)}
+                item_arrays[key] = array = np.ascontiguousarray(value)
+                entry[key] = {"dtype": str(array.dtype), "shape": list(array.shape)}
             else:
                 entry[key] = value.tolist() if isinstance(value, np.ndarray) else value
         encoded.append(entry)
-    return encoded
+        arrays.append(item_arrays)
+    return encoded, arrays
+
+
+def _kept_arrays(before: list[dict], arrays: list[dict]) -> set[tuple[int, str]]:
+    """(item, key) of the arrays with the bytes of those sent before at their place (compared as
+    bytes: no copy, and a NaN equals itself)."""
+    kept = set()
+    for index, (old_arrays, item_arrays) in enumerate(zip(before, arrays, strict=False)):
+        for key, new in item_arrays.items():
+            old = old_arrays.get(key)
+            if old is not None and old.dtype == new.dtype and old.shape == new.shape and (
+                    old is new or np.array_equal(old.reshape(-1).view(np.uint8), new.reshape(-1).view(np.uint8))):
+                kept.add((index, key))
+    return kept
 
 
 class RViz:

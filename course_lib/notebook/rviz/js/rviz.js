@@ -3,7 +3,9 @@
 // The kernel (course_lib/notebook/rviz/view.py) does the ROS and the geometry; this draws its
 // items with three.js, in the fixed frame (ROS axes: z up). Messages from the kernel:
 //   {kind: "layers", seq, layers: {name: [item, ...]}}, arrays as binary buffers
-//     ({buffer: i, dtype, shape}); a layer not named keeps what it shows.
+//     ({buffer: i, dtype, shape}), or {same: true}: the array this place (layer, item, key) had in
+//     the message before; a layer not named keeps what it shows. A points item's optional `pose`
+//     (4x4, row-major) places its positions in the fixed frame.
 // Each time a message's layers are on screen the browser answers {kind: "drawn", seq, frames,
 // render_ms}: the kernel sends more only while few are unanswered (newest wins; nothing queues).
 // The tools answer {kind: "tool", tool, point, yaw}. Traits: `camera`, `displays` (status lines),
@@ -33,10 +35,68 @@ function unitShapes() {
   };
 }
 
+const ARRAYS = ["positions", "colors", "matrices", "jpeg"];
+
+// A view of the message's bytes (copied only when a float's start is not 4-byte aligned).
 function typedArray(ref, buffers) {
   const view = buffers[ref.buffer];
-  const bytes = view.buffer.slice(view.byteOffset, view.byteOffset + view.byteLength);
-  return ref.dtype === "uint8" ? new Uint8Array(bytes) : new Float32Array(bytes);
+  const Type = ref.dtype === "uint8" ? Uint8Array : Float32Array;
+  if (view.byteOffset % Type.BYTES_PER_ELEMENT === 0)
+    return new Type(view.buffer, view.byteOffset, view.byteLength / Type.BYTES_PER_ELEMENT);
+  return new Type(view.buffer.slice(view.byteOffset, view.byteOffset + view.byteLength));
+}
+
+// An item with its arrays as typed arrays, a `same` one taken from the item before it at its
+// place; null when that is unknown (a view opened after the message before: the kernel sends all
+// again when this view says it is ready).
+function decodeItem(item, buffers, before) {
+  const out = { ...item };
+  for (const key of ARRAYS) {
+    if (!item[key]) continue;
+    if (item[key].same && !(before && before[key])) return null;
+    out[key] = item[key].same ? before[key] : typedArray(item[key], buffers);
+  }
+  if (out.colors) // see-through when an alpha is under 255; checked again only for new colours
+    out.transparent = item.colors.same ? before.transparent : hasAlpha(out.colors);
+  return out;
+}
+
+function hasAlpha(colors) {
+  for (let i = 3; i < colors.length; i += 4) if (colors[i] < 255) return true;
+  return false;
+}
+
+// Points and segments keep one geometry, its attributes allocated with room to grow: a new
+// drawing is copied into them and only its range uploaded; an array the object drew last time
+// (a `same` one) is not uploaded again. The object is never culled (its bounds change with each
+// drawing) and is placed by the item's pose.
+function setVertices(object, item) {
+  const geometry = object.geometry, count = item.positions.length / 3;
+  const position = geometry.getAttribute("position");
+  if (!position || position.count < count) {
+    const room = Math.max(64, Math.ceil(count * 1.25));
+    geometry.dispose(); // the old GPU buffers go; the geometry is used again
+    geometry.setAttribute("position", new THREE.BufferAttribute(new Float32Array(room * 3), 3).setUsage(THREE.DynamicDrawUsage));
+    geometry.setAttribute("color", new THREE.BufferAttribute(new Uint8Array(room * 4), 4, true).setUsage(THREE.DynamicDrawUsage));
+    object.userData.drawn = {};
+  }
+  upload(geometry.getAttribute("position"), item.positions, object.userData.drawn, "positions");
+  upload(geometry.getAttribute("color"), item.colors, object.userData.drawn, "colors");
+  geometry.setDrawRange(0, count);
+  object.frustumCulled = false;
+  object.matrixAutoUpdate = false;
+  if (item.pose) object.matrix.fromArray(item.pose.flat()).transpose(); // row-major, as numpy's
+  else object.matrix.identity();
+  object.matrixWorldNeedsUpdate = true;
+}
+
+function upload(attribute, values, drawn, key) {
+  if (drawn[key] === values) return;
+  attribute.array.set(values);
+  attribute.clearUpdateRanges();
+  attribute.addUpdateRange(0, values.length);
+  attribute.needsUpdate = true;
+  drawn[key] = values;
 }
 
 // Materials are shared and kept, never disposed with a layer: three.js deletes a shader program
@@ -142,7 +202,7 @@ class Scene {
 
   // Perspective: point sizes in metres; top-down: metres times the pixels per metre (at least 2 px).
   pointSizes() {
-    for (const group of this.layers.values())
+    for (const { group } of this.layers.values())
       for (const object of group.children)
         if (object.isPoints) {
           const metres = object.userData.size;
@@ -157,23 +217,25 @@ class Scene {
     this.dirty = true;
   }
 
-  itemObjects(item, buffers) {
-    const colors = item.colors ? typedArray(item.colors, buffers) : null;
-    const transparent = colors ? colors.some((value, index) => index % 4 === 3 && value < 255) : false;
-    if (item.type === "points" || item.type === "lines") {
-      const geometry = new THREE.BufferGeometry();
-      geometry.setAttribute("position", new THREE.BufferAttribute(typedArray(item.positions, buffers), 3));
-      geometry.setAttribute("color", new THREE.BufferAttribute(colors, 4, true));
-      if (item.type === "lines")
-        return [new THREE.LineSegments(geometry, sharedMaterial(`lines|${transparent}`,
-          () => new THREE.LineBasicMaterial({ vertexColors: true, transparent })))];
-      const points = new THREE.Points(geometry, sharedMaterial(`points|${item.size}|${transparent}`,
-        () => new THREE.PointsMaterial({ vertexColors: true, transparent })));
-      points.userData.size = item.size;
-      return [points];
-    }
+  // An item's three.js objects: those of `old` (the item before it at its place) updated when
+  // it is points or segments as this one is, else new ones.
+  itemSlot(item, old) {
+    if (item.type !== "points" && item.type !== "lines") return { type: item.type, objects: this.itemObjects(item) };
+    const transparent = item.transparent;
+    const object = old && old.type === item.type ? old.objects[0]
+      : new (item.type === "points" ? THREE.Points : THREE.LineSegments)(new THREE.BufferGeometry());
+    object.material = item.type === "lines"
+      ? sharedMaterial(`lines|${transparent}`, () => new THREE.LineBasicMaterial({ vertexColors: true, transparent }))
+      : sharedMaterial(`points|${item.size}|${transparent}`, () => new THREE.PointsMaterial({ vertexColors: true, transparent }));
+    object.userData.size = item.size;
+    setVertices(object, item);
+    return old && old.objects[0] === object ? old : { type: item.type, objects: [object] };
+  }
+
+  itemObjects(item) {
+    const colors = item.colors;
     if (item.type === "shapes") {
-      const matrices = typedArray(item.matrices, buffers);
+      const matrices = item.matrices;
       const count = matrices.length / 16;
       const opacity = Math.round(colors.filter((_, index) => index % 4 === 3).reduce((a, b) => a + b, 0) / count) / 255;
       const material = sharedMaterial(`shapes|${opacity}`, () => new THREE.MeshLambertMaterial({ transparent: opacity < 1, opacity }));
@@ -187,7 +249,7 @@ class Scene {
       return [mesh];
     }
     if (item.type === "texts") {
-      const positions = typedArray(item.positions, buffers);
+      const positions = item.positions;
       return item.texts.map((text, i) => {
         const sprite = textSprite(text, colors.slice(4 * i, 4 * i + 4), item.heights[i]);
         sprite.position.set(positions[3 * i], positions[3 * i + 1], positions[3 * i + 2]);
@@ -197,19 +259,20 @@ class Scene {
     return [];
   }
 
-  setLayer(name, items, buffers) {
-    const old = this.layers.get(name);
-    if (old) {
-      this.scene.remove(old);
-      old.traverse((object) => { // materials (and text textures) are shared and stay
+  setLayer(name, items) {
+    const old = this.layers.get(name) || { group: new THREE.Group(), slots: [] };
+    if (!this.layers.has(name)) this.scene.add(old.group);
+    const slots = items.map((item, index) => this.itemSlot(item, old.slots[index]));
+    for (const slot of old.slots) {
+      if (slots.includes(slot)) continue;
+      for (const object of slot.objects) { // materials (and text textures) are shared and stay
+        old.group.remove(object);
         if (object.geometry && !Object.values(this.shapes).includes(object.geometry)) object.geometry.dispose();
-      });
+      }
     }
-    const group = new THREE.Group();
-    this.setPanel(name, items.find((item) => item.type === "image"), buffers);
-    for (const item of items) for (const object of this.itemObjects(item, buffers)) group.add(object);
-    this.scene.add(group);
-    this.layers.set(name, group);
+    for (const slot of slots) for (const object of slot.objects) if (object.parent !== old.group) old.group.add(object);
+    this.setPanel(name, items.find((item) => item.type === "image"));
+    this.layers.set(name, { group: old.group, slots });
   }
 
   // The point of the fixed frame's ground (z = 0) under a pixel of the canvas, or null (the sky).
@@ -232,7 +295,7 @@ class Scene {
   }
 
   // An Image display's picture: a 2D panel over the canvas's top left corner, as RViz docks it.
-  setPanel(name, item, buffers) {
+  setPanel(name, item) {
     let panel = this.panels.get(name);
     if (!item) {
       if (panel) {
@@ -251,7 +314,7 @@ class Scene {
       this.panels.set(name, panel);
     }
     const old = panel.src;
-    panel.src = URL.createObjectURL(new Blob([typedArray(item.jpeg, buffers)], { type: "image/jpeg" }));
+    panel.src = URL.createObjectURL(new Blob([item.jpeg], { type: "image/jpeg" }));
     if (old) URL.revokeObjectURL(old);
     panel.style.width = `${item.width}px`;
     panel.style.height = `${Math.round(item.width * item.aspect)}px`;
@@ -263,7 +326,7 @@ class Scene {
   }
 
   dispose() {
-    for (const name of [...this.layers.keys()]) this.setLayer(name, [], []);
+    for (const name of [...this.layers.keys()]) this.setLayer(name, []);
     this.controls.dispose();
     this.renderer.dispose();
   }
@@ -359,16 +422,25 @@ function render({ model, el }) {
   scene.setCamera(model.get("camera"));
   el.insertBefore(toolBar(model, scene), el.firstChild);
   useTools(model, scene);
-  // The drawings not on screen yet, oldest first, one shown per animation frame: the kernel sends
-  // them evenly, but a busy page or server hands them over in bunches, and a bunch merged into one
-  // frame showed 12-17 frames/s of a 20 Hz scan. Beyond MAX_WAITING the oldest two merge (per
-  // layer the newer drawing wins; a layer only the older had stays): a lagging page skips, never queues.
+  // The drawings not on screen yet, decoded as they came (views of the messages' bytes), oldest
+  // first, one shown per animation frame: the kernel sends them evenly, but a busy page or server
+  // hands them over in bunches, and a bunch merged into one frame showed 12-17 frames/s of a 20 Hz
+  // scan. Beyond MAX_WAITING the oldest two merge (per layer the newer drawing wins; a layer only
+  // the older had stays): a lagging page skips, never queues.
   const waiting = [];
+  const received = new Map(); // each layer's items as last received, for their `same` arrays
   let running = true;
 
   model.on("msg:custom", (content, buffers) => {
     if (content.kind !== "layers") return;
-    const layers = new Map(Object.entries(content.layers).map(([name, items]) => [name, { items, buffers }]));
+    const layers = new Map();
+    for (const [name, items] of Object.entries(content.layers)) {
+      const before = received.get(name) || [];
+      const decoded = items.map((item, index) => decodeItem(item, buffers, before[index]));
+      if (decoded.includes(null)) continue;
+      received.set(name, decoded);
+      layers.set(name, decoded);
+    }
     waiting.push({ seq: content.seq, layers });
     while (waiting.length > MAX_WAITING) {
       const [older, newer] = waiting.splice(0, 2);
@@ -392,7 +464,7 @@ function render({ model, el }) {
     if (scene.controls.autoRotate) scene.controls.update(); // a spinning orbit: a frame each time
     if (waiting.length) {
       const { seq, layers } = waiting.shift();
-      for (const [name, { items, buffers }] of layers) scene.setLayer(name, items, buffers);
+      for (const [name, items] of layers) scene.setLayer(name, items);
       scene.pointSizes();
       scene.render();
       el.dataset.seq = String(seq);
