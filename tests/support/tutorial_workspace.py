@@ -7,7 +7,9 @@ the workspace builds it under a file lock, the others wait for it):
   the lines that test expects), so that one rosidl build serves tests/course_lib/ros/test_workspace.py and
   tests/course_lib/ros2cli/test_ros2cli_interface_builds.py;
 - tutorial_nodes: an ament_python package that uses MsgTutorial (hello_node, topic_publisher,
-  topic_subscriber).
+  topic_subscriber). Its two nodes are this workspace's own, not a copy of lesson 01b's or of the
+  pubsub assignment's solution (assignments/reference_ws/src/pubsub): the publisher takes a `start`
+  parameter and both use the topic `topic`, which tests/course_lib/ros/test_workspace.py remaps.
 
 A test that builds in this workspace again holds `rebuilding()`; `built()` returns the
 workspace and its sourced environment under the same lock, so no test reads it mid-build.
@@ -22,6 +24,7 @@ from pathlib import Path
 from course_lib.ros import colcon, pkg_create, workspace
 
 from . import course as course_support
+from .from_source import REFERENCE_SOURCE
 
 # Comments say at which nesting level they are, as in ros2cli_test_interfaces.
 TEST_CLI_INTERFACES = {
@@ -49,7 +52,8 @@ TEST_CLI_INTERFACES = {
                                       "bool[3] bool_values\n"),
 }
 
-MSG_TUTORIAL = "builtin_interfaces/Time stamp\nint32 data\n"
+#: Lesson 01b's message, as the reference package tutorial_interfaces defines it.
+MSG_TUTORIAL = (REFERENCE_SOURCE / "tutorial_interfaces" / "msg" / "MsgTutorial.msg").read_text()
 
 PUBLISHER = '''import rclpy
 from rclpy.executors import ExternalShutdownException

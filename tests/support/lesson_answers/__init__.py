@@ -1,5 +1,8 @@
 """Right answers to the lessons' exercises, as files, and the files the lessons' %%writefile cells
-write: for the tests of the self-checks and of the lessons' commands."""
+write: for the tests of the self-checks and of the lessons' commands.
+
+These answers exist here only: a lesson hands out the exercise's stub, and course_lib, which students
+have, holds no solution. What the lessons write themselves is read from the notebooks, not copied."""
 
 import json
 from pathlib import Path
