@@ -68,14 +68,23 @@ def domain_id():
 #: The test files that take longest (whole grading runs, JupyterLab in Chromium), longest first:
 #: a long file started last ends the suite last. With `--dist loadfile` xdist hands out files in
 #: collection order only under `--no-loadscope-reorder` (the Makefile passes it); by default it
-#: hands out the files with the most tests first (test_launch_parser.py), and the hub and the
-#: lessons in Chromium started 7-8 minutes into an 11-minute run.
-LONGEST_FIRST = ("test_term.py", "test_browser.py", "test_autograder_zoo.py", "test_browser_lessons.py",
-                 "test_hub.py", "test_ros2cli_interface_builds.py", "test_browser_validate.py", "test_autograder.py",
-                 "test_lesson_commands.py", "test_autograder_pipeline.py")
+#: hands out the files with the most tests first (tests/course_lib/launch/test_launch_parser.py), and
+#: the hub and the lessons in Chromium started 7-8 minutes into an 11-minute run.
+LONGEST_FIRST = (
+    "tests/autograder/test_term.py",
+    "tests/browser/test_browser.py",
+    "tests/assignments/test_autograder_zoo.py",
+    "tests/browser/test_browser_lessons.py",
+    "tests/coursehub/test_hub.py",
+    "tests/course_lib/ros2cli/test_ros2cli_interface_builds.py",
+    "tests/browser/test_browser_validate.py",
+    "tests/assignments/test_autograder.py",
+    "tests/lessons/test_lesson_commands.py",
+    "tests/assignments/test_autograder_pipeline.py",
+)
 
 
-#: Set to 1 to run the lessons under nbmake even when tests/test_browser.py runs them in Chromium.
+#: Set to 1 to run the lessons under nbmake even when tests/browser/test_browser.py runs them in Chromium.
 NBMAKE_LESSONS_ENV = "COURSE_TEST_NBMAKE_LESSONS"
 
 
@@ -86,7 +95,7 @@ def _lessons_run_in_chromium(items) -> bool:
     if os.environ.get(NBMAKE_LESSONS_ENV) == "1" or not any(
             item.name.startswith("test_course_notebook_runs_clean_in_jupyterlab[") for item in items):
         return False
-    from browser_support import ChromiumUnavailable, find_chromium  # tests/ is on the path: its tests were collected
+    from support.browser import ChromiumUnavailable, find_chromium  # tests/ is on the path (pyproject's pythonpath)
 
     try:
         find_chromium()
@@ -99,14 +108,14 @@ def pytest_collection_modifyitems(items):
     """Move the items of LONGEST_FIRST to the front, in that order (the rest keep theirs); skip
     nbmake's lesson runs when the browser test runs the lessons (see _lessons_run_in_chromium)."""
     def rank(item):
-        name = item.path.name
+        name = item.path.relative_to(item.config.rootpath).as_posix()
         return LONGEST_FIRST.index(name) if name in LONGEST_FIRST else len(LONGEST_FIRST)
 
     items.sort(key=rank)
     if _lessons_run_in_chromium(items):
         run_in_lab = {item.name.split("[", 1)[1].rstrip("]") for item in items
                       if item.name.startswith("test_course_notebook_runs_clean_in_jupyterlab[")}
-        skip = pytest.mark.skip(reason=f"runs top to bottom in JupyterLab (tests/test_browser.py or "
+        skip = pytest.mark.skip(reason=f"runs top to bottom in JupyterLab (tests/browser/test_browser.py or "
                                        f"test_browser_lessons.py); "
                                        f"{NBMAKE_LESSONS_ENV}=1 runs it under nbmake too")
         for item in items:

@@ -32,16 +32,15 @@ import tempfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path[:0] = [str(ROOT), str(ROOT / "tests")]  # the grader runs from the repository
-
-import zoo  # noqa: E402 (tests/zoo builds submissions from the reference solutions)
-from zoo.brightness import CALLBACK  # noqa: E402
-from zoo.brightness import entries as brightness_entries  # noqa: E402
-from zoo.pillar import entries as pillar_entries  # noqa: E402
+sys.path.insert(0, str(ROOT))  # the grader and tests.support run from the repository, uninstalled
 
 from autograder.sandbox import namespaces  # noqa: E402
 from autograder.term import grade, release  # noqa: E402
 from course_lib.checks import assignments  # noqa: E402
+from tests.support import zoo  # noqa: E402 (it builds submissions from the reference solutions)
+from tests.support.zoo.brightness import CALLBACK  # noqa: E402
+from tests.support.zoo.brightness import entries as brightness_entries  # noqa: E402
+from tests.support.zoo.pillar import entries as pillar_entries  # noqa: E402
 
 ASSIGNMENTS = list(assignments.ASSIGNMENTS)
 #: The first statement of crop_pictures in the catdog_warp reference (readmarker/crop.py).

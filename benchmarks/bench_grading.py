@@ -36,9 +36,7 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path[:0] = [str(ROOT), str(ROOT / "tests")]  # the grader runs from the repository
-
-import zoo  # noqa: E402 (tests/zoo builds submissions from the reference solutions)
+sys.path.insert(0, str(ROOT))  # the grader and tests.support run from the repository, uninstalled
 
 from autograder.builds import caches  # noqa: E402
 from autograder.grading import pipeline  # noqa: E402
@@ -46,6 +44,7 @@ from autograder.sandbox import namespaces  # noqa: E402
 from autograder.term import grade, release  # noqa: E402
 from course_lib import contract  # noqa: E402
 from course_lib.checks import assignments  # noqa: E402
+from tests.support import zoo  # noqa: E402 (it builds submissions from the reference solutions)
 
 ASSIGNMENTS = list(assignments.ASSIGNMENTS)
 #: The steps shown on their own (autograder.grading.pipeline.STEPS); the others are summed as "other".

@@ -1,7 +1,7 @@
 """Where one grading's processor time goes, by program and phase, beside the floor (issue #48).
 
 Not a test: it prints what it measured. It releases every assignment into a scratch course, hands
-in each reference solution (tests/zoo), grades them once to warm the caches (message packages,
+in each reference solution (tests/support/zoo), grades them once to warm the caches (message packages,
 workspace builds), then runs, per assignment, the instructor's command
 
     python -m autograder grade COURSE --assignment A --student S --force
@@ -40,9 +40,8 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path[:0] = [str(ROOT), str(ROOT / "tests"), str(ROOT / "benchmarks")]
+sys.path.insert(0, str(ROOT))  # the grader and tests.support run from the repository, uninstalled
 
-import zoo  # noqa: E402 (tests/zoo builds submissions from the reference solutions)
 from bench_suite_cpu import TICKS, _program  # noqa: E402
 
 from autograder.grading import fork_server  # noqa: E402
@@ -51,6 +50,7 @@ from autograder.term import grade, release  # noqa: E402
 from course_lib import contract  # noqa: E402
 from course_lib.checks import assignments  # noqa: E402
 from course_lib.supervision import process_tree  # noqa: E402
+from tests.support import zoo  # noqa: E402 (it builds submissions from the reference solutions)
 
 ASSIGNMENTS = list(assignments.ASSIGNMENTS)
 GRADER = "grader main thread"

@@ -34,10 +34,9 @@ import time
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(REPO))
-sys.path.insert(0, str(REPO / "tests"))
+sys.path.insert(0, str(REPO))  # the hub (coursehub/) and tests.support run from the repository, uninstalled
 
-from hub_support import course_processes, log_in, run_in_kernel, running_hub, why_no_hub  # noqa: E402
+from tests.support.hub import course_processes, log_in, run_in_kernel, running_hub, why_no_hub  # noqa: E402
 
 ROS_SESSION = '''
 import time, psutil

@@ -29,12 +29,11 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tests"))
-
-from launch_demo import CHATTER_NODE, make_prefix  # noqa: E402
+sys.path.insert(0, str(ROOT))  # tests.support runs from the repository
 
 from course_lib import launch  # noqa: E402
 from course_lib.ros import rosenv  # noqa: E402
+from tests.support.launch_demo import CHATTER_NODE, make_prefix  # noqa: E402
 
 TWO_NODES = """<launch>
   <node pkg="bench_demo" exec="talker" name="talker"/>

@@ -1,7 +1,7 @@
 """Pictures recovered when the board holds photographs, by the detector alone and by the reference.
 
 Not a test: it prints recovery rates and processor time per frame on large seeded sets
-(tests/test_photos.py asserts the bounds on small ones). The scenes are
+(tests/course_lib/imaging/test_photos.py asserts the bounds on small ones). The scenes are
 render_scene(seed, board=photo_board(seed, corners)): photograph-like pictures whose corners
 are nearly black ("dark"), of every kind ("any"), or all eight of one kind (near_black, brown,
 navy, mid_dark, grey, gradient, texture, light); the drawn cat and dog board is measured too.
@@ -29,9 +29,9 @@ import tempfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tests"))
+sys.path.insert(0, str(ROOT))  # tests.support runs from the repository
 
-from photo_support import READMARKER, photo_scenes, recovery, reference_crop  # noqa: E402
+from tests.support.photo import READMARKER, photo_scenes, recovery, reference_crop  # noqa: E402
 
 
 def crop_at(revision: str):

@@ -44,8 +44,7 @@ from types import SimpleNamespace
 import numpy as np
 
 REPO = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(REPO))
-sys.path.insert(0, str(REPO / "tests"))
+sys.path.insert(0, str(REPO))  # tests.support runs from the repository
 
 BEAMS, RATE = 720, 20.0
 CLOUD_POINTS, CLOUD_RATE = 50_000, 5.0
@@ -208,10 +207,9 @@ def _environment(**values):
 def in_browser(seconds: float, scenario: str, code: Path | None = None) -> dict:
     """One stream shown in JupyterLab; `code`: a folder whose course_lib the notebook's kernel
     imports (PYTHONPATH) instead of this checkout's."""
-    from browser_notebook import close_notebook, open_notebook, run_notebook, write_notebook
-    from browser_support import launched_chromium, running_jupyterlab
-
     from course_lib.ros import message_yaml, rosenv, session
+    from tests.support.browser import launched_chromium, running_jupyterlab
+    from tests.support.browser_notebook import close_notebook, open_notebook, run_notebook, write_notebook
 
     rate, display, topic, msg_type, camera = SCENARIOS[scenario]
 
@@ -269,7 +267,7 @@ def main(argv=None) -> None:
     parser.add_argument("--rounds", type=int, default=1, help="runs of each stream (each code), alternating")
     parser.add_argument("--baseline", type=Path, help="a folder with another course_lib to run each stream with first")
     args = parser.parse_args(argv)
-    sys.path[2:2] = args.extra
+    sys.path[1:1] = args.extra
     if "a" in args.parts:
         print(f"(a) kernel processor time per {BEAMS}-beam scan update, {args.updates} updates each\n")
         print("| way | per scan | at 20 Hz, share of a core |\n|---|---:|---:|")

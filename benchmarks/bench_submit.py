@@ -33,15 +33,15 @@ from datetime import datetime, timezone
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path[:0] = [str(ROOT), str(ROOT / "tests")]  # the grader runs from the repository
+sys.path.insert(0, str(ROOT))  # the grader and tests.support run from the repository, uninstalled
 
 import nbformat  # noqa: E402
-import zoo  # noqa: E402 (tests/zoo builds submissions from the reference solutions)
-from zoo.brightness import SUM  # noqa: E402
 
 from autograder.config import COURSE_ID  # noqa: E402
 from autograder.term import release  # noqa: E402
 from coursehub.grading_service import Service  # noqa: E402
+from tests.support import zoo  # noqa: E402 (it builds submissions from the reference solutions)
+from tests.support.zoo.brightness import SUM  # noqa: E402
 
 ASSIGNMENT = "brightness"
 

@@ -10,7 +10,7 @@ its processor time), so this is the list of what to make cheaper.
 
     .venv/bin/python benchmarks/bench_suite_cpu.py [--top 25] [-- PYTEST_ARGS ...]
 
-With PYTEST_ARGS it runs `pytest PYTEST_ARGS` instead (say `-n 0 tests/test_launch.py`). It prints
+With PYTEST_ARGS it runs `pytest PYTEST_ARGS` instead (say `-n 0 tests/course_lib/launch/test_launch.py`). It prints
 the machine's processor time during the run, the part it could attribute to the suite's processes,
 and the largest shares by test file, by test and by program (python by its module or script,
 chromium by its process type). Exit status: pytest's.

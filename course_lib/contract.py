@@ -1,6 +1,6 @@
 """What the grader (autograder/) and the checks (course_lib/checks/) agree on, each defined once:
 the environment variables one sets for the other, the seeds, the folders, and the limits of the
-student's code. A test (tests/test_repository.py) fails when one of these names or folders is
+student's code. A test (tests/repository/test_repository.py) fails when one of these names or folders is
 spelled out again elsewhere: import it from here.
 
 The grader sets these variables for the processes it starts (the notebook's kernel, the hidden

@@ -7,9 +7,9 @@ import os
 import tempfile
 
 import pytest
-from browser_support import ChromiumUnavailable, launched_chromium
-from launch_demo import make_prefix
-from process_support import marker, processes_with
+from support.browser import ChromiumUnavailable, launched_chromium
+from support.launch_demo import make_prefix
+from support.process import marker, processes_with
 
 from autograder import answers
 from course_lib.ros2cli import daemon

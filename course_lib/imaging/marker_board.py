@@ -40,7 +40,7 @@ CORNER_OF_MARKER: tuple[int, int, int, int] = (2, 3, 0, 1)
 DEFAULT_SIZE: tuple[int, int] = (320, 240)
 
 #: crop_similarity at or above this means "the same crop". Measured on seeds 0-99 easy and
-#: 0-299 hard with a reference detect + warp (as in tests/test_scenes.py): correct crops of all 299
+#: 0-299 hard with a reference detect + warp (as in tests/course_lib/imaging/test_scenes.py): correct crops of all 299
 #: fully framed pictures scored 0.967 or more against expected_crops() (0.91 or more against the
 #: printed picture, source="picture"), while crops with the corners in a wrong order (mirrored,
 #: upside down, rotated by 90/180/270 degrees) or of the other picture scored 0.53 at most. The

@@ -5,7 +5,7 @@ layout) -> a picture (``frames.pdf`` or a figure in the notebook), without Graph
     Path("frames.gv").write_text(dot_text(data, 12.5))
     figure = draw(read_gv("frames.gv"))          # what the notebook shows
 
-Plain Python and matplotlib, no ROS; tested in tests/test_tf2_tools.py.
+Plain Python and matplotlib, no ROS; tested in tests/course_lib/robot/test_tf2_tools.py.
 """
 
 from __future__ import annotations
