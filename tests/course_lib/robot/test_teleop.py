@@ -78,10 +78,10 @@ def test_the_terminal_tool_in_a_pty_publishes_the_keys_twists_and_stops_on_ctrl_
     context = rclpy.Context()
     rclpy.init(context=context, domain_id=domain_id)
     heard, seen = [], []
+    node = Node("cmd_vel_reader", context=context)
+    executor = SingleThreadedExecutor(context=context)
     try:
-        node = Node("cmd_vel_reader", context=context)
         node.create_subscription(Twist, "/cmd_vel", heard.append, 10)
-        executor = SingleThreadedExecutor(context=context)
         executor.add_node(node)
         assert read_until(main, "currently:\tspeed 0.5\tturn 1.0 ", seen), "".join(seen)
         assert "Moving around:\n   u    i    o\n   j    k    l\n   m    ,    .\n" in "".join(seen).replace("\r\n", "\n")
@@ -106,6 +106,9 @@ def test_the_terminal_tool_in_a_pty_publishes_the_keys_twists_and_stops_on_ctrl_
         assert wait_until(lambda: executor.spin_once(timeout_sec=0.1) or heard[-1].linear.x == 0.0)
         assert process.returncode == 0
     finally:
+        # The node leaves the graph now, whatever failed: a later test in this domain must not see it.
+        executor.shutdown()
+        node.destroy_node()
         rclpy.try_shutdown(context=context)
         process_tree.stop_group(process, STOP_STEPS)
         os.close(main)
