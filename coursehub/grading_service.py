@@ -272,9 +272,10 @@ def main(argv=None) -> int:
         except KeyboardInterrupt:
             pass
         service.stopping.set()
-        # The gradings cut short (queued again at the next start) leave no work folder: the process
-        # becomes their remover when its worker threads hold any (autograder.grading.work_folders).
-        work_folders.end_gradings()
+    # The gradings cut short (queued again at the next start) leave no work folder: the process
+    # becomes their remover when its worker threads hold any (autograder.grading.work_folders),
+    # after the fork server ended (the remover would not end it).
+    work_folders.end_gradings()
     return 0
 
 

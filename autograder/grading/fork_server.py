@@ -103,7 +103,9 @@ class ForkServer:
 
     def __init__(self, programs: tuple[str, ...] = PROGRAMS, preload: tuple[str, ...] = PRELOAD):
         self.programs = tuple(programs)
-        self.folder = Path(tempfile.mkdtemp(prefix="autograder-fork-server-"))  # 0700, root's
+        # 0700, root's; a socket's path has at most 107 bytes, which a test's TMPDIR may leave no room for.
+        short = len(tempfile.gettempdir()) < 64
+        self.folder = Path(tempfile.mkdtemp(prefix="autograder-fork-server-", dir=None if short else "/tmp"))
         self.socket_path = str(self.folder / "socket")
         listener = socket.socket(socket.AF_UNIX, socket.SOCK_SEQPACKET)
         listener.bind(self.socket_path)
