@@ -32,6 +32,16 @@ def photo_scenes(seeds, corners="any", difficulty="hard"):
         yield scenes.render_scene(seed, difficulty=difficulty, board=board)
 
 
+def layout_scenes(seeds, layout, difficulty="hard"):
+    """board_layouts.layout_scene(seed, layout, table) for the seeds whose pose can frame a whole
+    picture, the table taking turns by seed (wood, dark weave, busy print)."""
+    from course_lib.imaging import board_layouts
+
+    for seed in board_layouts.framed_seeds(seeds, layout, difficulty):
+        yield board_layouts.layout_scene(seed, layout, board_layouts.TABLES[seed % len(board_layouts.TABLES)],
+                                         difficulty)
+
+
 @dataclasses.dataclass
 class Recovery:
     """What a crop function made of some scenes.

@@ -3,8 +3,9 @@
 The marker convention (dictionary, marker ids per picture, which marker corner touches the
 picture, crop corners) is course_lib.imaging.marker_board's; this module only applies it:
 
-1. detect the ArUco markers in the frame, and look again, where the board's layout puts them,
-   for board markers that merged with a dark picture corner (find_board_markers);
+1. detect the ArUco markers in the frame, and look again, where a picture's own markers (or,
+   when they cannot tell, the course board's layout) put them, for board markers that merged
+   with a dark picture corner (find_board_markers);
 2. for each picture whose four markers were all found, take the picture's four corners from
    the markers (marker_board.picture_corners);
 3. warp that quadrilateral onto a width x height crop (marker_board.crop_corners).
@@ -92,13 +93,14 @@ def find_board_markers(frame, detector=None, erode_passes=ERODE_PASSES, predict=
     brown, navy, a dark texture), the thresholded marker and the picture are one blob, whose
     outline is no square, and the detector misses the marker. Two second looks separate them:
 
-    1. the board's layout is known: the markers found give the board's homography, which
+    1. a picture's markers found give its homography (the board's layout may be any), which
        predicts where each missing marker is; there, in a small window with everything but the
        marker and its paper painted over (look_where_predicted), the detector looks again;
-    2. when fewer than two board markers are known: thin every dark area by a pixel or so (a
-       maximum filter) and detect again on the whole frame: the one-point contact breaks while
-       the marker's cells survive; the corners found are moved back out by the amount thinned.
-       Then step 1 again with the markers found.
+    2. when fewer than two board markers are known, or (the first, cheapest pass only) a
+       picture's markers found leave its shape open (one, or two on one side): thin every dark
+       area by a pixel or so (a maximum filter) and detect again on the whole frame: the
+       one-point contact breaks while the marker's cells survive; the corners found are moved
+       back out by the amount thinned. Then step 1 again with the markers found.
 
     Args:
         frame, detector: as for find_markers.
@@ -113,8 +115,8 @@ def find_board_markers(frame, detector=None, erode_passes=ERODE_PASSES, predict=
     grey = frame if frame.ndim == 2 else cv2.cvtColor(frame, cv2.COLOR_BGR2GRAY)
     if predict:
         found.update(look_where_predicted(grey, found, detector))
-    for scale, kernel in erode_passes:
-        if sum(i in found for i in _BOARD_IDS) >= 2:
+    for number, (scale, kernel) in enumerate(erode_passes):
+        if sum(i in found for i in _BOARD_IDS) >= 2 and not (number == 0 and _shape_open(found)):
             break
         new = {i: c for i, c in thinned_markers(grey, scale, kernel, detector).items()
                if i in _BOARD_IDS and i not in found}
@@ -123,6 +125,16 @@ def find_board_markers(frame, detector=None, erode_passes=ERODE_PASSES, predict=
             found.update(look_where_predicted(grey, found, detector))
     return found
     ### END SOLUTION
+
+
+def _shape_open(found):
+    """True when a picture has markers found, but not all four, and they do not fix its shape
+    (one, or two on one side: see picture_prediction)."""
+    for ids in marker_board.PICTURES.values():
+        where = {ids.index(i) for i in ids if i in found}
+        if where and len(where) < 4 and not (where & {0, 3} and where & {1, 2} and where & {0, 1} and where & {2, 3}):
+            return True
+    return False
 
 
 def thinned_markers(grey, scale, kernel, detector=None):
@@ -152,13 +164,18 @@ WINDOW_LOOKS = ((1, 1), *ERODE_PASSES)
 def look_where_predicted(grey, found, detector=None):
     """Board markers missing from `found`, looked for where the found ones predict them.
 
-    The board's homography (board units -> frame pixels) is fitted to the corners of every
-    board marker found; it puts each missing marker at a quadrilateral of the frame. A small
-    window around it keeps the marker and KEPT_PAPER units of paper around it and paints the
-    rest, the picture it touches included, with the paper's grey: nothing dark touches the
-    marker any more, whatever the colour of the picture's corner. The detector looks in that
+    A picture's missing marker is predicted from the picture's own markers when they fix its
+    shape: three of four, or two diagonal ones. The markers are squares of one size that touch
+    the picture's corners, so their corners give the picture's width and height and its
+    homography (picture_prediction), whatever the board's layout. Where that finds nothing, or
+    the markers do not fix the shape, the course board's homography (board units -> frame
+    pixels), fitted to the corners of every board marker found, predicts it, when it fits all but
+    one of them (course_prediction). A small window around the predicted marker keeps the
+    marker and KEPT_PAPER units of paper around it and paints the rest, the picture it touches
+    included, with the paper's grey: nothing dark touches the marker any more, whatever the
+    colour of the picture's corner. The detector looks in that
     window (WINDOW_LOOKS); a marker counts when it has the predicted id and lies where it was
-    predicted. Markers found refine the homography for another round.
+    predicted. Markers found refine the predictions for another round.
 
     Args:
         grey: the frame, grey uint8 (height, width).
@@ -169,24 +186,125 @@ def look_where_predicted(grey, found, detector=None):
         dict marker id -> float32 (4, 2) corners of the board markers found in this look only.
     """
     ### BEGIN SOLUTION
-    board = boards.default_board()  # only its geometry (board units) is used, the same for any pictures
     new = {}
     while True:
-        known = [i for i in _BOARD_IDS if i in found or i in new]
-        missing = [i for i in _BOARD_IDS if i not in known]
-        if not known or not missing:
+        known = {i: new[i] if i in new else found[i] for i in _BOARD_IDS if i in found or i in new}
+        if not known or len(known) == len(_BOARD_IDS):
             return new
-        homography = board_homography(board, {i: new[i] if i in new else found[i] for i in known})
-        if homography is None:
-            return new
-        more = {}
-        for marker_id in missing:
-            corners = _look_in_window(grey, board, homography, marker_id, detector)
-            if corners is not None:
-                more[marker_id] = corners
+        more, course = {}, course_prediction(known)
+        for picture, ids in marker_board.PICTURES.items():
+            missing = [i for i in ids if i not in known]
+            own = picture_prediction({i: known[i] for i in ids if i in known}, picture) if missing else None
+            predictions = [p for p in (own, course and course[picture]) if p]
+            for marker_id in missing:
+                for homography, squares, slot in predictions:  # the next only where one finds nothing
+                    corners = _look_in_window(grey, homography, squares[marker_id], slot, marker_id, detector)
+                    if corners is not None:
+                        more[marker_id] = corners
+                        break
         if not more:
             return new
         new.update(more)
+    ### END SOLUTION
+
+
+#: A marker's corners off a fitted homography by more than this fraction of its side do not fit it.
+FIT_TOLERANCE = 0.2
+
+
+def picture_prediction(markers, picture):
+    """A picture's homography fitted to its own markers (id -> corners), whatever the board's layout.
+
+    In picture units the picture spans (0, 0)-(width, height) and each marker is a square of side
+    boards.Board.MARKER diagonally outside the corner it touches. Width and height are unknown:
+    one linear least-squares step gives them (_linear_shape), then the homography is fitted to
+    the markers' corners for them. Three markers fix both, and so do two diagonal ones (less
+    well); two on one side leave one unknown (None).
+
+    Returns:
+        (homography picture units -> frame pixels, {id: its square in picture units}, the
+        picture's corners in picture units), or None when the markers do not fix the shape or
+        one of them does not fit (FIT_TOLERANCE).
+    """
+    ### BEGIN SOLUTION
+    ids = marker_board.PICTURES[picture]
+    where = [ids.index(i) for i in markers]  # 0 top-left, 1 top-right, 2 bottom-right, 3 bottom-left
+    if len(markers) < 2 or _shape_open(markers):
+        return None
+    side = boards.Board.MARKER
+    seen = np.concatenate([markers[i] for i in markers]).astype(np.float32).reshape(-1, 2)
+    width, height = _linear_shape(markers, where, side)
+    if width < side / 4 or height < side / 4:
+        return None  # no picture: markers mixed up
+    squares = _picture_squares(ids, width, height, side)
+    model = np.concatenate([squares[i] for i in markers]).astype(np.float32)
+    homography, _ = cv2.findHomography(model, seen, 0)
+    if homography is None or _misfits(homography, model, seen):
+        return None
+    slot = np.array([[0, 0], [width, 0], [width, height], [0, height]], np.float64)
+    return homography, squares, slot
+    ### END SOLUTION
+
+
+def _linear_shape(markers, where, side):
+    """A picture's (width, height) from its markers (id -> corners; `where` their positions 0-3),
+    solved in one linear least-squares step.
+
+    A marker corner at picture point (x0 + a * width, y0 + b * height) (a: the marker is on the
+    right, b: at the bottom) gives two equations of the homography that are linear in its eight
+    entries h and in the six products width * h1, width * h4, width * h7, height * h2,
+    height * h5 and height * h8, as in the direct linear transform; the frame points are
+    centred and scaled first, so that the system is well conditioned.
+    """
+    seen = np.concatenate([markers[i] for i in markers]).astype(np.float64).reshape(-1, 2)
+    seen = (seen - seen.mean(axis=0)) / max(1e-9, float(np.abs(seen - seen.mean(axis=0)).mean()))
+    squares = _picture_squares(range(4), 0.0, 0.0, 1.0)
+    rows, values = [], []
+    for index, (u, v) in enumerate(seen):
+        position = where[index // 4]
+        x, y = squares[position][index % 4]
+        a, b = float(position in (1, 2)), float(position in (2, 3))
+        rows.append([x, y, 1, 0, 0, 0, -u * x, -u * y, a, 0, -u * a, b, 0, -u * b])
+        rows.append([0, 0, 0, x, y, 1, -v * x, -v * y, 0, a, -v * a, 0, b, -v * b])
+        values += [u, v]
+    solution = np.linalg.lstsq(np.array(rows), np.array(values), rcond=None)[0]
+    h, width_h, height_h = solution[:8], solution[8:11], solution[11:14]
+    column_x, column_y = h[[0, 3, 6]], h[[1, 4, 7]]
+    width = float(width_h @ column_x / max(1e-12, column_x @ column_x))
+    height = float(height_h @ column_y / max(1e-12, column_y @ column_y))
+    return width * side, height * side
+
+
+def _picture_squares(ids, width, height, side):
+    """Marker id -> its square (OpenCV corner order) in picture units, for a picture of this size."""
+    origins = ((-side, -side), (width, -side), (width, height), (-side, height))
+    return {i: np.array([[x, y], [x + side, y], [x + side, y + side], [x, y + side]], np.float64)
+            for i, (x, y) in zip(ids, origins, strict=True)}
+
+
+def _misfits(homography, model, seen):
+    """How many markers (four rows of `model` and `seen` each) lie farther than FIT_TOLERANCE of
+    their side from where `homography` puts them."""
+    errors = np.linalg.norm(_project(homography, model) - seen, axis=1).reshape(-1, 4).max(axis=1)
+    sides = np.linalg.norm(seen.reshape(-1, 4, 2) - np.roll(seen.reshape(-1, 4, 2), 1, axis=1), axis=2).min(axis=1)
+    return int((errors > FIT_TOLERANCE * sides).sum())
+
+
+def course_prediction(known):
+    """Per picture, (homography board units -> frame pixels, {id: square}, slot) of the course's
+    board, fitted to the `known` board markers (id -> corners); None when the course layout does
+    not agree with them: its fit leaves out more than one of them (board_homography)."""
+    ### BEGIN SOLUTION
+    board = boards.default_board()  # only its geometry (board units) is used, the same for any pictures
+    homography = board_homography(board, known)
+    if homography is None:
+        return None
+    square = np.concatenate([board.marker_square(i) for i in known]).astype(np.float32)
+    seen = np.concatenate([known[i] for i in known]).astype(np.float32).reshape(-1, 2)
+    if _misfits(homography, square, seen) > 1:
+        return None
+    return {picture: (homography, {i: board.marker_square(i) for i in ids}, board.picture_slot(picture))
+            for picture, ids in marker_board.PICTURES.items()}
     ### END SOLUTION
 
 
@@ -224,29 +342,28 @@ def _inside(points, shape):
                 and points[:, 1].max() <= height - 1 - FRAME_INSET)
 
 
-def _look_in_window(grey, board, homography, marker_id, detector):
-    """The corners of board marker `marker_id` found in the window where `homography` puts it, or None."""
+def _look_in_window(grey, homography, square, slot, marker_id, detector):
+    """The corners of board marker `marker_id` found in the window where `homography` puts its
+    `square`, next to the picture `slot` (both in the same units), or None."""
     ### BEGIN SOLUTION
-    square = board.marker_square(marker_id)
     predicted = _project(homography, square)
     side = float(np.linalg.norm(predicted - np.roll(predicted, 1, axis=0), axis=1).min())
     height, width = grey.shape
     if side < 10 or not _inside(predicted, grey.shape):
         return None  # too small to read, or cut by the frame edge
     centre = square.mean(axis=0)
-    kept = _project(homography, centre + (square - centre) * (1 + 2 * KEPT_PAPER / board.MARKER))
+    unit = boards.Board.MARKER / float(np.linalg.norm(square[1] - square[0]))  # board units per unit
+    kept = _project(homography, centre + (square - centre) * (1 + 2 * KEPT_PAPER / boards.Board.MARKER))
     x0, y0 = np.maximum(np.floor(kept.min(axis=0)).astype(int) - 2, 0)
     x1, y1 = np.minimum(np.ceil(kept.max(axis=0)).astype(int) + 3, (width, height))
     window = grey[y0:y1, x0:x1]
     offset = np.float32([x0, y0])
-    picture = next(name for name, ids in marker_board.PICTURES.items() if marker_id in ids)
-    slot = board.picture_slot(picture)
     pad = 8  # paper around the window, so that the detector's border rule keeps the marker
     for overlap, (scale, kernel) in ((o, look) for o in PICTURE_OVERLAPS for look in WINDOW_LOOKS):
         if (scale, kernel) == WINDOW_LOOKS[0]:  # a new overlap: paint the window again
             mask = np.zeros(window.shape, np.uint8)
             cv2.fillConvexPoly(mask, np.round((kept - offset) * 16).astype(np.int32), 255, cv2.LINE_8, shift=4)
-            painted = _project(homography, slot + np.sign(slot - slot.mean(axis=0)) * overlap)
+            painted = _project(homography, slot + np.sign(slot - slot.mean(axis=0)) * overlap / unit)
             cv2.fillConvexPoly(mask, np.round((painted - offset) * 16).astype(np.int32), 0, cv2.LINE_8, shift=4)
             paper = float(np.percentile(window[mask > 0], 90))  # the marker's white cells and its paper
             clean = cv2.copyMakeBorder(np.where(mask > 0, window, np.uint8(paper)), pad, pad, pad, pad,
