@@ -44,8 +44,7 @@ RUNNER = f"""\
 import os, random, signal, sys, threading
 import rclpy
 import rclpy.signals
-sys.path.insert(0, sys.argv[1])
-import find_pictures_server
+import find_pictures_server  # beside this script
 
 spinning, ended = threading.Event(), threading.Event()
 spin = rclpy.spin
@@ -110,8 +109,8 @@ def test_a_server_process_ends_on_sigterm_with_exit_code_0(server_env):
     folder, env = server_env
     from course_lib.ros.processes import NodeProcess
 
-    source = "import sys; sys.path.insert(0, sys.argv[1]); import find_pictures_server; find_pictures_server.main()"
-    server = NodeProcess([sys.executable, "-c", source, str(folder)], env=env)
+    source = "import find_pictures_server; find_pictures_server.main()"  # python -c: its folder is importable
+    server = NodeProcess([sys.executable, "-c", source], env=env, cwd=folder)
     server.start()
     try:
         server.wait_for_node("find_pictures_server", timeout=30)
