@@ -112,9 +112,13 @@ def read_key(stream) -> str:
 
 def main(args=None) -> int:
     import rclpy
+    from rclpy.duration import Duration
     from rclpy.node import Node
+    from rclpy.signals import SignalHandlerOptions
 
-    rclpy.init(args=sys.argv if args is None else args)
+    # Ctrl-C between two keys (the terminal not in raw mode) is a SIGINT: a KeyboardInterrupt, with
+    # the context still up to publish the stop (rclpy's own handler would shut it down first).
+    rclpy.init(args=sys.argv if args is None else args, signal_handler_options=SignalHandlerOptions.NO)
     node = Node("teleop_twist_keyboard")
     publisher = node.create_publisher(type(twist_message((0, 0, 0, 0))), "cmd_vel", 10)
     state = Teleop(speed=node.declare_parameter("speed", 0.5).value, turn=node.declare_parameter("turn", 1.0).value)
@@ -133,6 +137,9 @@ def main(args=None) -> int:
         pass
     finally:
         publisher.publish(twist_message((0, 0, 0, 0)))
+        # The stop must reach the robot: a node that ends right after publishing may take the
+        # message with it (the subscribers acknowledge it; a second at most).
+        publisher.wait_for_all_acked(Duration(seconds=1))
         node.destroy_node()
         rclpy.try_shutdown()
     return 0

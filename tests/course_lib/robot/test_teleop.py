@@ -68,12 +68,22 @@ def read_until(descriptor: int, words: str, seen: list[str]) -> bool:
     return wait_until(arrived) and words in "".join(seen)
 
 
+def _controlling_terminal() -> None:
+    """In the tool's new session: the pty its controlling terminal, as a terminal window's is. Ctrl-C
+    typed while the tool is between two reads (not in raw mode) is then a SIGINT, as for a user;
+    without one the terminal dropped the key and the tool read on for ever."""
+    import fcntl
+    import termios
+
+    fcntl.ioctl(0, termios.TIOCSCTTY, 0)
+
+
 def test_the_terminal_tool_in_a_pty_publishes_the_keys_twists_and_stops_on_ctrl_c(domain_id):
     """About 1.5 CPU-s: one ROS process and a subscriber."""
     main, child = pty.openpty()
     process = subprocess.Popen([str(ROS2), "run", "teleop_twist_keyboard", "teleop_twist_keyboard"],
                                env=rosenv.ros_environment(domain_id), stdin=child, stdout=child, stderr=child,
-                               start_new_session=True)
+                               start_new_session=True, preexec_fn=_controlling_terminal)
     os.close(child)
     context = rclpy.Context()
     rclpy.init(context=context, domain_id=domain_id)
