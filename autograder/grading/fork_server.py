@@ -42,20 +42,23 @@ import tempfile
 import traceback
 from pathlib import Path
 
+from autograder.sandbox.sandbox_entry import CLONE_NEWPID, FORWARDED, PR_SET_PDEATHSIG
+
 CLIENT = Path(__file__).resolve().parent / "fork_client.py"
 #: Where the client is in a folder that holds the autograder package (a copy of it: autograder.grading.staging).
 CLIENT_IN_PACKAGE = CLIENT.relative_to(CLIENT.parents[2])
 #: The programs the server runs (``python -m`` modules).
-PROGRAMS = ("autograder.grading.sandboxed_autograde", "autograder.grading.hidden_checks_process")
+NOTEBOOK_RUN = "autograder.grading.sandboxed_autograde"  # the notebook's run (nbgrader's autograde)
+CHECKS_RUN = "autograder.grading.hidden_checks_process"  # the hidden checks' process
+PROGRAMS = (NOTEBOOK_RUN, CHECKS_RUN)
 #: What the programs import when they run, imported by the server once (the grader's own modules
 #: are imported again by each run, from the sandbox's copy).
 PRELOAD = ("nbgrader.converters", "nbgrader.preprocessors", "nbclient", "jupyter_client", "rclpy",
            "course_lib.checks.registry", "course_lib.checks.student_server", "course_lib.checks.probe",
            *PROGRAMS)
-_CLONE_NEWNS, _CLONE_NEWNET, _CLONE_NEWPID = 0x00020000, 0x40000000, 0x20000000
-_PR_SET_PDEATHSIG, _PR_SET_NAME = 1, 15
+_CLONE_NEWNS, _CLONE_NEWNET = 0x00020000, 0x40000000
+_PR_SET_NAME = 15
 _RLIMITS = [getattr(resource, name) for name in dir(resource) if name.startswith("RLIMIT_")]
-FORWARDED = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP, signal.SIGQUIT, signal.SIGUSR1, signal.SIGUSR2)
 
 _current: ForkServer | None = None
 
@@ -166,7 +169,7 @@ class ForkServer:
 def run_name(module: str) -> str:
     """The name (comm, as ps shows it) of a run of `module`: "fork:" and the module's last part,
     "autograde" and "checks" for the grader's two programs."""
-    short = dict(zip(PROGRAMS, ("autograde", "checks"), strict=True))
+    short = {NOTEBOOK_RUN: "autograde", CHECKS_RUN: "checks"}
     return ("fork:" + short.get(module, module.rsplit(".", 1)[-1]))[:15]
 
 
@@ -178,7 +181,7 @@ def _serve(listener: socket.socket, control: socket.socket, programs: tuple, pre
     """The server: the programs imported, then a handler forked per client until the grader closes
     `control`; it ends once they have. (What else the grader had open stays so: the runs are the
     grader's own programs, and they start a student's code with only its standard streams.)"""
-    _libc().prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
+    _libc().prctl(PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
     _libc().prctl(_PR_SET_NAME, b"fork-server", 0, 0, 0)
     # A Ctrl-C to the grader's group is the grader's to handle; a SIGTERM ends the server (and
     # its runs, through their parent-death signals).
@@ -225,7 +228,7 @@ def _reaped(pids: set) -> set:
 
 def _handle(client: socket.socket, programs: tuple) -> None:
     """One client: its run forked into its namespaces, signals passed on, its end reported."""
-    _libc().prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
+    _libc().prctl(PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
     _libc().prctl(_PR_SET_NAME, b"fork-handler", 0, 0, 0)
     message, fds, _flags, _address = socket.recv_fds(client, 1 << 20, 3)
     pid, uid, _gid = struct.unpack("3i", client.getsockopt(socket.SOL_SOCKET, socket.SO_PEERCRED,
@@ -236,7 +239,7 @@ def _handle(client: socket.socket, programs: tuple) -> None:
         return
     spaces = {kind: os.open(f"/proc/{pid}/ns/{kind}", os.O_RDONLY) for kind in ("net", "mnt", "pid")}
     limits = {limit: resource.prlimit(pid, limit) for limit in _RLIMITS}
-    for kind, flag in (("net", _CLONE_NEWNET), ("mnt", _CLONE_NEWNS), ("pid", _CLONE_NEWPID)):
+    for kind, flag in (("net", _CLONE_NEWNET), ("mnt", _CLONE_NEWNS), ("pid", CLONE_NEWPID)):
         if _libc().setns(spaces[kind], flag) != 0:
             error = ctypes.get_errno()
             os.write(fds[2], f"autograder: the fork server could not join the sandbox's {kind} namespace: "
@@ -274,7 +277,7 @@ def _run(request: dict, fds: list[int], limits: dict) -> None:
     grader's modules again from the client's PYTHONPATH, then MODULE as __main__."""
     code = 1
     try:
-        _libc().prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
+        _libc().prctl(PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
         _libc().prctl(_PR_SET_NAME, run_name(request["module"]).encode(), 0, 0, 0)
         for target, fd in enumerate(fds):
             os.dup2(fd, target)

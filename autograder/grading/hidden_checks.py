@@ -57,9 +57,8 @@ def run_checks(sub: Submission, names: list[str], out: Path, workdir: Path, doma
 
     checks = registry.checks_of(sub.assignment)
     out.mkdir(mode=0o700)
-    command = fork_server.program("autograder.grading.hidden_checks_process", [sub.assignment, *names,
-                                                                                "--workdir", str(workdir), "--out",
-                                                                                str(out)], env)
+    command = fork_server.program(fork_server.CHECKS_RUN,
+                                  [sub.assignment, *names, "--workdir", str(workdir), "--out", str(out)], env)
     wall = sum(checks[name].timeout + 30 for name in names)
     env = {**env, contract.CHECK_SEED_ENV: None, contract.SEED_ENV: os.environ.get(contract.SEED_ENV)}
     if seconds is not None:

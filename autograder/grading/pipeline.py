@@ -76,9 +76,6 @@ KEPT_FOR_CHECKS = 20.0
 #: one-core machine, where overlapping them gains nothing.
 #: Largest file a submission may write (MB).
 FILE_MB = 256
-#: The program that runs the notebook in the sandbox (nbgrader's autograde), through the grader's
-#: fork server when it has one (autograder.grading.fork_server).
-RUN_NOTEBOOK = "autograder.grading.sandboxed_autograde"
 #: Base of the per-worker uids (root only): uid = KERNEL_UID_BASE + reserved ROS domain id.
 KERNEL_UID_BASE = 61000
 #: The early build and checks run as the worker's uid + EARLY_UID_OFFSET: the kernel, which runs
@@ -211,7 +208,7 @@ def run_notebook(g: Grading) -> None:
     """``nbgrader autograde`` in the sandbox (autograder.grading.sandboxed_autograde), within the notebook's limits."""
     from course_lib.ros import processes
 
-    command = fork_server.program(RUN_NOTEBOOK, [str(g.root), g.sub.assignment, g.sub.student], g.env)
+    command = fork_server.program(fork_server.NOTEBOOK_RUN, [str(g.root), g.sub.assignment, g.sub.student], g.env)
     g.notebook_seconds = round(min(NOTEBOOK_TIMEOUT, g.seconds_left(keep=KEPT_FOR_CHECKS)), 1)
     limits = processes.Limits(wall_seconds=g.notebook_seconds, memory_mb=contract.MEMORY_MB, file_size_mb=FILE_MB,
                               grace_seconds=2.0)
