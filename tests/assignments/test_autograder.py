@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import nbformat
@@ -197,7 +198,9 @@ PUBSUB_MISTAKES = {
     "best_effort": ([("self.create_publisher(MsgTutorial, TOPIC, QUEUE_DEPTH)",
                       "self.create_publisher(MsgTutorial, TOPIC, rclpy.qos.qos_profile_sensor_data)")], "publisher",
                     "publisher queue depth 5"),
-    "one_hertz": ([("create_timer(0.1,", "create_timer(1.0,")], "publisher", "rate 1.00 Hz from the stamps of 3"),
+    # The rate is measured from the stamps of a 1 s timer: 0.99 or 1.01 on a busy machine.
+    "one_hertz": ([("create_timer(0.1,", "create_timer(1.0,")], "publisher",
+                  re.compile(r"rate (0\.9[5-9]|1\.0[0-5]) Hz from the stamps of 3")),
     "counter_stuck": ([("        self.count += 1\n", "")], "publisher", "add one per message"),
     # Package-level mistakes (a missing <depend>, a wrong entry point, a build error) go through the
     # whole pipeline in the zoo (tests/support/zoo/pubsub.py), with these phrases; a wrong message field is
@@ -213,4 +216,5 @@ def test_pubsub_typical_mistake_loses_points_with_its_reason(tmp_path, monkeypat
     result = runner.execute("pubsub", check, 5, workdir=_module_dir(tmp_path, "pubsub", edits, monkeypatch),
                              mode="graded")
     assert result.points < result.max_points, result.verdict_lines()
-    assert reason in "\n".join(result.verdict_lines())
+    verdict = "\n".join(result.verdict_lines())
+    assert reason.search(verdict) if isinstance(reason, re.Pattern) else reason in verdict, verdict
