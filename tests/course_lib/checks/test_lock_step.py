@@ -116,7 +116,8 @@ def test_the_plain_simulators_wall_clock_timeout_would_step_past_it(domain_id, u
     with lock_step(domain_id, judged=False, reply_timeout=1.0) as (sim, proc, executor):
         maybe_stop, stepped = stop_for(proc, sim, executor, at=1.0, seconds=3.0)
         drive(sim, executor, at_each_spin=maybe_stop)
-        assert stepped[0] >= 1 and sim.passed_over >= stepped[0]  # more on a busy machine: that is the flaw
+        # More on a busy machine: that is the flaw. One step may be the answer sent just before SIGSTOP.
+        assert sim.passed_over >= 1 and sim.passed_over <= stepped[0] <= sim.passed_over + 1
         assert sim.sim.pose() != undisturbed
 
 
