@@ -65,7 +65,8 @@ def domain_id():
                 session.stop()
 
 
-#: The test files that take longest (whole grading runs, JupyterLab in Chromium), longest first:
+#: The test files that take longest (whole grading runs, JupyterLab in Chromium), longest first
+#: (a folder ending in "/" stands for its files):
 #: a long file started last ends the suite last. With `--dist loadfile` xdist hands out files in
 #: collection order only under `--no-loadscope-reorder` (the Makefile passes it); by default it
 #: hands out the files with the most tests first (tests/course_lib/launch/test_launch_parser.py), and
@@ -74,7 +75,7 @@ LONGEST_FIRST = (
     "tests/autograder/test_term.py",
     "tests/browser/test_browser.py",
     "tests/assignments/test_autograder_zoo.py",
-    "tests/browser/test_browser_lessons.py",
+    "notebooks/",  # the lessons under nbmake, one file each
     "tests/coursehub/test_hub.py",
     "tests/course_lib/ros2cli/test_ros2cli_interface_builds.py",
     "tests/browser/test_browser_validate.py",
@@ -84,40 +85,29 @@ LONGEST_FIRST = (
 )
 
 
-#: Set to 1 to run the lessons under nbmake even when tests/browser/test_browser.py runs them in Chromium.
-NBMAKE_LESSONS_ENV = "COURSE_TEST_NBMAKE_LESSONS"
-
-
-def _lessons_run_in_chromium(items) -> bool:
-    """True when this run's browser test runs every lesson top to bottom in JupyterLab (Chromium
-    on PATH, the test collected): that run checks all nbmake checks (every code cell ran, no
-    error) and more (what JupyterLab shows), so nbmake's run of the same lessons is skipped."""
-    if os.environ.get(NBMAKE_LESSONS_ENV) == "1" or not any(
-            item.name.startswith("test_course_notebook_runs_clean_in_jupyterlab[") for item in items):
-        return False
-    from support.browser import ChromiumUnavailable, find_chromium  # tests/ is on the path (pyproject's pythonpath)
-
-    try:
-        find_chromium()
-    except ChromiumUnavailable:
-        return False
-    return True
-
-
 def pytest_collection_modifyitems(items):
-    """Move the items of LONGEST_FIRST to the front, in that order (the rest keep theirs); skip
-    nbmake's lesson runs when the browser test runs the lessons (see _lessons_run_in_chromium)."""
+    """Move the items of LONGEST_FIRST to the front, in that order (the rest keep theirs)."""
     def rank(item):
         name = item.path.relative_to(item.config.rootpath).as_posix()
-        return LONGEST_FIRST.index(name) if name in LONGEST_FIRST else len(LONGEST_FIRST)
+        for place, first in enumerate(LONGEST_FIRST):
+            if name == first or (first.endswith("/") and name.startswith(first)):
+                return place
+        return len(LONGEST_FIRST)
 
     items.sort(key=rank)
-    if _lessons_run_in_chromium(items):
-        run_in_lab = {item.name.split("[", 1)[1].rstrip("]") for item in items
-                      if item.name.startswith("test_course_notebook_runs_clean_in_jupyterlab[")}
-        skip = pytest.mark.skip(reason=f"runs top to bottom in JupyterLab (tests/browser/test_browser.py or "
-                                       f"test_browser_lessons.py); "
-                                       f"{NBMAKE_LESSONS_ENV}=1 runs it under nbmake too")
-        for item in items:
-            if item.path.suffix == ".ipynb" and item.path.name in run_in_lab:
-                item.add_marker(skip)
+
+
+@pytest.hookimpl(wrapper=True)
+def pytest_runtest_call(item):
+    """nbmake's run of a lesson also keeps the executed notebook (artifacts/lessons/) and fails on
+    what a student would see wrong in its outputs (support.lesson_runs)."""
+    from support import lesson_runs  # tests/ is on the path (pyproject's pythonpath)
+
+    if not lesson_runs.is_lesson(item):
+        return (yield)
+    with lesson_runs.keeping_executed(item) as kept:
+        outcome = yield
+    found = lesson_runs.problems(item.path.name, kept[0])
+    if found:
+        raise lesson_runs.failure(item.path, kept[0], found)
+    return outcome

@@ -1,11 +1,14 @@
-"""Every course notebook runs clean in JupyterLab, as a student runs it: Run > Run All Cells.
+"""The course's notebooks in JupyterLab, as a student sees them: what only a browser shows.
+
+nbmake runs every lesson top to bottom (conftest.py, support.lesson_runs). Here, every lesson's text
+renders as written, and the lessons that show a widget (the RViz view, the keyboard pad) run top
+to bottom with Run > Run All Cells, their widgets drawn beside the student's code.
 
 One JupyterLab server and one headless Chromium serve the whole module. The server's root is a
 scratch directory holding a copy of notebooks/ (outputs never reach the repository) and the
 checker's own small notebooks, which prove that the checker passes a good notebook and fails
 one that raises, and a small notebook whose live image view (course_lib.notebook.live) must change
-while the camera runs. Screenshots go to artifacts/browser/<notebook>.png. The lessons that build
-packages run in tests/browser/test_browser_lessons.py, beside this file (browser_notebook.SECOND_LAB_LESSONS).
+while the camera runs. Screenshots go to artifacts/browser/<notebook>.png.
 """
 
 import json
@@ -27,7 +30,9 @@ from support.browser_notebook import (
     open_notebook,
     run_in_lab,
     run_notebook,
+    text_problems,
     toolbar_labels,
+    widget_lessons,
     write_notebook,
 )
 
@@ -37,7 +42,8 @@ ROOT = contract.ROOT
 NOTEBOOKS = ROOT / "notebooks"
 RUN_TIMEOUT = LESSON_RUN_TIMEOUT
 
-COURSE_NOTEBOOKS = course_lessons(second_lab=False)
+COURSE_NOTEBOOKS = course_lessons()
+WIDGET_LESSONS = widget_lessons()
 
 pytestmark = pytest.mark.browser
 
@@ -57,10 +63,15 @@ with progress.Progress("waiting for the test") as shown:
     shown.step("until the file go exists")
     waiting.spin_until(lambda: Path("go").exists(), timeout=600)"""]
 
-# What the lessons' long calls leave under their cells (course_lib.progress): the build of lesson
-# 00 and the publisher self-check of lesson 01 said what ran while it ran.
-PROGRESS_LINES = {"00_setup_and_workspace.ipynb": "colcon build in ros2_ws: finished after ",
-                  "01_publisher_subscriber.ipynb": "self-check: running your publisher: finished after "}
+# Markdown a reader would see garbled, one way per cell (text_problems must name each).
+GARBLED_TEXT = (
+    "Lesson without a title",
+    "**1.** ```\nros2 topic list -t\n/chatter [std_msgs/msg/String]\n/parameter_events [rcl_interfaces/msg/"
+    "ParameterEvent]\n/rosout [rcl_interfaces/msg/Log]\n```\nWhich topic carries the talker's text?",
+    "| topic | type |\n| /chatter | std_msgs/msg/String |",
+    "![the board](no_such_picture.png)",
+    "  ```python\nprint('an indented fence')\n```  ```",
+)
 
 # A node cell run three times in one kernel (a student re-running it), then the graph.
 NODE_CELL = "listener = session.add_node(Listener())"
@@ -117,6 +128,7 @@ def lab(tmp_path_factory):
     write_notebook(root / "checker" / "rerun_node.ipynb", RERUN_NOTEBOOK)
     write_notebook(root / "checker" / "progress.ipynb", PROGRESS_NOTEBOOK)
     write_notebook(root / "checker" / "live_view.ipynb", LIVE_NOTEBOOK)
+    write_notebook(root / "checker" / "garbled_text.ipynb", [], markdown=GARBLED_TEXT)
     # Lesson 02's camera, started as lesson 02 starts it; and lesson 03's, as lesson 03 does.
     write_notebook(root / "checker" / "lesson02_left_running.ipynb", [
         "from course_lib import processes", lesson_line("02_images_and_brightness.ipynb", "CAMERA_ARGS = "),
@@ -131,14 +143,20 @@ def lab(tmp_path_factory):
 
 
 @pytest.mark.timeout(RUN_TIMEOUT + 180)
+@pytest.mark.parametrize("notebook", WIDGET_LESSONS or [
+    pytest.param(None, marks=pytest.mark.skip(reason=f"no lesson in {NOTEBOOKS} shows a widget"))])
+def test_a_lesson_with_widgets_runs_clean_in_jupyterlab_and_draws_them(notebook, browser, lab):
+    """After Run All Cells every code cell has run, none shows an error, every image renders, and
+    each of the course's widgets the lesson shows is drawn."""
+    assert_lesson_runs_clean(browser, lab, notebook)
+
+
 @pytest.mark.parametrize("notebook", COURSE_NOTEBOOKS or [
     pytest.param(None, marks=pytest.mark.skip(reason=f"no notebooks in {NOTEBOOKS} yet"))])
-def test_course_notebook_runs_clean_in_jupyterlab(notebook, browser, lab):
-    """After Run All Cells every code cell has run, none shows an error, every image renders; the
-    long calls said what they did."""
-    run = assert_lesson_runs_clean(browser, lab, notebook)
-    if notebook in PROGRESS_LINES:
-        assert any(PROGRESS_LINES[notebook] in output for output in run.outputs), run.outputs
+def test_every_lessons_text_renders_as_written(notebook, browser, lab):
+    """JupyterLab renders every markdown cell: no code fence or table shown as plain text, every
+    image loads, every formula typesets, a title on top."""
+    assert text_problems(browser, lab, f"notebooks/{notebook}") == []
 
 
 # The first code cell's output while its prompt shows "[*]" and the output holds `text`, else null.
@@ -274,6 +292,16 @@ def test_checker_fails_an_image_that_does_not_render(browser, lab):
     run = run_in_lab(browser, lab, "checker/broken_image.ipynb")
     assert run.errors == [] and run.image_outputs == 1
     assert run.problems() == ["image does not render in cell 0"]
+
+
+def test_text_check_names_each_way_markdown_shows_garbled(browser, lab):
+    """text_problems, which judges the lessons' text, finds each of GARBLED_TEXT's cells."""
+    found = text_problems(browser, lab, "checker/garbled_text.ipynb")
+    assert [problem.split(":")[0] for problem in found] == ["cell 1", "cell 2", "cell 3", "cell 4", "cell 0"], found
+    assert "code fence shows as text" in found[0] and "table shows as text" in found[1], found
+    assert "no_such_picture.png" in found[2] and "does not load" in found[2], found
+    assert "code fence shows as text" in found[3], found
+    assert found[4] == "cell 0: no title (# heading)"
 
 
 @pytest.mark.timeout(RUN_TIMEOUT)

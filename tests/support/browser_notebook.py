@@ -4,7 +4,8 @@
   (in one JupyterLab page per server, as a student does), press a notebook toolbar button by its
   label (the way in for nbgrader's "Validate" button); ``click_menu``;
 - ``run_notebook``: Run > Run All Cells, wait for the kernel, and report what the student sees;
-- the course's lessons: which run in which lab, copied and run clean (``assert_lesson_runs_clean``).
+- the course's lessons: copied, their text rendered (``text_problems``), and those that show a
+  widget run clean with it drawn (``assert_lesson_runs_clean``).
 """
 
 from __future__ import annotations
@@ -26,15 +27,20 @@ MAX_SCREENSHOT_HEIGHT = 16000
 
 ERROR_MIME = "application/vnd.jupyter.error"
 IMAGE_MIMES = ("image/png", "image/jpeg", "image/gif", "image/svg+xml", "image/webp", "image/bmp")
+#: The course's widgets, drawn by their JavaScript in the browser only (nbmake runs a lesson without
+#: it): the module a lesson's code uses to show one, and what the page shows once it is drawn.
+WIDGETS = {"course_lib.notebook.rviz": ".rviz-canvas", "course_lib.robot.teleop_widget": ".course-teleop"}
 
 
 # --- the notebook UI -----------------------------------------------------------------------
 
-def write_notebook(path: Path, sources: list[str]) -> None:
-    """Write a notebook of code cells (no outputs) with the python3 kernel, for a test to open."""
+def write_notebook(path: Path, sources: list[str], markdown: tuple[str, ...] = ()) -> None:
+    """Write a notebook of code cells (no outputs), after the markdown cells given, with the python3
+    kernel, for a test to open."""
     import nbformat
 
-    notebook = nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell(s) for s in sources])
+    notebook = nbformat.v4.new_notebook(cells=[nbformat.v4.new_markdown_cell(m) for m in markdown]
+                                        + [nbformat.v4.new_code_cell(s) for s in sources])
     notebook.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3 (ipykernel)",
                                        "language": "python"}
     nbformat.write(notebook, path)
@@ -179,6 +185,9 @@ class NotebookRun:
         seconds: time from clicking Run All Cells until the kernel was idle again.
         screenshot: where the full-page screenshot was saved (None when not asked for).
         outputs: the text each code cell's output area shows (widgets' text included).
+        widgets: number of widget outputs (ipywidgets/anywidget views) in the notebook model.
+        drawn_widgets: for each of WIDGETS' selectors, how many the output areas show drawn.
+        broken_widgets: "cell N: text" for every widget output that shows an error or is still loading.
     """
 
     path: str
@@ -192,6 +201,9 @@ class NotebookRun:
     seconds: float
     screenshot: Path | None = None
     outputs: list[str] = dataclasses.field(default_factory=list)
+    widgets: int = 0
+    drawn_widgets: dict[str, int] = dataclasses.field(default_factory=dict)
+    broken_widgets: list[str] = dataclasses.field(default_factory=list)
 
     @property
     def unexecuted(self) -> list[str]:
@@ -206,11 +218,12 @@ class NotebookRun:
         found += [f"image does not render in {b}" for b in self.broken_images]
         if self.images < self.image_outputs:
             found.append(f"{self.image_outputs} image outputs but only {self.images} <img> on the page")
+        found += [f"widget not shown in {b}" for b in self.broken_widgets]
         return found
 
 
 _PAGE_STATE_JS = """
-([notebookSelector, errorMime, imageMimes]) => {
+([notebookSelector, errorMime, imageMimes, drawnSelectors]) => {
   const panel = document.querySelector(notebookSelector);
   const codeCells = [...panel.querySelectorAll('.jp-Notebook .jp-CodeCell')];
   const prompts = codeCells.map(c => (c.querySelector('.jp-InputArea-prompt') || {}).innerText || '');
@@ -218,6 +231,12 @@ _PAGE_STATE_JS = """
   const images = [];
   codeCells.forEach((c, i) => c.querySelectorAll('.jp-OutputArea img').forEach(img =>
       images.push({cell: i, ok: img.complete && img.naturalWidth > 0})));
+  const widgetOutputs = [...panel.querySelectorAll(
+    '.jp-OutputArea-output[data-mime-type="application/vnd.jupyter.widget-view+json"]')];
+  const brokenWidgets = widgetOutputs.filter(w => /Error displaying widget|Loading widget/.test(w.innerText))
+      .map(w => codeCells.findIndex(c => c.contains(w)) + ': ' + w.innerText.slice(0, 120));
+  const drawnWidgets = Object.fromEntries(drawnSelectors.map(
+      s => [s, panel.querySelectorAll('.jp-OutputArea ' + s).length]));
   const stderr = panel.querySelectorAll(
     '.jp-OutputArea-output[data-mime-type="application/vnd.jupyter.stderr"]').length;
   const app = window.jupyterapp;
@@ -225,6 +244,8 @@ _PAGE_STATE_JS = """
   const widget = app.shell.currentWidget;
   const errors = [];
   let imageOutputs = 0;
+  let widgets = 0;
+  const widgetMime = 'application/vnd.jupyter.widget-view+json';
   let codeIndex = -1;
   for (const cell of widget.content.model.cells) {
     if (cell.type !== 'code') continue;
@@ -233,9 +254,10 @@ _PAGE_STATE_JS = """
       const data = cell.outputs.get(k).data;
       if (data[errorMime]) errors.push(`cell ${codeIndex}: ${data[errorMime].ename}: ${data[errorMime].evalue}`);
       if (imageMimes.some(m => m in data)) imageOutputs += 1;
+      if (widgetMime in data) widgets += 1;
     }
   }
-  return {prompts, images, errors, imageOutputs, stderr, outputs};
+  return {prompts, images, errors, imageOutputs, stderr, outputs, widgets, drawnWidgets, brokenWidgets};
 }
 """
 
@@ -285,14 +307,15 @@ def run_notebook(page, path: str, code_cells: int, timeout: float, screenshot: P
     # Images decode asynchronously after their output is attached.
     page.wait_for_function(f"""() => [...document.querySelectorAll('{NOTEBOOK} .jp-OutputArea img')]
                                .every(img => img.complete)""", timeout=30_000)
-    state = page.evaluate(_PAGE_STATE_JS, [NOTEBOOK, ERROR_MIME, list(IMAGE_MIMES)])
+    state = page.evaluate(_PAGE_STATE_JS, [NOTEBOOK, ERROR_MIME, list(IMAGE_MIMES), list(WIDGETS.values())])
     if "error" in state:
         raise RuntimeError(state["error"])
     run = NotebookRun(
         path=path, code_cells=code_cells, prompts=state["prompts"], errors=state["errors"],
         images=len(state["images"]), broken_images=[f"cell {i['cell']}" for i in state["images"] if not i["ok"]],
         image_outputs=state["imageOutputs"], stderr_outputs=state["stderr"], seconds=seconds,
-        outputs=state["outputs"])
+        outputs=state["outputs"], widgets=state["widgets"], drawn_widgets=state["drawnWidgets"],
+        broken_widgets=[f"cell {b}" for b in state["brokenWidgets"]])
     if screenshot is not None and (screenshot_always or run.problems()):
         save_full_notebook_screenshot(page, screenshot)
         run.screenshot = screenshot
@@ -331,19 +354,25 @@ SCREENSHOTS = contract.ROOT / "artifacts" / "browser"
 #: take a minute on a busy 2-core machine; allow plenty).
 LESSON_RUN_TIMEOUT = 300
 
-#: The lessons tests/browser/test_browser_lessons.py runs, in a JupyterLab of its own; tests/browser/test_browser.py
-#: runs the others. Under `--dist loadfile` each file goes to one xdist worker, so the two halves
-#: run side by side: all six lessons in one file took 6 of its 8 minutes, the longest file of
-#: the suite. These four build packages with colcon (about half of the lessons' time).
-SECOND_LAB_LESSONS = ("01b_custom_messages.ipynb", "02_images_and_brightness.ipynb",
-                      "02b_packages_launch_parameters.ipynb", "04_services_and_actions.ipynb")
+def course_lessons() -> list[str]:
+    """Every lesson: its path under notebooks/."""
+    return sorted(str(p.relative_to(LESSONS_DIR)) for p in LESSONS_DIR.rglob("*.ipynb")
+                  if ".ipynb_checkpoints" not in p.parts)
 
 
-def course_lessons(second_lab: bool) -> list[str]:
-    """The lessons (paths under notebooks/) one of the two lesson files runs (see SECOND_LAB_LESSONS)."""
-    lessons = sorted(str(p.relative_to(LESSONS_DIR)) for p in LESSONS_DIR.rglob("*.ipynb")
-                     if ".ipynb_checkpoints" not in p.parts)
-    return [lesson for lesson in lessons if (lesson in SECOND_LAB_LESSONS) == second_lab]
+def widgets_shown(lesson: str) -> list[str]:
+    """The modules of WIDGETS whose widgets `lesson` (its path under notebooks/) shows."""
+    import nbformat
+
+    code = "\n".join(cell.source for cell in nbformat.read(LESSONS_DIR / lesson, as_version=4).cells
+                     if cell.cell_type == "code")
+    return [module for module in WIDGETS if module in code]
+
+
+def widget_lessons() -> list[str]:
+    """The lessons that show a widget (WIDGETS): they run top to bottom in Chromium as well as under
+    nbmake, to show that their widgets draw beside the student's code."""
+    return [lesson for lesson in course_lessons() if widgets_shown(lesson)]
 
 
 def copy_lessons(root: Path) -> None:
@@ -370,11 +399,51 @@ def run_in_lab(context, lab: JupyterLab, path: str, screenshot: Path | None = No
 
 def assert_lesson_runs_clean(context, lab: JupyterLab, notebook: str) -> NotebookRun:
     """Run a lesson (its path under notebooks/) top to bottom in lab: every code cell ran, none
-    shows an error, every image renders. A run with problems leaves a screenshot in
-    artifacts/browser/ (every run does with COURSE_TEST_SCREENSHOTS=1). Returns the run."""
+    shows an error, every image and widget renders, each of the course's widgets it shows is drawn.
+    A run with problems leaves a screenshot in artifacts/browser/ (every run does with
+    COURSE_TEST_SCREENSHOTS=1). Returns the run."""
     screenshot = SCREENSHOTS / (notebook.removesuffix(".ipynb").replace("/", "__") + ".png")
     run = run_in_lab(context, lab, f"notebooks/{notebook}", screenshot,
                      screenshot_always=os.environ.get("COURSE_TEST_SCREENSHOTS") == "1")
     assert not run.problems(), f"{notebook} in JupyterLab (screenshot {screenshot}):\n" + "\n".join(run.problems())
+    undrawn = [module for module in widgets_shown(notebook) if not run.drawn_widgets[WIDGETS[module]]]
+    assert not undrawn, f"{notebook} in JupyterLab shows no drawn widget of {undrawn} (screenshot {screenshot})"
     return run
 
+
+
+# Each markdown cell of the open notebook as JupyterLab rendered it: what a reader would see wrong.
+_TEXT_PROBLEMS_JS = """(notebookSelector) => {
+  const cells = [...document.querySelectorAll(notebookSelector + ' .jp-Notebook .jp-Cell')];
+  const found = [];
+  cells.forEach((cell, i) => {
+    if (!cell.classList.contains('jp-MarkdownCell')) return;
+    const shown = cell.querySelector('.jp-RenderedMarkdown');
+    if (!shown) { found.push(`cell ${i}: not rendered`); return; }
+    if (shown.innerText.includes('```')) found.push(`cell ${i}: a code fence shows as text`);
+    shown.querySelectorAll('p').forEach(p => {
+      if (/^\\s*\\|.*\\|\\s*$/m.test(p.innerText))
+        found.push(`cell ${i}: a table shows as text: ${p.innerText.slice(0, 80)}`);
+    });
+    shown.querySelectorAll('img').forEach(img => {
+      if (!(img.complete && img.naturalWidth > 0))
+        found.push(`cell ${i}: image ${img.getAttribute('src')} does not load`);
+    });
+    if (shown.querySelector('mjx-merror, .MathJax_Error')) found.push(`cell ${i}: a formula does not typeset`);
+  });
+  if (!cells.length || !cells[0].querySelector('.jp-RenderedMarkdown h1')) found.push('cell 0: no title (# heading)');
+  return found;
+}"""
+
+
+def text_problems(context, lab: JupyterLab, path: str) -> list[str]:
+    """Open path and return what its markdown cells show wrong, rendered by JupyterLab: a cell left
+    unrendered, a code fence (e.g. one on the line of a text) or a table shown as plain text, an
+    image that does not load, a formula that does not typeset, no title. Nothing runs."""
+    page = open_notebook(context, lab, path)
+    try:
+        page.wait_for_function(f"""() => [...document.querySelectorAll('{NOTEBOOK} .jp-RenderedMarkdown img')]
+                                   .every(img => img.complete)""", timeout=30_000)
+        return page.evaluate(_TEXT_PROBLEMS_JS, NOTEBOOK)
+    finally:
+        close_notebook(page, lab, path)
