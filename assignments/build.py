@@ -74,7 +74,14 @@ def test_cell(assignment: str, name: str):
     return code(source, "test", f"check_{name}", spec.points)
 
 
-def setup_cell(assignment: str, extra: str = ""):
+def setup_cell(assignment: str, extra: str = "", packages: bool = True):
+    """The first cell: this assignment's checks and, where it has packages, the course helpers its
+    cells use (a quiz needs no more than its checks)."""
+    if not packages:
+        return code(f"""
+# Run this cell first. It imports this assignment's checks.
+from course_lib.checks import {assignment} as checks
+{extra}""", "locked", "setup")
     return code(f"""
 # Run this cell first. It imports the course helpers and this assignment's checks.
 import importlib
@@ -175,7 +182,7 @@ def assignment_notebook(spec: Assignment) -> nbformat.NotebookNode:
     from course_lib.checks import registry
 
     text = spec.notebook
-    cells = [md(text.intro, "intro"), setup_cell(spec.name, text.imports)]
+    cells = [md(text.intro, "intro"), setup_cell(spec.name, text.imports, bool(spec.packages))]
     if spec.packages:
         cells += package_cells(list(spec.packages), text.plain_ros)
     cells += question_cells(spec.name, spec.questions)

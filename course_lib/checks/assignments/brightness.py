@@ -7,12 +7,15 @@ The contract is the notebook's introduction (BRIGHTNESS_INTRO). Whether the node
 
 from __future__ import annotations
 
-import numpy as np
+from typing import TYPE_CHECKING
 
-from course_lib.checks import brightness_throughput, packages
+from course_lib.checks import packages
 from course_lib.checks.context import Context, scaled
 from course_lib.checks.registry import check
 from course_lib.checks.spec import Assignment, NotebookText
+
+if TYPE_CHECKING:
+    import numpy as np
 
 # --- the notebook's words (markdown) and the spec ----------------------------------------
 
@@ -74,6 +77,8 @@ EXECUTABLE = SPEC.executable(PACKAGE)
 
 def _test_images(rng: np.random.Generator) -> list[tuple[str, np.ndarray]]:
     """Generated images; one whose mean has a fraction above .5 tells floor from round."""
+    import numpy as np
+
     bgr = rng.integers(0, 256, size=(int(rng.integers(40, 120)), int(rng.integers(40, 160)), 3), dtype=np.uint8)
     grey = rng.integers(0, 256, size=(int(rng.integers(30, 90)), int(rng.integers(30, 90))), dtype=np.uint8)
     dark = rng.integers(0, 40, size=(48, 64, 3), dtype=np.uint8)
@@ -265,6 +270,10 @@ def node(ctx: Context) -> None:
     """BrightnessNode: name brightness_node, /image -> /brightness with sensor-data QoS, bgr8 and mono8, 30 Hz at 1080p, remappable."""  # noqa: E501 (the check's description, one line: registry.check)
     # Every input is drawn first: what is drawn must not depend on how the run goes (the
     # self-check's answers were recorded for exactly these inputs).
+    import numpy as np
+
+    from course_lib.checks import brightness_throughput
+
     colour = [ctx.rng.integers(0, 256, size=(480, 640, 3), dtype=np.uint8) // int(d) for d in (1, 2, 3)]
     grey = [ctx.rng.integers(0, 256, size=(240, 320), dtype=np.uint8) // int(d) for d in (1, 4)]
     remapped_image = ctx.rng.integers(0, 256, size=(120, 160, 3), dtype=np.uint8)

@@ -12,8 +12,6 @@ from __future__ import annotations
 import re
 import time
 
-import numpy as np
-
 from course_lib.checks import packages
 from course_lib.checks.context import Context, clip, scaled
 from course_lib.checks.registry import check
@@ -90,6 +88,8 @@ def _seed(ctx) -> int:
 
 def compare_crop(ctx, label: str, crop, expected, show: bool = False) -> bool:
     """One item: the student's crop is the expected picture (shape, dtype, content, colours)."""
+    import numpy as np
+
     from course_lib.imaging import marker_board
 
     if not isinstance(crop, np.ndarray):
@@ -187,6 +187,8 @@ def hard(ctx: Context) -> None:
 @check(points=2, timeout=60)
 def missing_and_none(ctx: Context) -> None:
     """A picture with any one of its markers missing is left out; frames without markers give an empty dict."""
+    import numpy as np
+
     from course_lib.imaging import marker_board, scenes
 
     # Every marker is the missing one once, in every grading: scene k lacks the k-th marker of
@@ -213,6 +215,8 @@ def missing_and_none(ctx: Context) -> None:
 @check(points=1, timeout=60)
 def noisy(ctx: Context) -> None:
     """crop_pictures copes with sensor noise, blur and JPEG artefacts, and with another crop size."""
+    import numpy as np
+
     from course_lib.imaging import camera_views, scenes
 
     pose = scenes.scene_pose(_seed(ctx), difficulty="easy")

@@ -17,8 +17,6 @@ from course_lib.checks import packages
 from course_lib.checks.context import Context, scaled
 from course_lib.checks.registry import check
 from course_lib.checks.spec import Assignment, NotebookText
-from course_lib.imaging import pan_camera
-from course_lib.imaging.marker_board import PICTURES
 
 # --- the notebook's words (markdown) and the spec ----------------------------------------
 
@@ -152,6 +150,8 @@ def service(ctx: Context) -> None:
 def ids_wrong(pan: float, ids, whose: str) -> str | None:
     """Why `ids` are not the markers in view at `pan` (None when they are): every marker in view
     must be there, and no other but those a detector may find or miss (pan_camera.uncertain_markers)."""
+    from course_lib.imaging import pan_camera
+
     ids, sure, maybe = list(ids), list(pan_camera.markers_in_view(pan)), pan_camera.uncertain_markers(pan)
     if not set(sure) <= set(ids) <= set(sure) | set(maybe):
         return f"at pan {pan:g} {whose} ids are {ids}, the markers in view are {sure}" + _either_way(maybe)
@@ -163,6 +163,9 @@ def ids_wrong(pan: float, ids, whose: str) -> str | None:
 def framed_wrong(pan: float, framed) -> str | None:
     """Why `framed` is not the pictures framed at `pan` (None when it is), the pictures a detector
     may find framed or not (pan_camera.maybe_framed_at) counting neither way."""
+    from course_lib.imaging import pan_camera
+    from course_lib.imaging.marker_board import PICTURES
+
     framed, sure, maybe = list(framed), list(pan_camera.framed_at(pan)), pan_camera.maybe_framed_at(pan)
     if not set(sure) <= set(framed) <= set(sure) | set(maybe):
         return f"at pan {pan:g} the response's framed is {framed}, the pictures framed are {sure}" + _either_way(maybe)
@@ -173,6 +176,8 @@ def framed_wrong(pan: float, framed) -> str | None:
 
 def stops_at(start: float, steps: list[float], stop: float) -> int:
     """How many of a search's `steps` from `start` lead to `stop` (one of them, or `start`: 0)."""
+    from course_lib.imaging import pan_camera
+
     return next(k for k, pan in enumerate([pan_camera.wrap(start), *steps]) if math.isclose(pan, stop, abs_tol=1e-6))
 
 
@@ -224,6 +229,8 @@ def _wait_result(ctx, probe, proc, handle, seconds: float, feedback: list):
 def action(ctx: Context) -> None:
     """find_pictures turns from a fresh start angle step by step, feedback after each, until the pictures are framed."""
     from action_msgs.msg import GoalStatus
+
+    from course_lib.imaging import pan_camera
 
     start = round(float(ctx.rng.uniform(-58.0, -30.0)), 1)
     pictures = [["cat"], ["dog"], []][int(ctx.rng.integers(3))]
@@ -284,6 +291,8 @@ def action(ctx: Context) -> None:
 def cancel(ctx: Context) -> None:
     """A find_pictures goal canceled after its first feedback stops there: cancel accepted, status CANCELED."""
     from action_msgs.msg import GoalStatus
+
+    from course_lib.imaging import pan_camera
 
     start = round(float(ctx.rng.uniform(-170.0, -120.0)), 1)
     steps = len(pan_camera.search_pans(start, []))
