@@ -4,7 +4,9 @@ starts with nbgrader, nbconvert, nbclient and the grader already imported instea
 again in every submission's sandbox (about 1 CPU-s each).
 
 The grader forks the server before its worker threads start (:func:`serving`); the server imports
-the programs' modules once and listens on a Unix socket in a folder only root may enter. In the
+the programs' modules once and listens on a Unix socket in a folder only root may enter. A grader
+that has loaded rclpy (a test's process) is no safe parent for runs that start ROS
+(:func:`forkable`): its server is a fresh Python instead, the same server with imports of its own. In the
 sandbox, :meth:`ForkServer.command` runs autograder/grading/fork_client.py in place of
 ``python -m MODULE ARG...``; for each client the server forks a handler, which
 
@@ -114,10 +116,13 @@ class ForkServer:
         listener.bind(self.socket_path)
         listener.listen(64)
         control_here, control_there = socket.socketpair()
+        fresh = not forkable()
         self.pid = os.fork()
         if self.pid == 0:
             try:
                 control_here.close()
+                if fresh:
+                    _exec_server(listener, control_there, self.programs, preload)
                 _serve(listener, control_there, self.programs, preload)
             finally:
                 os._exit(0)
@@ -164,6 +169,27 @@ class ForkServer:
             os.unlink(self.socket_path)
         with contextlib.suppress(OSError):
             self.folder.rmdir()
+
+
+def forkable() -> bool:
+    """True when a child forked from this process may use ROS: rclpy's extension was never loaded
+    here. Once rclpy.init has run (even after its shutdown), its signal handling's C++ thread, and
+    Fast DDS's threads once a node existed, are objects whose threads a forked child lacks: a run
+    forked from them that starts ROS ends with "std::system_error: Invalid argument" (SIGABRT). The
+    grade command and the hub's service never load rclpy before the server; a test's process may."""
+    return "rclpy._rclpy_pybind11" not in sys.modules
+
+
+def _exec_server(listener: socket.socket, control: socket.socket, programs: tuple, preload: tuple) -> None:
+    """Become a fresh Python that serves on `listener` (for a grader that is not :func:`forkable`):
+    the same server, its imports its own."""
+    package_parent = str(Path(__file__).resolve().parents[2])
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(p for p in (package_parent, os.environ.get("PYTHONPATH"))
+                                                       if p)}
+    for end in (listener, control):
+        os.set_inheritable(end.fileno(), True)
+    os.execve(sys.executable, [sys.executable, "-m", __name__, str(listener.fileno()), str(control.fileno()),
+                               ",".join(programs), ",".join(preload)], env)
 
 
 def run_name(module: str) -> str:
@@ -319,3 +345,9 @@ def _run(request: dict, fds: list[int], limits: dict) -> None:
             sys.stdout.flush()
             sys.stderr.flush()
         os._exit(code)
+
+
+if __name__ == "__main__":  # a server started by _exec_server
+    _listener_fd, _control_fd, _programs, _preload = sys.argv[1:5]
+    _serve(socket.socket(fileno=int(_listener_fd)), socket.socket(fileno=int(_control_fd)),
+           tuple(_programs.split(",")), tuple(p for p in _preload.split(",") if p))

@@ -160,3 +160,48 @@ def test_program_goes_through_the_server_while_one_serves():
     assert command == [sys.executable, "-I", "-S", str(REPO / fork_server.CLIENT_IN_PACKAGE), server.socket_path,
                        fork_server.PROGRAMS[0], "a"]
     assert not server.alive()
+
+
+#: A grader that has run rclpy.init (a test's process, say) serves a run that starts ROS: the
+#: server must not be a fork of it (rclpy's signal thread, a C++ object, would be copied without
+#: its thread, and the run would end with "std::system_error: Invalid argument", SIGABRT).
+GRADER_AFTER_RCLPY = """import json, sys
+from pathlib import Path
+import rclpy
+rclpy.init()
+rclpy.create_node("the_graders_own").destroy_node()
+rclpy.shutdown()
+from autograder.grading import fork_server
+from autograder.sandbox import namespaces
+from course_lib.ros import processes
+folder = Path(sys.argv[1])
+server = fork_server.ForkServer(programs=("ros_probe",), preload=())
+try:
+    proc = namespaces.run_sandboxed(server.command("ros_probe", [], Path(sys.argv[2])), [], "ros probe", None,
+                                    {"PYTHONPATH": str(folder)}, folder,
+                                    processes.Limits(wall_seconds=60, memory_mb=16384, grace_seconds=1.0))
+    print(json.dumps({"forkable": fork_server.forkable(), "code": proc.returncode, "log": proc.log[-3000:]}))
+finally:
+    server.close()
+"""
+ROS_PROBE = """import rclpy
+rclpy.init()
+node = rclpy.create_node("ros_probe")
+print("node", node.get_name())
+node.destroy_node()
+rclpy.shutdown()
+"""
+
+
+def test_a_grader_that_ran_rclpy_serves_runs_that_start_ros(tmp_path):
+    import json
+    import subprocess
+
+    (tmp_path / "ros_probe.py").write_text(ROS_PROBE)
+    env = {**os.environ, "PYTHONPATH": str(REPO)}
+    done = subprocess.run([sys.executable, "-c", GRADER_AFTER_RCLPY, str(tmp_path), str(REPO)], env=env,
+                          capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr[-3000:]
+    report = json.loads(done.stdout.strip().splitlines()[-1])
+    assert report["forkable"] is False
+    assert report["code"] == 0 and "node ros_probe" in report["log"], report["log"]
