@@ -94,7 +94,8 @@ def test_zoo_entry_gets_its_expected_score_and_reason(graded, student):
     assert result.status == "graded", result.reason
     scores = _check_scores(result)
     for check in ("values", "node"):
-        assert _matches(entry[check], scores[check]), (check, scores, _outputs(graded["course"], student)[-3000:])
+        outputs = _outputs(graded["course"], student)
+        assert _matches(entry[check], scores[check]), f"{check}: {scores}\n{outputs[-3000:]}"
     reasons = entry["reason"] if isinstance(entry["reason"], tuple) else (entry["reason"],)
     text = _outputs(graded["course"], student)
     assert any(reason in text for reason in reasons), (reasons, text[-3000:])
@@ -117,7 +118,7 @@ def test_package_submission_gets_its_scores_with_its_reasons_on_the_feedback_pag
     scores = _check_scores(result)
     outputs = zoo.graded_outputs(graded["course"], student, assignment)
     for check, expected in entry["scores"].items():
-        assert _matches(expected, scores[check]), (check, scores, outputs[-3000:])
+        assert _matches(expected, scores[check]), f"{check}: {scores}\n{outputs[-3000:]}"
     feedback.write_feedback(graded["course"], student=student, assignment=assignment)
     page = (graded["course"] / "feedback" / student / assignment / f"{assignment}.html").read_text()
     page = page.replace("&#39;", "'").replace("&quot;", '"')
