@@ -62,6 +62,9 @@ _CLONE_NEWNS, _CLONE_NEWNET = 0x00020000, 0x40000000
 _PR_SET_NAME = 15
 _RLIMITS = [getattr(resource, name) for name in dir(resource) if name.startswith("RLIMIT_")]
 
+#: The name of a server's socket folder, in the temporary folder: FOLDER_PREFIX and a random part.
+FOLDER_PREFIX = "autograder-fork-server-"
+
 _current: ForkServer | None = None
 
 
@@ -110,7 +113,9 @@ class ForkServer:
         self.programs = tuple(programs)
         # 0700, root's; a socket's path has at most 107 bytes, which a test's TMPDIR may leave no room for.
         short = len(tempfile.gettempdir()) < 64
-        self.folder = Path(tempfile.mkdtemp(prefix="autograder-fork-server-", dir=None if short else "/tmp"))
+        parent = tempfile.gettempdir() if short else "/tmp"
+        _remove_stale_folders(Path(parent))
+        self.folder = Path(tempfile.mkdtemp(prefix=FOLDER_PREFIX, dir=parent))
         self.socket_path = str(self.folder / "socket")
         listener = socket.socket(socket.AF_UNIX, socket.SOCK_SEQPACKET)
         listener.bind(self.socket_path)
@@ -169,6 +174,25 @@ class ForkServer:
             os.unlink(self.socket_path)
         with contextlib.suppress(OSError):
             self.folder.rmdir()
+
+
+def _remove_stale_folders(parent: Path) -> None:
+    """Remove the socket folders of servers that are gone (a grader killed with SIGKILL leaves its
+    folder): those whose socket no server listens on any more. A folder without a socket yet may be
+    a server's that is starting: it stays."""
+    for folder in parent.glob(FOLDER_PREFIX + "*"):
+        path = folder / "socket"
+        try:
+            if folder.is_symlink() or folder.stat().st_uid != os.getuid() or not path.is_socket():
+                continue
+            with socket.socket(socket.AF_UNIX, socket.SOCK_SEQPACKET) as probe:
+                probe.connect(str(path))
+        except ConnectionRefusedError:
+            with contextlib.suppress(OSError):
+                path.unlink()
+                folder.rmdir()
+        except OSError:
+            continue
 
 
 def forkable() -> bool:
@@ -257,6 +281,8 @@ def _handle(client: socket.socket, programs: tuple) -> None:
     _libc().prctl(PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
     _libc().prctl(_PR_SET_NAME, b"fork-handler", 0, 0, 0)
     message, fds, _flags, _address = socket.recv_fds(client, 1 << 20, 3)
+    if not message:  # a look whether the server still listens (_remove_stale_folders)
+        return
     pid, uid, _gid = struct.unpack("3i", client.getsockopt(socket.SOL_SOCKET, socket.SO_PEERCRED,
                                                            struct.calcsize("3i")))
     request = json.loads(message)

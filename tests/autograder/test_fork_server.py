@@ -205,3 +205,20 @@ def test_a_grader_that_ran_rclpy_serves_runs_that_start_ros(tmp_path):
     report = json.loads(done.stdout.strip().splitlines()[-1])
     assert report["forkable"] is False
     assert report["code"] == 0 and "node ros_probe" in report["log"], report["log"]
+
+
+def test_the_folder_of_a_killed_server_is_removed_by_the_next_and_a_live_ones_stays():
+    """A grader killed with SIGKILL leaves its server's socket folder; the next server removes it."""
+    live = fork_server.ForkServer(programs=("fork_probe",), preload=())
+    killed = fork_server.ForkServer(programs=("fork_probe",), preload=())
+    try:
+        os.kill(killed.pid, signal.SIGKILL)
+        os.waitpid(killed.pid, 0)
+        killed.pid = None
+        assert killed.folder.is_dir()
+        next_one = fork_server.ForkServer(programs=("fork_probe",), preload=())
+        next_one.close()
+        assert not killed.folder.exists() and live.folder.is_dir() and live.alive()
+    finally:
+        live.close()
+        killed.close()
