@@ -207,9 +207,7 @@ def forkable() -> bool:
 def _exec_server(listener: socket.socket, control: socket.socket, programs: tuple, preload: tuple) -> None:
     """Become a fresh Python that serves on `listener` (for a grader that is not :func:`forkable`):
     the same server, its imports its own."""
-    package_parent = str(Path(__file__).resolve().parents[2])
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join(p for p in (package_parent, os.environ.get("PYTHONPATH"))
-                                                       if p)}
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(p for p in sys.path if p)}  # the grader's own modules
     for end in (listener, control):
         os.set_inheritable(end.fileno(), True)
     os.execve(sys.executable, [sys.executable, "-m", __name__, str(listener.fileno()), str(control.fileno()),
