@@ -20,6 +20,7 @@ from course_lib.ros import session
 NOTEBOOKS = contract.ROOT / "notebooks"
 LESSON_02 = NOTEBOOKS / "02_images_and_brightness.ipynb"
 LESSON_04 = NOTEBOOKS / "04_services_and_actions.ipynb"
+LESSON_05 = NOTEBOOKS / "05_recording_and_replaying.ipynb"
 LESSON_06 = NOTEBOOKS / "06_mobile_robot.ipynb"
 
 
@@ -179,6 +180,16 @@ def test_lesson_04_pan_camera_figure_titles_stay_apart():
         assert min(gaps) > 5, f"the titles overlap or touch: gaps {gaps} pixels"
     finally:
         plt.close(figure)
+
+
+def test_lesson_05_says_no_fixed_order_of_the_recorders_subscriptions():
+    """Lesson 05's text before its last plot explains why the topics start apart without saying
+    which the recorder subscribed first: discovery decides (in the walkthrough in Chromium the plot's
+    title said "frames recorded from 0.69 s, /brightness from 0.00 s" under text that said
+    /brightness came after the frames)."""
+    (text,) = [s for s in _cells(LESSON_05, "markdown") if "plot the frames' own brightness" in s]
+    flat = " ".join(text.split())
+    assert "in the order discovery found them" in flat and "after the frames" not in flat
 
 
 def test_lesson_06_drives_its_plain_functions_to_the_pillar_for_other_seeds_too():
