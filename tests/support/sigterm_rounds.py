@@ -7,8 +7,10 @@ new process starts without them (main() installs them again), and the SIGTERM di
 found is put back. The script ends with exit code 3 when a round does not end within ENDS_WITHIN
 seconds of its SIGTERM (it prints where each thread was), and prints "all rounds ended" when every round did.
 
-Without a handler of its own, a node spun by a MultiThreadedExecutor hangs (or fails to make its
-wait set) in about 7 % of rounds: ROUNDS miss it with a chance under 1 %.
+Without a handler of its own, a node without timers hangs (or fails to make its wait set) in about
+7 % of rounds, spun by a MultiThreadedExecutor or a SingleThreadedExecutor: ROUNDS miss it with a
+chance under 1 %. main() passes rclpy.spin an executor of its own: rclpy's global executor would
+outlive a round's context.
 """
 
 from __future__ import annotations
