@@ -24,7 +24,7 @@ _rosenv.prepare_current_process()
 SHORT_NAMES = {
     **{name: f"ros.{name}" for name in (
         "ament", "bag_files", "bag_metadata", "colcon", "discovery", "graph", "interfaces", "message_yaml",
-        "node_logs", "package_files", "parameters", "pkg_create", "processes", "rates", "rosenv", "session",
+        "node_logs", "package_files", "parameters", "pkg_create", "processes", "rates", "rosenv", "session", "sigterm",
         "underlay", "wheelfix", "workspace")},
     **{name: f"supervision.{name}" for name in (
         "bounded_log", "process_limits", "process_registry", "process_tree", "supervised_process", "supervisor")},

@@ -154,4 +154,4 @@ def test_a_quiz_with_one_wrong_answer_loses_exactly_its_point_and_the_feedback_s
     assert result.score == result.max_score - 1 == 15, zoo.graded_outputs(root, "mistaken", "quiz")
     page = (root / "feedback" / "mistaken" / "quiz" / "quiz.html").read_text()
     page = page.replace("&quot;", '"').replace("&#39;", "'")
-    assert f"{question}: not {letter}; {quiz_key.explain(question, letter)}" in page
+    assert f"{question}: not {letter}. {quiz_key.explain(question, letter)}" in page

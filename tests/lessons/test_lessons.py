@@ -19,6 +19,8 @@ from course_lib.ros import session
 
 NOTEBOOKS = contract.ROOT / "notebooks"
 LESSON_02 = NOTEBOOKS / "02_images_and_brightness.ipynb"
+LESSON_04 = NOTEBOOKS / "04_services_and_actions.ipynb"
+LESSON_05 = NOTEBOOKS / "05_recording_and_replaying.ipynb"
 LESSON_06 = NOTEBOOKS / "06_mobile_robot.ipynb"
 
 
@@ -150,9 +152,44 @@ def test_lesson_04_defines_the_interfaces_the_services_actions_assignment_gives(
     """The .srv and .action lesson 04 builds are the reference camera_interfaces, word for word:
     the assignment's contract is what the lesson taught."""
     reference = contract.ROOT / "assignments" / "reference_ws" / "src" / "camera_interfaces"
-    code = "\n".join(_cells(NOTEBOOKS / "04_services_and_actions.ipynb", "code"))
+    code = "\n".join(_cells(LESSON_04, "code"))
     for name, path in (("MARKERS_IN_VIEW", "srv/MarkersInView.srv"), ("FIND_PICTURES", "action/FindPictures.action")):
         assert f'{name} = """{(reference / path).read_text()}"""' in code, path
+
+
+def test_lesson_04_pan_camera_figure_titles_stay_apart():
+    """Lesson 04's three views of the pan camera: each title (the markers, the pictures framed, what
+    ArUco finds) fits beside its neighbours as matplotlib lays the figure out for the notebook. In
+    the walkthrough in Chromium the -10 degree title's "framed ['cat', 'dog']" ran into "pan 0:"."""
+    import cv2
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from course_lib.imaging import pan_camera
+
+    (source,) = [s for s in _cells(LESSON_04, "code") if "ax.set_title(" in s and "pan_camera.frame_at" in s]
+    exec(source, {"cv2": cv2, "plt": plt, "pan_camera": pan_camera})
+    figure = plt.gcf()
+    try:
+        figure.canvas.draw()
+        boxes = [ax.title.get_window_extent(figure.canvas.get_renderer()) for ax in figure.axes]
+        assert len(boxes) == 3
+        gaps = [right.x0 - left.x1 for left, right in pairwise(boxes)]
+        assert min(gaps) > 5, f"the titles overlap or touch: gaps {gaps} pixels"
+    finally:
+        plt.close(figure)
+
+
+def test_lesson_05_says_no_fixed_order_of_the_recorders_subscriptions():
+    """Lesson 05's text before its last plot explains why the topics start apart without saying
+    which the recorder subscribed first: discovery decides (in the walkthrough in Chromium the plot's
+    title said "frames recorded from 0.69 s, /brightness from 0.00 s" under text that said
+    /brightness came after the frames)."""
+    (text,) = [s for s in _cells(LESSON_05, "markdown") if "plot the frames' own brightness" in s]
+    flat = " ".join(text.split())
+    assert "in the order discovery found them" in flat and "after the frames" not in flat
 
 
 def test_lesson_06_drives_its_plain_functions_to_the_pillar_for_other_seeds_too():

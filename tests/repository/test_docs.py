@@ -5,6 +5,7 @@ docs/*.md and assignments/README.md name exists; the tables and points the docs 
 from __future__ import annotations
 
 import re
+import subprocess
 import sys
 from pathlib import Path
 
@@ -16,8 +17,18 @@ from course_lib.checks import assignments, registry
 
 ROOT = contract.ROOT
 DOCS = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md")), ROOT / "assignments" / "README.md"]
+
+
+def _top_folders() -> list[str]:
+    """The repository's top-level folders, without what git ignores: a student's lab puts fetched
+    assignments (brightness/) there and the tests artifacts/, whose names the docs use otherwise."""
+    folders = sorted(p.name for p in ROOT.iterdir() if p.is_dir() and not p.name.startswith("."))
+    ignored = subprocess.run(["git", "check-ignore", *folders], cwd=ROOT, capture_output=True, text=True)
+    return [name for name in folders if name not in ignored.stdout.split()]
+
+
 #: The repository's top-level folders: a path in backticks that starts with one of them is a path of the repository.
-TOP = sorted(p.name for p in ROOT.iterdir() if p.is_dir() and not p.name.startswith("."))
+TOP = _top_folders()
 PACKAGES = ("course_lib", "autograder", "coursehub", "benchmarks")
 
 

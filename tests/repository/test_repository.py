@@ -44,6 +44,24 @@ def test_no_environment_or_colcon_output_is_committed():
     assert not bad, bad
 
 
+def test_what_make_lab_and_the_lessons_write_into_the_clone_is_ignored():
+    """Under `make lab` the lab's root is the clone: Fetch puts each assignment in <assignment>/ there
+    (a student's solutions, which a `git add -A` must not take), and the lessons write their
+    workspaces, snapshots and lesson 05's bag beside the notebooks (the walkthrough found
+    notebooks/camera_bag/, left by cells run again after the clean-up, and the fetched folders
+    untracked but not ignored)."""
+    from course_lib.checks import assignments
+
+    written = [f"{name}/{name}.ipynb" for name in assignments.discover()]
+    written += ["notebooks/camera_bag/metadata.yaml", "notebooks/camera_ws/src/x", "notebooks/snapshots/x.png"]
+    out = subprocess.run(["git", "check-ignore", "--no-index", "--verbose", "--non-matching", *written], cwd=ROOT,
+                         capture_output=True, text=True)
+    if out.returncode not in (0, 1):
+        pytest.skip("not a git checkout: " + out.stderr.strip())
+    not_ignored = [line.split("\t")[-1] for line in out.stdout.splitlines() if line.startswith("::")]
+    assert not not_ignored, f"add these to .gitignore: {not_ignored}"
+
+
 def test_ci_runs_the_readme_test_command():
     assert "make test" in (ROOT / ".ci" / "run").read_text()
     assert "make test" in (ROOT / "README.md").read_text()

@@ -138,4 +138,4 @@ def answers(ctx: Context) -> None:
             continue
         answer = normalized(given[name])
         why = ctx.expected("explain", name, answer)
-        ctx.item(why is None, f"{name}: {answer} is right" if why is None else f"{name}: not {answer}; {why}", weight)
+        ctx.item(why is None, f"{name}: {answer} is right" if why is None else f"{name}: not {answer}. {why}", weight)

@@ -82,7 +82,7 @@ def test_one_wrong_answer_loses_exactly_its_points_and_says_why(tmp_path, monkey
     result = graded(tmp_path, monkeypatch, {**RIGHT, "q6": wrong.upper()})  # " B" and "B" count as "b"
     assert result.points == result.max_points - QUIZ_QUESTIONS["q6"].points
     failed = [item["message"] for item in result.items if not item["ok"]]
-    assert failed == [f"q6: not {wrong}; {key.explain('q6', wrong)}"]
+    assert failed == [f"q6: not {wrong}. {key.explain('q6', wrong)}"]  # as the lesson quizzes say it
     assert key.explain("q6", wrong) == key.KEY["q6"].wrong[wrong] and "robot1/dark" not in failed[0]
 
 

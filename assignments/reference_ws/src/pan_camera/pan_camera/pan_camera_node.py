@@ -28,6 +28,7 @@ from course_lib.imaging.pan_camera import (
     markers_of,
     wrap,
 )
+from course_lib.ros import sigterm
 
 #: Steps of a whole turn: a search that has not framed the pictures by then gives up (aborts).
 FULL_TURN = round(360 / STEP_DEGREES)
@@ -107,6 +108,7 @@ class PanCameraNode(Node):
 
 
 def main(args=None):
+    sigterm.end_spin_as_ctrl_c()  # `kill` ends the node as Ctrl-C does (before rclpy.init: see its docstring)
     rclpy.init(args=args)
     node = None
     try:
