@@ -65,5 +65,5 @@ def test_a_submitted_quiz_is_graded_and_its_feedback_fetched(lab_root, capsys):
     nbgrader(lab_root, "fetch_feedback", "quiz")
     (page,) = (lab_root / "quiz" / "feedback").glob("*/quiz.html")
     text = page.read_text()
-    assert f"{WRONG[0]}: not {WRONG[1]}; {key.explain(*WRONG)}" in text
+    assert f"{WRONG[0]}: not {WRONG[1]}. {key.explain(*WRONG)}" in text
     assert "q1: c is right" in text and "Score: 15.0 / 16.0" in text
