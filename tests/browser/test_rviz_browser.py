@@ -219,7 +219,7 @@ DRAWING_JS = """(after) => { const views = document.querySelectorAll('.rviz-view
 
 
 @pytest.mark.timeout(400)
-def test_the_view_keeps_drawing_after_a_kernel_restart_and_a_re_run_cell_with_one_node(shown):
+def test_the_view_keeps_drawing_after_a_kernel_restart_and_a_re_run_cell_with_one_node(shown, lab):
     """Restart the kernel, run all, run the view's cell again: one view on the page, one node
     _rviz_rviz in the ROS graph with one subscription to /scan, and a new marker drawn at its pixels."""
     from course_lib.ros import session
@@ -239,7 +239,11 @@ def test_the_view_keeps_drawing_after_a_kernel_restart_and_a_re_run_cell_with_on
         return len(nodes), len(scans)
     # The restarted kernel's participant may take a moment to leave the graph.
     session.wait_for(lambda: views_in_graph() == (1, 1), timeout=60)
-    assert views_in_graph() == (1, 1), "(nodes _rviz_rviz, their subscriptions to /scan)"
+    if views_in_graph() != (1, 1):  # which kernels still run, and where they are
+        kernels = [(process.pid, " ".join(process.cmdline())[-60:]) for process in lab.descendants()
+                   if "ipykernel" in " ".join(process.cmdline())]
+        raise AssertionError(f"(nodes _rviz_rviz, their subscriptions to /scan) = {views_in_graph()}; the "
+                             f"server's kernels {kernels}\n{lab.kernel_stacks()}")
     # A new message reaches the new view: a green cube at (2, -2), from this process.
     from visualization_msgs.msg import Marker
 
