@@ -1,6 +1,6 @@
 """The mobile robot in a world, simulated by MuJoCo: plain Python, no ROS.
 
-    sim = Simulation("pillar", seed=3)      # worlds/pillar.xml, the pillar placed by the seed
+    sim = Simulation("pillar", seed=3)      # robot_sim/worlds/pillar.xml, the pillar placed by the seed
     sim.command(0.5, 0.0)                   # m/s forward, rad/s turning (clamped to the limits)
     sim.step(2.0)                           # two simulated seconds
     sim.pose()                              # (x, y, yaw) of base_link in the world (= odom)
@@ -41,7 +41,7 @@ def _import_mujoco():
 
 mujoco = _import_mujoco()
 
-WORLDS_DIR = Path(__file__).parent / "worlds"
+WORLDS_DIR = Path(__file__).parent / "robot_sim" / "worlds"
 #: Model files in WORLDS_DIR that are parts of worlds, not worlds.
 _PARTS = ("husky",)
 
