@@ -314,17 +314,19 @@ def main(argv=None) -> int:
         for suffix in trees:  # the other tree's caches, if its builds key them otherwise
             if suffix:
                 subprocess.run([*cli, "grade", str(course), "--force"], env=envs[suffix], check=True,
-                               stdout=subprocess.DEVNULL)
+                               stdout=subprocess.DEVNULL, cwd=trees[suffix])
         for _ in range(args.rounds):
             for assignment in chosen:
                 for suffix in sorted(trees, reverse=True):  # the other tree first, then this one
-                    column, env = assignment + suffix, envs[suffix]
+                    # In the tree's own folder: `python -m` puts the working folder before PYTHONPATH.
+                    column, env, tree = assignment + suffix, envs[suffix], trees[suffix]
                     before = load()
                     split, total, wall = run_sampled([*cli, "grade", str(course), "--assignment", assignment,
-                                                      "--student", "student0", "--force"], env, args.period)
+                                                      "--student", "student0", "--force"], env, args.period, tree)
                     scores[column] = scores.get(column, set()) | {_score(course, assignment)}
                     feedback, feedback_total, _ = run_sampled([*cli, "feedback", str(course), "--assignment",
-                                                               assignment, "--student", "student0"], env, args.period)
+                                                               assignment, "--student", "student0"], env, args.period,
+                                                              tree)
                     split[FEEDBACK] = feedback_total
                     runs[column].append((split, total, wall, feedback_total))
                     if column not in floors:
