@@ -19,9 +19,16 @@ order they start in. nbgrader's process is split at its kernel's start and end. 
 it: the same kernel launcher running no cell, then the submission's cells alone (nbclient, the
 grading's flags), and a process that imports rclpy (and one that also makes a node).
 
-    .venv/bin/python benchmarks/bench_grading_split.py [--assignment A ...] [--period 0.05]
+    .venv/bin/python benchmarks/bench_grading_split.py [--assignment A ...] [--period 0.05] [--before DIR]
+                                                       [--rounds N]
 
-Per assignment it prints CPU-seconds per row (rows that are 0 everywhere are left out), what the
+With ``--before DIR`` (a checkout of another commit, e.g. ``git worktree add DIR HEAD~3``) every
+command also runs with DIR's grader and course_lib (PYTHONPATH=DIR) on the same submissions, the
+two alternating per assignment, and each assignment gets a column "A (before)" beside "A": a change
+measured side by side in one run. With ``--rounds N`` each column is graded N times (the columns
+alternating in every round) and each row shows the median.
+
+Per assignment (and tree) it prints CPU-seconds per row (rows that are 0 everywhere are left out), what the
 samples saw, the command's wait4 total, the machine's busy time meanwhile, the wall time and the
 load average before and after, then the floor.
 """
@@ -30,9 +37,11 @@ from __future__ import annotations
 
 import argparse
 import collections
+import csv
 import json
 import os
 import platform
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -246,10 +255,10 @@ NODE_FLOOR = ("import rclpy; rclpy.init(); node = rclpy.create_node('floor'); no
               "rclpy.try_shutdown()")
 
 
-def floor(course: Path, assignment: str, scratch: Path, env: dict, period: float) -> dict:
+def floor(course: Path, assignment: str, scratch: Path, env: dict, period: float, name: str = "") -> dict:
     """The floor's rows: the grading's kernel launcher running no cell, then the submission's cells
     (nbclient in a process of its own, the grading's flags, in a copy of the submitted folder)."""
-    work = scratch / f"floor-{assignment}"
+    work = scratch / f"floor-{name or assignment}"
     subprocess.run(["cp", "-a", str(course / "submitted" / "student0" / assignment), str(work)], check=True)
     notebook = work / f"{assignment}.ipynb"
     kernels = scratch / "jupyter" / "kernels" / "python3"
@@ -271,37 +280,76 @@ def load() -> str:
     return open("/proc/loadavg").read().split()[0]
 
 
+def _score(course: Path, assignment: str) -> str:
+    """student0's score of `assignment` in the course's grades.csv (written by every grade command)."""
+    with open(course / "grades.csv", newline="") as handle:
+        for row in csv.DictReader(handle):
+            if row["assignment"] == assignment and row["student_id"] == "student0":
+                return f"{float(row['raw_score']):g}/{float(row['max_score']):g}"
+    return "?"
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--assignment", action="append", choices=ASSIGNMENTS, help="default: all")
     parser.add_argument("--period", type=float, default=0.05, help="seconds between samples of /proc")
+    parser.add_argument("--before", type=Path, help="a checkout of another commit, measured beside this one")
+    parser.add_argument("--rounds", type=int, default=1, help="gradings per column; each row shows their median")
     args = parser.parse_args(argv)
     chosen = args.assignment or ASSIGNMENTS
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")])}
-    env.pop("COURSE_LIB_UNDER_TEST", None)
-    measured, floors, loads = {}, {}, {}
+    trees = {"": ROOT, **({" (before)": args.before.resolve()} if args.before else {})}
+    envs = {}
+    for suffix, tree in trees.items():
+        envs[suffix] = {**os.environ, "PYTHONPATH": os.pathsep.join([str(tree), os.environ.get("PYTHONPATH", "")])}
+        envs[suffix].pop("COURSE_LIB_UNDER_TEST", None)
+    env = envs[""]
+    runs, floors, loads, scores = collections.defaultdict(list), {}, {}, {}
+    cli = [sys.executable, "-m", "autograder"]
     with tempfile.TemporaryDirectory(prefix="bench-grading-split-") as scratch:
         course = Path(scratch) / "course"
         release.release(course, chosen)
         for assignment in chosen:
             zoo.submit(course, "student0", assignment)
-        warm = grade.grade(course, progress=False, force=True)  # the caches every grading below reuses
-        scores = {r.assignment: f"{r.score:g}/{r.max_score:g}" for r in warm}
-        cli = [sys.executable, "-m", "autograder"]
-        for assignment in chosen:
-            before = load()
-            split, total, wall = run_sampled([*cli, "grade", str(course), "--assignment", assignment,
-                                              "--student", "student0", "--force"], env, args.period)
-            feedback, feedback_total, _ = run_sampled([*cli, "feedback", str(course), "--assignment", assignment,
-                                                       "--student", "student0"], env, args.period)
-            split[FEEDBACK] = feedback_total
-            measured[assignment] = (split, total, wall, feedback_total)
-            floors[assignment] = floor(course, assignment, Path(scratch), env, args.period)
-            loads[assignment] = f"{before} → {load()}"
+        grade.grade(course, progress=False, force=True)  # the caches every grading below reuses
+        for suffix in trees:  # the other tree's caches, if its builds key them otherwise
+            if suffix:
+                subprocess.run([*cli, "grade", str(course), "--force"], env=envs[suffix], check=True,
+                               stdout=subprocess.DEVNULL, cwd=trees[suffix])
+        for _ in range(args.rounds):
+            for assignment in chosen:
+                for suffix in sorted(trees, reverse=True):  # the other tree first, then this one
+                    # In the tree's own folder: `python -m` puts the working folder before PYTHONPATH.
+                    column, env, tree = assignment + suffix, envs[suffix], trees[suffix]
+                    before = load()
+                    split, total, wall = run_sampled([*cli, "grade", str(course), "--assignment", assignment,
+                                                      "--student", "student0", "--force"], env, args.period, tree)
+                    scores[column] = scores.get(column, set()) | {_score(course, assignment)}
+                    feedback, feedback_total, _ = run_sampled([*cli, "feedback", str(course), "--assignment",
+                                                               assignment, "--student", "student0"], env, args.period,
+                                                              tree)
+                    split[FEEDBACK] = feedback_total
+                    runs[column].append((split, total, wall, feedback_total))
+                    if column not in floors:
+                        floors[column] = floor(course, assignment, Path(scratch), env, args.period, column)
+                    loads[column] = loads.get(column, f"{before} → ").split("→")[0] + f"→ {load()}"
         nodes = {name: run_sampled([sys.executable, "-c", code], env, args.period)[1]
                  for name, code in (("import rclpy", "import rclpy"), ("rclpy: init, a node, shutdown", NODE_FLOOR))}
-    report(chosen, measured, floors, nodes, scores, loads)
+    columns = [assignment + suffix for assignment in chosen for suffix in sorted(trees, reverse=True)]
+    measured = {column: _median(runs[column]) for column in columns}
+    scores = {column: ", ".join(sorted(found)) for column, found in scores.items()}
+    report(columns, measured, floors, nodes, scores, loads)
+    if args.rounds > 1:
+        print(f"\neach row: the median of {args.rounds} rounds (so the rows need not add up to the total's median)")
+    if args.before:
+        print(f"\n(before): {args.before.resolve()}; without: {ROOT}")
     return 0
+
+
+def _median(runs: list[tuple]) -> tuple:
+    """(split, total, wall, feedback total) of several gradings: the median of each row and number."""
+    rows = {row for split, *_ in runs for row in split}
+    split = collections.Counter({row: statistics.median(run[0].get(row, 0.0) for run in runs) for row in rows})
+    return (split, *(statistics.median(run[index] for run in runs) for index in (1, 2, 3)))
 
 
 def _driver(split: dict) -> float:

@@ -1,5 +1,5 @@
 """The robot's size, speed limits and frames, written once: the MuJoCo model
-(``worlds/husky.xml``), the simulation and the ROS node all take them from here.
+(``robot_sim/worlds/husky.xml``), the simulation and the ROS node all take them from here.
 
 The numbers are Clearpath's public Husky A200 data (data sheet and user manual): mass 50 kg, outer
 size 990 × 670 × 390 mm, top speed 1.0 m/s, 13 in (0.33 m) wheels, an effective track of 0.555 m.

@@ -2,12 +2,14 @@
 
 It builds tf2_msgs, which PyPI lacks (:mod:`course_lib.robot.interface_install`), and installs ROS
 packages into the environment as colcon installs an ament_python package: a marker in the ament
-index, ``share/PKG/`` (package.xml, launch/) and executables in ``lib/PKG/`` that run a module's
-main(). ``robot_sim`` (the folder beside this module: ``ros2 run robot_sim simulator``,
-``ros2 launch robot_sim husky.launch.xml world:=pillar``), and the stand-ins of tools that PyPI
-lacks, under upstream's package and executable names: tf2_ros's ``static_transform_publisher``
-and ``tf2_echo``, tf2_tools' ``view_frames`` and ``teleop_twist_keyboard``. ``ros2 run`` finds
-them as it finds a package of a sourced workspace. Running it again rewrites the same files.
+index, ``share/PKG/`` and executables in ``lib/PKG/`` that run a module's main(). ``robot_sim``
+(the folder beside this module: ``ros2 run robot_sim simulator``, ``ros2 launch robot_sim
+husky.launch.xml world:=pillar``) is an ament_python package that colcon builds on a full ROS
+install; here it gets the files its setup.py installs (SHARED, and the executables). Then the
+stand-ins of tools that PyPI lacks, under upstream's package and executable names: tf2_ros's
+``static_transform_publisher`` and ``tf2_echo``, tf2_tools' ``view_frames`` and
+``teleop_twist_keyboard``. ``ros2 run`` finds them as it finds a package of a sourced workspace.
+Running it again rewrites the same files.
 """
 
 from __future__ import annotations
@@ -27,6 +29,8 @@ PACKAGES = {
     "teleop_twist_keyboard": {"teleop_twist_keyboard": "course_lib.robot.teleop_keyboard"},
 }
 EXECUTABLES = PACKAGES[PACKAGE]
+#: What robot_sim's setup.py installs into share/robot_sim (its data_files besides the ament index's marker).
+SHARED = ("package.xml", "launch", "worlds")
 #: What a stand-in's package.xml says it is (it has no folder of its own: it is all code).
 STAND_IN_XML = """<?xml version="1.0"?>
 <package format="3">
@@ -60,7 +64,10 @@ def install_package(prefix: Path | None = None) -> str:
         share = prefix / "share" / package
         shutil.rmtree(share, ignore_errors=True)
         if package == PACKAGE:
-            shutil.copytree(SOURCE, share, ignore=shutil.ignore_patterns("__pycache__"))
+            share.mkdir(parents=True)
+            shutil.copy(SOURCE / "package.xml", share)
+            for folder in SHARED[1:]:
+                shutil.copytree(SOURCE / folder, share / folder, ignore=shutil.ignore_patterns("__pycache__"))
         else:
             share.mkdir(parents=True)
             (share / "package.xml").write_text(STAND_IN_XML.format(name=package, executables=", ".join(executables)))
@@ -82,8 +89,9 @@ def main(argv: list[str] | None = None) -> int:
         print(f"python -m course_lib install-robot takes no arguments, got {' '.join(argv)}", file=sys.stderr)
         return 2
     if rosenv.detect_install().kind != "pip":
-        print(f"install-robot: not needed, {rosenv.detect_install().describe()} has ROS's own tf2_msgs; "
-              "build robot_sim in a workspace of that install")
+        print(f"install-robot: not needed, {rosenv.detect_install().describe()} has ROS's own tf2_msgs; build "
+              f"robot_sim in a workspace: mkdir -p robot_ws/src && ln -s {SOURCE} robot_ws/src/ && "
+              "python -m course_lib build robot_ws, then source robot_ws/install/setup.bash")
         return 0
     if interface_install.main([]):
         # Not fatal for the rest of the set-up: the course works without the robot until a C compiler

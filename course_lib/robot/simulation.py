@@ -1,6 +1,6 @@
 """The mobile robot in a world, simulated by MuJoCo: plain Python, no ROS.
 
-    sim = Simulation("pillar", seed=3)      # worlds/pillar.xml, the pillar placed by the seed
+    sim = Simulation("pillar", seed=3)      # robot_sim/worlds/pillar.xml, the pillar placed by the seed
     sim.command(0.5, 0.0)                   # m/s forward, rad/s turning (clamped to the limits)
     sim.step(2.0)                           # two simulated seconds
     sim.pose()                              # (x, y, yaw) of base_link in the world (= odom)
@@ -15,15 +15,33 @@ order, so that two simulations of one seed given the same commands give the same
 from __future__ import annotations
 
 import dataclasses
+import importlib
 import math
+import os
 from pathlib import Path
 
-import mujoco
 import numpy as np
 
 from course_lib.robot import husky
 
-WORLDS_DIR = Path(__file__).parent / "worlds"
+
+def _import_mujoco():
+    """mujoco without its OpenGL part (the course never renders with it: the laser's rays need no
+    GL): unless MUJOCO_GL says otherwise, importing it would load GLFW and look for its library with
+    subprocesses, 0.06 of the 0.1 processor seconds the import costs. The variable is set for the
+    import only, so that processes started later see the environment as it was."""
+    if "MUJOCO_GL" in os.environ:
+        return importlib.import_module("mujoco")
+    os.environ["MUJOCO_GL"] = "disable"
+    try:
+        return importlib.import_module("mujoco")
+    finally:
+        del os.environ["MUJOCO_GL"]
+
+
+mujoco = _import_mujoco()
+
+WORLDS_DIR = Path(__file__).parent / "robot_sim" / "worlds"
 #: Model files in WORLDS_DIR that are parts of worlds, not worlds.
 _PARTS = ("husky",)
 
@@ -108,8 +126,8 @@ class Simulation:
         self._start_quaternion = self.model.site_quat[start].copy()
         self._free_qpos = self.model.jnt_qposadr[self.model.joint("base").id]
         self._free_qvel = self.model.jnt_dofadr[self.model.joint("base").id]
-        self._robot_geoms = {g for g in range(self.model.ngeom) if self.model.geom_group[g] == 1}
-        self._obstacle_geoms = {g for g in range(self.model.ngeom) if self.model.geom_group[g] == 0}
+        # Per geom: 1 for the robot's, 2 for walls and obstacles, 0 for the rest (the floor).
+        self._geom_kind = np.where(self.model.geom_group == 1, 1, np.where(self.model.geom_group == 0, 2, 0))
         beam_angles = laser.angles()
         self._beams = np.stack([np.cos(beam_angles), np.sin(beam_angles), np.zeros_like(beam_angles)], axis=1)
         self._ray_geoms = np.zeros(laser.beams, dtype=np.int32)
@@ -193,11 +211,10 @@ class Simulation:
 
     def touching(self) -> bool:
         """Whether the robot touches a wall or obstacle (contacts with the floor do not count)."""
-        for contact in self.data.contact[:self.data.ncon]:
-            pair = {int(contact.geom1), int(contact.geom2)}
-            if pair & self._robot_geoms and pair & self._obstacle_geoms:
-                return True
-        return False
+        if self.data.ncon == 0:
+            return False
+        kinds = self._geom_kind[self.data.contact.geom]  # (contacts, 2): one row per contact
+        return bool(((kinds[:, 0] | kinds[:, 1]) == 3).any())
 
     # --- the laser -----------------------------------------------------------------------------
 

@@ -4,6 +4,8 @@
     ros2 run robot_sim simulator --ros-args -p world:=pillar -p seed:=3
     python -m course_lib.robot.simulator_node --ros-args -p lock_step:=true
 
+Its parameters, their defaults and what they set: PARAMETERS (``ros2 param describe``).
+
 Each tick (``1/scan_rate`` simulated seconds) the node publishes the simulated time on /clock,
 odom -> base_link on /tf, the odometry on /odom and then the scan on /scan, all stamped with the
 simulated time (it never goes back: a reset restarts the robot, not the clock). A /cmd_vel holds
@@ -24,6 +26,10 @@ Two ways to run (parameter ``lock_step``):
   pace: a wall-clock timeout depends on the machine's load). The checks judge by the controller's
   processor time instead and never pass a scan over (course_lib.checks.lock_step): when the
   controller is to blame they ``halt`` the simulation for good, with the reason.
+  ``max_real_time_factor`` caps the pace: with N > 0 the simulated time runs at most N times as
+  fast as the wall clock (1: never faster than real time, to watch a drive), the next tick
+  waiting, after its answer, for the wall time :func:`pace_delay` computes; 0 (the default): as
+  fast as the slowest keeps up. ``held_back`` adds up the wall seconds the cap waited.
 """
 
 from __future__ import annotations
@@ -36,6 +42,7 @@ import rclpy
 from builtin_interfaces.msg import Time
 from geometry_msgs.msg import TransformStamped, Twist
 from nav_msgs.msg import Odometry
+from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.clock import Clock, ClockType
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
@@ -54,6 +61,30 @@ def stamp(seconds: float) -> Time:
     return Time(sec=nanoseconds // 10**9, nanosec=nanoseconds % 10**9)
 
 
+#: The node's parameters: default and what it sets (``ros2 param describe /robot_simulator NAME``).
+PARAMETERS = {
+    "world": ("pillar", "the world: pillar, walls or maze, or the path of an MJCF file that includes husky.xml"),
+    "seed": (0, "places the pillar (pillar world) and draws the laser's noise"),
+    "scan_rate": (20.0, "scans, and simulation ticks, per simulated second"),
+    "lock_step": (False, "wait after each scan for the /cmd_vel that answers it, instead of running in real time"),
+    "real_time_factor": (1.0, "real time: simulated seconds per wall second"),
+    "max_real_time_factor": (0.0, "lock-step: simulated seconds per wall second at most; 0: as fast as the "
+                                  "slowest keeps up"),
+    "reply_timeout": (5.0, "lock-step: wall seconds after which a scan nobody answers is passed over"),
+    "beams": (Laser.beams, "the laser's beams over its 270 degrees"),
+    "noise": (Laser.noise, "the standard deviation of the laser's Gaussian noise (m)"),
+}
+
+
+def pace_delay(simulated: float, wall: float, factor: float) -> float:
+    """Wall seconds to wait before showing simulated time `simulated` when `wall` wall seconds have
+    passed (both counted from the same start) and the simulation may run at most `factor` times
+    as fast as the wall clock; 0 when `factor` is 0 (no cap) or the simulation is behind."""
+    if factor <= 0:
+        return 0.0
+    return max(0.0, simulated / factor - wall)
+
+
 def yaw_quaternion(yaw: float) -> tuple[float, float, float, float]:
     """(x, y, z, w) of a turn by `yaw` about z."""
     return 0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2)
@@ -64,19 +95,20 @@ class RobotSimulator(Node):
 
     def __init__(self, **node_options):
         super().__init__("robot_simulator", **node_options)
-        world = self.declare_parameter("world", "pillar").value
-        seed = self.declare_parameter("seed", 0).value
-        self.scan_rate = self.declare_parameter("scan_rate", 20.0).value
-        self.lock_step = self.declare_parameter("lock_step", False).value
-        self.real_time_factor = self.declare_parameter("real_time_factor", 1.0).value
-        self.reply_timeout = self.declare_parameter("reply_timeout", 5.0).value
-        beams = self.declare_parameter("beams", Laser.beams).value
-        noise = self.declare_parameter("noise", Laser.noise).value
-        self.sim = Simulation(world, seed=seed, laser=Laser(beams=beams, noise=noise))
+        values = {name: self.declare_parameter(name, default, ParameterDescriptor(description=words)).value
+                  for name, (default, words) in PARAMETERS.items()}
+        world, seed = values["world"], values["seed"]
+        self.scan_rate, self.lock_step = values["scan_rate"], values["lock_step"]
+        self.real_time_factor, self.max_real_time_factor = values["real_time_factor"], values["max_real_time_factor"]
+        self.reply_timeout = values["reply_timeout"]
+        self.sim = Simulation(world, seed=seed, laser=Laser(beams=values["beams"], noise=values["noise"]))
         self.clock_offset = 0.0  # simulated seconds before the last reset
         self.scans = 0  # scans published
         self.passed_over = 0  # lock-step: scans nobody answered, stepped over (on_unanswered)
         self.halted: str | None = None  # lock-step: why the simulation stopped for good (halt)
+        self.held_back = 0.0  # lock-step: wall seconds max_real_time_factor held the next tick back
+        self._pace_start: tuple[float, float] | None = None  # lock-step: (wall, simulated) when it (re)started
+        self._pace_timer = None  # lock-step: the timer of a tick the cap holds back
         self.last_scan: LaserScan | None = None
 
         self.clock_pub = self.create_publisher(ClockMessage, "/clock", 10)
@@ -91,14 +123,15 @@ class RobotSimulator(Node):
 
         self.tf_static_pub.publish(TFMessage(transforms=[self.laser_transform()]))
         # Wall-clock timers, also when a launch file sets use_sim_time for every node.
-        steady = Clock(clock_type=ClockType.STEADY_TIME)
+        self.steady = steady = Clock(clock_type=ClockType.STEADY_TIME)
         self.awaiting_reply_since = None  # lock-step: when the scan that waits for its answer went out
         if self.lock_step:
             self.timer = self.create_timer(min(0.1, self.reply_timeout), self.on_lock_step_timer, clock=steady)
         else:
             self.wall_start = time.monotonic()
             self.timer = self.create_timer(1.0 / (self.scan_rate * self.real_time_factor), self.on_tick, clock=steady)
-        pace = ("lock-step: waiting for a /scan subscriber and a /cmd_vel publisher" if self.lock_step
+        cap = f", at most x{self.max_real_time_factor:g} real time" if self.max_real_time_factor > 0 else ""
+        pace = (f"lock-step{cap}: waiting for a /scan subscriber and a /cmd_vel publisher" if self.lock_step
                 else f"real time x{self.real_time_factor:g}")
         self.get_logger().info(f"Robot in world '{world}' (seed {seed}){self.pillar_words()}, {pace}")
 
@@ -119,7 +152,7 @@ class RobotSimulator(Node):
             self.get_logger().error(f"Refused /cmd_vel: {error}. The robot stops.")
             self.sim.command(0.0, 0.0)
         if self.lock_step and self.awaiting_reply_since is not None and self.halted is None:
-            self.tick()
+            self.advance()
 
     def on_reset(self, request, response):
         self.clock_offset += self.sim.time
@@ -141,11 +174,12 @@ class RobotSimulator(Node):
 
     def on_lock_step_timer(self) -> None:
         """Lock-step: start (or pause) with the graph; ask on_unanswered about a scan that waits."""
-        if self.halted is not None:
+        if self.halted is not None or self._pace_timer is not None:
             return
         connected = self.scan_pub.get_subscription_count() > 0 and self.cmd_sub.get_publisher_count() > 0
         if self.awaiting_reply_since is None:
             if connected:
+                self._pace_start = (time.monotonic(), self.now)  # a pause does not earn a burst
                 self.publish_state()
                 self.awaiting_reply_since = time.monotonic()
         elif not connected:
@@ -160,13 +194,37 @@ class RobotSimulator(Node):
             self.passed_over += 1
             self.get_logger().warning(f"No /cmd_vel within {self.reply_timeout:g} s of the scan at t={self.now:.2f} s: "
                                       f"going on without it ({self.passed_over} scans passed over so far)")
-            self.tick()
+            self.advance()
 
     def halt(self, reason: str) -> None:
         """Lock-step: stop simulating for good (no more scans; /cmd_vel is ignored), saying why."""
         self.halted, self.awaiting_reply_since = reason, None
         self.timer.cancel()
+        self._cancel_pace_timer()
         self.get_logger().error(f"Simulation halted at t={self.now:.2f} s: {reason}")
+
+    def advance(self) -> None:
+        """Lock-step: the scan is answered (or passed over): tick now, or, when max_real_time_factor
+        says the simulation is ahead of the wall clock, once that many wall seconds have passed."""
+        wall, simulated = self._pace_start or (time.monotonic(), self.now)
+        delay = pace_delay(self.now + 1.0 / self.scan_rate - simulated, time.monotonic() - wall,
+                           self.max_real_time_factor)
+        if delay <= 0:
+            self.tick()
+            return
+        self.awaiting_reply_since = None
+        self.held_back += delay
+        self._pace_timer = self.create_timer(delay, self.on_pace_timer, clock=self.steady)
+
+    def on_pace_timer(self) -> None:
+        self._cancel_pace_timer()
+        if self.halted is None:
+            self.tick()
+
+    def _cancel_pace_timer(self) -> None:
+        if self._pace_timer is not None:
+            self.destroy_timer(self._pace_timer)
+            self._pace_timer = None
 
     def tick(self) -> None:
         """Lock-step: advance one tick and publish what the robot senses there."""

@@ -17,10 +17,10 @@ transform on the way is known. The buffer keeps ``cache_time`` (10 s) of each mo
 from __future__ import annotations
 
 import bisect
+import math
 import threading
 import time as wall
 
-import numpy as np
 from geometry_msgs.msg import TransformStamped
 from rclpy.duration import Duration
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile
@@ -61,38 +61,53 @@ def _seconds(nanoseconds: int) -> str:
     return f"{nanoseconds / 1e9:.6f}"
 
 
-def _slerp(q0: np.ndarray, q1: np.ndarray, ratio: float) -> np.ndarray:
-    if np.dot(q0, q1) < 0:
-        q1 = -q1
-    dot = min(float(np.dot(q0, q1)), 1.0)
+# Poses are (translation (x, y, z), rotation (x, y, z, w)) tuples of floats: a lookup composes a few
+# of them per call, and plain floats do that many times faster than numpy's small arrays.
+
+def _slerp(q0: tuple, q1: tuple, ratio: float) -> tuple:
+    dot = sum(a * b for a, b in zip(q0, q1, strict=True))
+    if dot < 0:
+        q1, dot = tuple(-v for v in q1), -dot
+    dot = min(dot, 1.0)
     if dot > 0.9995:  # nearly the same rotation: a straight line is exact enough
-        q = q0 + ratio * (q1 - q0)
+        q = tuple(a + ratio * (b - a) for a, b in zip(q0, q1, strict=True))
     else:
-        angle = np.arccos(dot)
-        q = (np.sin((1 - ratio) * angle) * q0 + np.sin(ratio * angle) * q1) / np.sin(angle)
-    return q / np.linalg.norm(q)
+        angle = math.acos(dot)
+        w0, w1 = math.sin((1 - ratio) * angle) / math.sin(angle), math.sin(ratio * angle) / math.sin(angle)
+        q = tuple(w0 * a + w1 * b for a, b in zip(q0, q1, strict=True))
+    norm = math.sqrt(sum(v * v for v in q))
+    return tuple(v / norm for v in q)
 
 
-def _rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
+def _cross(a: tuple, b: tuple) -> tuple:
+    return a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]
+
+
+def _rotate(q: tuple, v: tuple) -> tuple:
     """v turned by the unit quaternion q (x, y, z, w)."""
     u, w = q[:3], q[3]
-    return v + 2 * np.cross(u, np.cross(u, v) + w * v)
+    inner = _cross(u, v)
+    outer = _cross(u, (inner[0] + w * v[0], inner[1] + w * v[1], inner[2] + w * v[2]))
+    return v[0] + 2 * outer[0], v[1] + 2 * outer[1], v[2] + 2 * outer[2]
 
 
-def _multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+def _multiply(a: tuple, b: tuple) -> tuple:
     (ax, ay, az, aw), (bx, by, bz, bw) = a, b
-    return np.array([aw * bx + ax * bw + ay * bz - az * by, aw * by - ax * bz + ay * bw + az * bx,
-                     aw * bz + ax * by - ay * bx + az * bw, aw * bw - ax * bx - ay * by - az * bz])
+    return (aw * bx + ax * bw + ay * bz - az * by, aw * by - ax * bz + ay * bw + az * bx,
+            aw * bz + ax * by - ay * bx + az * bw, aw * bw - ax * bx - ay * by - az * bz)
 
 
 def _compose(a, b):
     """The pose `b` (in a's child frame) in a's parent frame: a ∘ b."""
-    return a[0] + _rotate(a[1], b[0]), _multiply(a[1], b[1])
+    moved = _rotate(a[1], b[0])
+    return (a[0][0] + moved[0], a[0][1] + moved[1], a[0][2] + moved[2]), _multiply(a[1], b[1])
 
 
 def _inverse(t):
-    q = t[1] * np.array([-1, -1, -1, 1])
-    return -_rotate(q, t[0]), q
+    x, y, z, w = t[1]
+    q = (-x, -y, -z, w)
+    back = _rotate(q, t[0])
+    return (-back[0], -back[1], -back[2]), q
 
 
 class _Link:
@@ -101,7 +116,7 @@ class _Link:
     def __init__(self, parent: str, static: bool):
         self.parent, self.static = parent, static
         self.stamps: list[int] = []
-        self.values: list[tuple[np.ndarray, np.ndarray]] = []
+        self.values: list[tuple[tuple, tuple]] = []
 
     def insert(self, stamp: int, value, cache_ns: int) -> None:
         if self.static:
@@ -132,7 +147,7 @@ class _Link:
             return self.values[after]
         (t0, v0), (t1, v1) = (self.stamps[after - 1], self.values[after - 1]), (self.stamps[after], self.values[after])
         ratio = (stamp - t0) / (t1 - t0)
-        return v0[0] + ratio * (v1[0] - v0[0]), _slerp(v0[1], v1[1], ratio)
+        return tuple(a + ratio * (b - a) for a, b in zip(v0[0], v1[0], strict=True)), _slerp(v0[1], v1[1], ratio)
 
 
 class Buffer:
@@ -152,15 +167,17 @@ class Buffer:
     def _set(self, transform: TransformStamped, static: bool) -> bool:
         parent, child = transform.header.frame_id.lstrip("/"), transform.child_frame_id.lstrip("/")
         t, r = transform.transform.translation, transform.transform.rotation
-        translation, rotation = np.array([t.x, t.y, t.z]), np.array([r.x, r.y, r.z, r.w])
-        norm = np.linalg.norm(rotation)
-        if not parent or not child or parent == child or not np.isfinite([*translation, *rotation]).all() or norm == 0:
+        translation, rotation = (t.x, t.y, t.z), (r.x, r.y, r.z, r.w)
+        norm = math.sqrt(sum(v * v for v in rotation))
+        finite = all(map(math.isfinite, translation + rotation))
+        if not parent or not child or parent == child or not finite or norm == 0:
             return False  # tf2 refuses such a transform with an error and keeps the rest
         with self._changed:
             link = self._links.get(child)
             if link is None or link.parent != parent or link.static != static:
                 link = self._links[child] = _Link(parent, static)
-            link.insert(_nanoseconds(transform.header.stamp), (translation, rotation / norm), self.cache_ns)
+            unit = tuple(v / norm for v in rotation)
+            link.insert(_nanoseconds(transform.header.stamp), (translation, unit), self.cache_ns)
             self._changed.notify_all()
         return True
 
@@ -200,7 +217,7 @@ class Buffer:
             if stamp == 0:
                 stamp = self._latest(source_side + target_side)
             try:
-                pose = up = (np.zeros(3), np.array([0.0, 0.0, 0.0, 1.0]))
+                pose = up = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0))
                 for child in source_side:  # source in the common ancestor's frame
                     pose = _compose(self._links[child].at(stamp), pose)
                 for child in target_side:  # target in the common ancestor's frame
@@ -235,8 +252,8 @@ class Buffer:
         found.header.frame_id, found.child_frame_id = target_frame, source_frame
         found.header.stamp = Time(nanoseconds=stamp).to_msg()
         t, r = found.transform.translation, found.transform.rotation
-        t.x, t.y, t.z = (float(v) for v in translation)
-        r.x, r.y, r.z, r.w = (float(v) for v in rotation)
+        t.x, t.y, t.z = translation
+        r.x, r.y, r.z, r.w = rotation
         return found
 
     def can_transform(self, target_frame: str, source_frame: str, time, timeout: Duration | None = None,

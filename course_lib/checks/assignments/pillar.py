@@ -242,8 +242,13 @@ class _Record:
         """Slower than STILL_SPEED for the last STILL_SECONDS (after the first second)."""
         if not self.ticks or self.ticks[-1][0] < STILL_SECONDS + 1.0:
             return False
-        recent = [speed for time, _, speed, _ in self.ticks if time >= self.ticks[-1][0] - STILL_SECONDS]
-        return all(abs(speed) < STILL_SPEED for speed in recent)
+        since = self.ticks[-1][0] - STILL_SECONDS
+        for time, _, speed, _ in reversed(self.ticks):  # the newest first: a moving robot ends it at once
+            if time < since:
+                return True
+            if abs(speed) >= STILL_SPEED:
+                return False
+        return True
 
 
 def _simulator(context, proc, seed: int, scan_topic: str, record: _Record):

@@ -24,7 +24,7 @@ from std_srvs.srv import Trigger
 from tf2_msgs.msg import TFMessage
 
 from course_lib.robot import husky
-from course_lib.robot.simulator_node import RobotSimulator
+from course_lib.robot.simulator_node import RobotSimulator, pace_delay
 
 BACKSTOP = 60.0
 
@@ -112,9 +112,9 @@ def run(domain_id):
         each.close()
 
 
-def drive_to_pillar(run, seed, seconds=20.0, reply_delay=0.0):
+def drive_to_pillar(run, seed, seconds=20.0, reply_delay=0.0, **parameters):
     """The simulation after `seconds` of the P-controller, which runs in a thread of its own."""
-    sim_run = run(world="pillar", seed=seed)
+    sim_run = run(world="pillar", seed=seed, **parameters)
     controller = PillarController(context=sim_run.context, reply_delay=reply_delay)
     executor = SingleThreadedExecutor(context=sim_run.context)
     executor.add_node(controller)
@@ -211,3 +211,40 @@ def test_reset_puts_the_robot_back_and_the_clock_goes_on(run):
     after = heard.odom[-1]
     assert after.pose.pose.position.x < 0.2
     assert after.header.stamp.sec >= 2, "the clock does not go back"
+
+
+def test_pace_delay_holds_the_simulation_at_most_factor_times_the_wall_clock():
+    assert pace_delay(simulated=1.0, wall=0.2, factor=2.0) == pytest.approx(0.3)  # 1 s at x2 is due at 0.5 s
+    assert pace_delay(simulated=1.0, wall=0.7, factor=2.0) == 0.0  # behind the wall clock: no wait
+    assert pace_delay(simulated=1.0, wall=0.1, factor=0.5) == pytest.approx(1.9)  # slower than real time
+    assert pace_delay(simulated=100.0, wall=0.0, factor=0.0) == 0.0  # 0: no cap
+
+
+def test_max_real_time_factor_caps_the_lock_step_pace_in_simulated_terms(run):
+    """At most N simulated seconds per wall second: a one-sided bound, which a busy machine (slower,
+    never faster) cannot break. Half real time: without the cap a lock-step run here goes 30 times
+    real time or more, and even a machine 50 times slower is ahead of the cap, which then waits."""
+    factor = 0.5
+    sim_run = run(world="walls", max_real_time_factor=factor)
+    sim_run.add(Replier)
+    scans = []  # (wall, simulated) per scan as it arrives
+    listener = sim_run.add(Node, node_name="listener")
+    listener.create_subscription(LaserScan, "scan", lambda scan: scans.append(
+        (time.monotonic(), scan.header.stamp.sec + scan.header.stamp.nanosec * 1e-9)), 100)
+    sim_run.until(lambda: len(scans) >= 2 and scans[-1][1] - scans[0][1] >= 0.5, "0.5 simulated seconds")
+    (wall0, sim0), (wall1, sim1) = scans[0], scans[-1]
+    assert (sim1 - sim0) / (wall1 - wall0) <= factor * 1.05, f"{sim1 - sim0:.2f} simulated s in {wall1 - wall0:.3f} s"
+    assert 0 < sim_run.sim_node.held_back <= time.monotonic() - wall0 + 0.1
+
+
+def test_the_cap_changes_the_pace_not_the_drive(run):
+    capped = drive_to_pillar(run, seed=2, seconds=3.0, max_real_time_factor=10.0)
+    free = drive_to_pillar(run, seed=2, seconds=3.0)
+    assert capped.pose() == free.pose()
+
+
+def test_without_a_cap_nothing_is_held_back(run):
+    sim_run = run(world="walls")
+    sim_run.add(Replier)
+    sim_run.until(lambda: sim_run.sim_node.sim.time >= 1.0, "1 simulated second")
+    assert sim_run.sim_node.held_back == 0.0
