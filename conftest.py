@@ -48,6 +48,19 @@ def session_domain():
             session.stop()
 
 
+@pytest.fixture(autouse=True, scope="module")
+def _no_session_left_running():
+    """Every test module ends with the notebook session stopped. Tests that drive a notebook from
+    the test's process (the browser tests) start it on the run's domain; left running, it made the
+    next module in that worker fail at session.start(domain_id=N) ("already runs on domain 101")."""
+    yield
+    import sys
+
+    session = sys.modules.get("course_lib.ros.session")
+    if session is not None and session.is_running():
+        session.stop()
+
+
 @pytest.fixture
 def domain_id():
     """A ROS domain id reserved for one test, for tests that need traffic nobody else sees.
