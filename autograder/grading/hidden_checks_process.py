@@ -30,6 +30,7 @@ from course_lib.checks.registry import get_check
 from course_lib.checks.result import Result
 from course_lib.checks.runner import embed_images, fresh_seed
 from course_lib.checks.student_server import StudentServers
+from course_lib.ros import type_support_lock
 
 #: Set by the grader: the wall time, in seconds, that all checks of the submission together may use.
 
@@ -76,6 +77,7 @@ def run_outside(assignment: str, names: list[str], workdir, out: Path, budget: f
     deadline = None if budget is None else started + max(1.0, budget - MARGIN)
     run = _Run(assignment, Path(workdir).resolve(), out, deadline,
                StudentServers(budget or sum(get_check(assignment, name).timeout for name in names)))
+    type_support_lock.install()  # the checks run side by side in threads: one imports a type's support
     base = own_domains()
     if base is None:  # one domain: one check at a time
         workers = [threading.Thread(target=lambda: [run.check(name) for name in names], daemon=True)]

@@ -48,7 +48,7 @@ import traceback
 from collections.abc import Callable
 
 from course_lib import waiting
-from course_lib.ros import node_logs, node_names, rclpy_backports, rosenv, teardown
+from course_lib.ros import node_logs, node_names, rclpy_backports, rosenv, teardown, type_support_lock
 from course_lib.ros.run_limits import time_limit
 
 #: How the name of every process's hidden helper node starts (a leading "_" hides it from node listings).
@@ -154,6 +154,7 @@ def start(domain_id: int | None = None) -> None:
         _stopped = False
         _install_node_hook()
         rclpy_backports.install()  # action clients spun by this thread while cells send goals
+        type_support_lock.install()  # this thread and the cells' threads may check one type at once
         state.thread.start()
         if not _atexit_registered:
             atexit.register(stop)
