@@ -112,13 +112,13 @@ def pytest_collection_modifyitems(items):
 
 @pytest.hookimpl(wrapper=True)
 def pytest_runtest_call(item):
-    """nbmake's run of a lesson also keeps the executed notebook (artifacts/lessons/) and fails on
-    what a student would see wrong in its outputs (support.lesson_runs)."""
+    """nbmake's run of a lesson gets a ROS domain of its own, keeps the executed notebook
+    (artifacts/lessons/) and fails on what a student would see wrong in its outputs (support.lesson_runs)."""
     from support import lesson_runs  # tests/ is on the path (pyproject's pythonpath)
 
     if not lesson_runs.is_lesson(item):
         return (yield)
-    with lesson_runs.keeping_executed(item) as kept:
+    with lesson_runs.own_domain(), lesson_runs.keeping_executed(item) as kept:
         outcome = yield
     found = lesson_runs.problems(item.path.name, kept[0])
     if found:

@@ -1,7 +1,8 @@
 """The lessons under nbmake: what the course checks in a lesson nbmake ran, beside nbmake's own checks.
 
 nbmake (pyproject.toml's addopts) runs every lesson of notebooks/ top to bottom in a kernel, as a
-student's CI would, and fails at the first cell that raises. conftest.py keeps the notebook it
+student's CI would, and fails at the first cell that raises. conftest.py gives each run a ROS
+domain of its own (:func:`own_domain`), keeps the notebook it
 executed, writes it to artifacts/lessons/<lesson>.ipynb (open it to see what the run showed), and
 fails the run with nbmake's own failure when :func:`problems` finds something a student would see:
 
@@ -39,6 +40,27 @@ BITMAPS = ("image/png", "image/jpeg")
 def is_lesson(item) -> bool:
     """True for nbmake's run of a lesson (a notebook under notebooks/, not a lesson's scratch copy)."""
     return getattr(item, "nbmake", False) and item.path.parent == LESSONS
+
+
+@contextlib.contextmanager
+def own_domain():
+    """A ROS domain reserved for one lesson's run: its kernel (started by nbmake in this block)
+    inherits ROS_DOMAIN_ID. The run's own domain is shared by the tests of every worker: a lesson's
+    nodes there showed up in another test's `ros2 node list` (lesson 02b's /dark_fraction)."""
+    import os
+
+    from course_lib.ros import rosenv
+
+    before = os.environ.get("ROS_DOMAIN_ID")
+    with rosenv.reserve_domain_id() as reservation:
+        os.environ["ROS_DOMAIN_ID"] = str(reservation.domain_id)
+        try:
+            yield reservation.domain_id
+        finally:
+            if before is None:
+                os.environ.pop("ROS_DOMAIN_ID", None)
+            else:
+                os.environ["ROS_DOMAIN_ID"] = before
 
 
 @contextlib.contextmanager
