@@ -38,6 +38,7 @@ import runpy
 import select
 import signal
 import socket
+import stat
 import struct
 import sys
 import tempfile
@@ -179,20 +180,28 @@ class ForkServer:
 def _remove_stale_folders(parent: Path) -> None:
     """Remove the socket folders of servers that are gone (a grader killed with SIGKILL leaves its
     folder): those whose socket no server listens on any more. A folder without a socket yet may be
-    a server's that is starting: it stays."""
+    a server's that is starting: it stays. The temporary folder is everyone's: only a real folder
+    of this uid counts (opened without following a link), and its socket is looked at and removed
+    through that open folder."""
     for folder in parent.glob(FOLDER_PREFIX + "*"):
-        path = folder / "socket"
         try:
-            if folder.is_symlink() or folder.stat().st_uid != os.getuid() or not path.is_socket():
-                continue
-            with socket.socket(socket.AF_UNIX, socket.SOCK_SEQPACKET) as probe:
-                probe.connect(str(path))
-        except ConnectionRefusedError:
-            with contextlib.suppress(OSError):
-                path.unlink()
-                folder.rmdir()
+            fd = os.open(folder, os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW)
         except OSError:
             continue
+        try:
+            if os.fstat(fd).st_uid != os.getuid() or not stat.S_ISSOCK(os.stat("socket", dir_fd=fd,
+                                                                            follow_symlinks=False).st_mode):
+                continue
+            with socket.socket(socket.AF_UNIX, socket.SOCK_SEQPACKET) as probe:
+                probe.connect(f"/proc/self/fd/{fd}/socket")
+        except ConnectionRefusedError:
+            with contextlib.suppress(OSError):
+                os.unlink("socket", dir_fd=fd)
+                os.rmdir(folder)  # a link put in its place since is no folder: rmdir fails
+        except OSError:
+            continue
+        finally:
+            os.close(fd)
 
 
 def forkable() -> bool:
