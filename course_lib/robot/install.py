@@ -65,9 +65,11 @@ def install_package(prefix: Path | None = None) -> str:
         shutil.rmtree(share, ignore_errors=True)
         if package == PACKAGE:
             share.mkdir(parents=True)
-            shutil.copy(SOURCE / "package.xml", share)
-            for folder in SHARED[1:]:
-                shutil.copytree(SOURCE / folder, share / folder, ignore=shutil.ignore_patterns("__pycache__"))
+            for name in SHARED:
+                if (SOURCE / name).is_dir():
+                    shutil.copytree(SOURCE / name, share / name, ignore=shutil.ignore_patterns("__pycache__"))
+                else:
+                    shutil.copy(SOURCE / name, share)
         else:
             share.mkdir(parents=True)
             (share / "package.xml").write_text(STAND_IN_XML.format(name=package, executables=", ".join(executables)))
