@@ -97,14 +97,16 @@ def twist_message(values: tuple[float, float, float, float]):
 
 
 def read_key(stream) -> str:
-    """One key from a terminal, in raw mode only while it is read (as upstream's getKey)."""
+    """One key from a terminal, in raw mode only while it is read (as upstream's getKey). A key typed
+    between two reads is kept: raw mode starts at once (TCSANOW), where tty.setraw's default flushes
+    the input first (upstream loses such a key, a Ctrl-C too, and the tool then reads on)."""
     import termios
     import tty
 
     descriptor = stream.fileno()
     saved = termios.tcgetattr(descriptor)
     try:
-        tty.setraw(descriptor)
+        tty.setraw(descriptor, termios.TCSANOW)
         return stream.read(1)
     finally:
         termios.tcsetattr(descriptor, termios.TCSADRAIN, saved)

@@ -7,6 +7,7 @@ import pty
 import select
 import signal
 import subprocess
+import threading
 import time
 
 import pytest
@@ -78,13 +79,48 @@ def _controlling_terminal() -> None:
     fcntl.ioctl(0, termios.TIOCSCTTY, 0)
 
 
-def test_the_terminal_tool_in_a_pty_publishes_the_keys_twists_and_stops_on_ctrl_c(domain_id):
-    """About 1.5 CPU-s: one ROS process and a subscriber."""
+def _start_in_a_pty(domain_id: int) -> tuple[subprocess.Popen, int]:
+    """The terminal tool in a pty of its own; the pty's side of the test."""
     main, child = pty.openpty()
     process = subprocess.Popen([str(ROS2), "run", "teleop_twist_keyboard", "teleop_twist_keyboard"],
                                env=rosenv.ros_environment(domain_id), stdin=child, stdout=child, stderr=child,
                                start_new_session=True, preexec_fn=_controlling_terminal)
     os.close(child)
+    return process, main
+
+
+def test_a_key_typed_between_two_reads_is_read_not_flushed():
+    """The tool reads in raw mode only while it waits for a key; a key typed before that (a Ctrl-C
+    right after a key that moved the robot) must be the next key read. With tty.setraw's default
+    (flush the input) it was lost, and the test that typed Ctrl-C waited for the tool's end."""
+    main, child = pty.openpty()
+    keys = []
+    with open(child, "r", closefd=True) as terminal:
+        os.write(main, b"u")  # the terminal is not in raw mode yet
+        time.sleep(0.1)  # the pty hands it to the line discipline
+        reader = threading.Thread(target=lambda: keys.append(teleop_keyboard.read_key(terminal)), daemon=True)
+        reader.start()
+        reader.join(5.0)
+        if reader.is_alive():  # the key is gone: a second one ends the read
+            os.write(main, b"x")
+            reader.join(5.0)
+    os.close(main)
+    assert keys == ["u"]
+
+
+def _press_until(main: int, executor, heard: list, key: str, condition) -> bool:
+    """Press `key` again until the twist it publishes arrives (the first may go out before the
+    publisher has matched this subscriber: a key press is not stored)."""
+    def done():
+        os.write(main, key.encode())
+        executor.spin_once(timeout_sec=0.2)
+        return bool(heard) and condition(heard[-1])
+    return wait_until(done)
+
+
+def test_the_terminal_tool_in_a_pty_publishes_the_keys_twists_and_stops_on_ctrl_c(domain_id):
+    """About 1.5 CPU-s: one ROS process and a subscriber."""
+    process, main = _start_in_a_pty(domain_id)
     context = rclpy.Context()
     rclpy.init(context=context, domain_id=domain_id)
     heard, seen = [], []
@@ -97,13 +133,7 @@ def test_the_terminal_tool_in_a_pty_publishes_the_keys_twists_and_stops_on_ctrl_
         assert "Moving around:\n   u    i    o\n   j    k    l\n   m    ,    .\n" in "".join(seen).replace("\r\n", "\n")
 
         def press_until(key: str, condition) -> bool:
-            """Press `key` again until the twist it publishes arrives (the first may go out before
-            the publisher has matched this subscriber: a key press is not stored)."""
-            def done():
-                os.write(main, key.encode())
-                executor.spin_once(timeout_sec=0.2)
-                return bool(heard) and condition(heard[-1])
-            return wait_until(done)
+            return _press_until(main, executor, heard, key, condition)
 
         assert press_until("i", lambda t: (t.linear.x, t.angular.z) == (0.5, 0.0))
         os.write(main, b"q")
@@ -117,6 +147,34 @@ def test_the_terminal_tool_in_a_pty_publishes_the_keys_twists_and_stops_on_ctrl_
         assert process.returncode == 0
     finally:
         # The node leaves the graph now, whatever failed: a later test in this domain must not see it.
+        executor.shutdown()
+        node.destroy_node()
+        rclpy.try_shutdown(context=context)
+        process_tree.stop_group(process, STOP_STEPS)
+        os.close(main)
+
+
+def test_ctrl_c_between_two_keys_is_a_sigint_that_ends_the_tool_with_a_stop(domain_id):
+    """The terminal is out of raw mode between two keys, so a Ctrl-C typed then is a SIGINT to the
+    tool's process group, not a key (a test that types Ctrl-C right after a key meets this now and
+    then). About 1.5 CPU-s."""
+    process, main = _start_in_a_pty(domain_id)
+    context = rclpy.Context()
+    rclpy.init(context=context, domain_id=domain_id)
+    heard, seen = [], []
+    node = Node("cmd_vel_reader", context=context)
+    executor = SingleThreadedExecutor(context=context)
+    try:
+        node.create_subscription(Twist, "/cmd_vel", heard.append, 10)
+        executor.add_node(node)
+        assert read_until(main, "currently:\tspeed 0.5\tturn 1.0 ", seen), "".join(seen)
+        assert _press_until(main, executor, heard, "i", lambda t: t.linear.x == 0.5)  # matched both ways
+        os.killpg(process.pid, signal.SIGINT)
+        assert wait_until(lambda: process.poll() is not None), "Ctrl-C between two keys was swallowed"
+        assert process.returncode == 0
+        assert wait_until(lambda: executor.spin_once(timeout_sec=0.1) or bool(heard))
+        assert heard[-1].linear.x == 0.0 and heard[-1].angular.z == 0.0
+    finally:
         executor.shutdown()
         node.destroy_node()
         rclpy.try_shutdown(context=context)
