@@ -95,7 +95,7 @@ def test_a_key_typed_between_two_reads_is_read_not_flushed():
     (flush the input) it was lost, and the test that typed Ctrl-C waited for the tool's end."""
     main, child = pty.openpty()
     keys = []
-    with open(child, "r", closefd=True) as terminal:
+    with open(child, closefd=True) as terminal:
         os.write(main, b"u")  # the terminal is not in raw mode yet
         time.sleep(0.1)  # the pty hands it to the line discipline
         reader = threading.Thread(target=lambda: keys.append(teleop_keyboard.read_key(terminal)), daemon=True)
