@@ -108,3 +108,26 @@ def test_the_handler_is_installed_from_the_main_thread_only():
         assert signal.getsignal(signal.SIGTERM) is sigterm._end_as_ctrl_c
     finally:
         signal.signal(signal.SIGTERM, before)
+
+
+def _spinning_mains() -> list:
+    """The node modules of the course's packages whose main() spins a node without a timer (a node
+    that may wait for messages that never come), and that import course_lib already. pubsub's
+    nodes stay plain rclpy, as upstream's examples (they depend on nothing of the course's)."""
+    from autograder.builds.reference import REFERENCE_SRC
+
+    modules = []
+    for path in sorted(REFERENCE_SRC.glob("*/*/*.py")):
+        source = path.read_text()
+        if "rclpy.spin(" in source and "create_timer(" not in source and "from course_lib" in source:
+            modules.append(pytest.param(source, id=f"{path.parent.name}.{path.stem}"))
+    return modules
+
+
+@pytest.mark.parametrize("source", _spinning_mains())
+def test_the_course_packages_nodes_hand_sigterm_on_before_rclpy_init(source):
+    """As lesson 04's server and pan_camera (whose SIGTERM rounds are tested): a `kill` of an idle
+    brightness, marker_reader or pillar node ends it as Ctrl-C does, and their templates show it."""
+    main = source[source.index("def main("):]
+    assert "sigterm.end_spin_as_ctrl_c()" in main
+    assert main.index("sigterm.end_spin_as_ctrl_c()") < main.index("rclpy.init(")

@@ -14,6 +14,7 @@ from sensor_msgs.msg import Image
 from std_msgs.msg import UInt8
 
 from course_lib import images
+from course_lib.ros import sigterm
 
 
 def average_brightness(image: np.ndarray) -> int:
@@ -43,6 +44,7 @@ class BrightnessNode(Node):
 
 
 def main(args=None):
+    sigterm.end_spin_as_ctrl_c()  # `kill` ends the node as Ctrl-C does (see course_lib.ros.sigterm)
     rclpy.init(args=args)
     node = None
     try:

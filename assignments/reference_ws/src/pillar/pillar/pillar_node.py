@@ -19,6 +19,7 @@ from sensor_msgs.msg import LaserScan
 from visualization_msgs.msg import Marker
 
 from course_lib.robot.tf_buffer import Buffer, TransformException, TransformListener
+from course_lib.ros import sigterm
 
 #: The pillar's radius (m): the laser sees its surface, the marker goes to its centre.
 PILLAR_RADIUS = 0.2
@@ -136,6 +137,7 @@ class PillarNode(Node):
 
 
 def main(args=None):
+    sigterm.end_spin_as_ctrl_c()  # `kill` ends the node as Ctrl-C does (see course_lib.ros.sigterm)
     rclpy.init(args=args)
     node = None
     try:

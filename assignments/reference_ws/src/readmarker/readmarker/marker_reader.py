@@ -17,6 +17,7 @@ from rclpy.qos import qos_profile_sensor_data
 from sensor_msgs.msg import Image
 
 from course_lib import images, marker_board
+from course_lib.ros import sigterm
 from readmarker.crop import crop_pictures
 
 #: Seconds between two warnings about bad input images.
@@ -103,6 +104,7 @@ class MarkerReader(Node):
 
 
 def main(args=None):
+    sigterm.end_spin_as_ctrl_c()  # `kill` ends the node as Ctrl-C does (see course_lib.ros.sigterm)
     rclpy.init(args=args)
     node = None
     try:
