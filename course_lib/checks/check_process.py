@@ -39,7 +39,8 @@ def run_in_this_process(assignment: str, name: str, seed: int, workdir: Path, ou
     finally:
         ctx.close()
     points = earned_points(spec.points, ctx.items, failed=error is not None)
-    return Result(assignment, name, points, spec.points, seed, ctx.items, ctx.notes, ctx.images, error)
+    return Result(assignment, name, points, spec.points, seed, ctx.items, ctx.notes, ctx.images, error,
+                  seeded=ctx.seeded)
 
 
 def main(argv=None) -> int:

@@ -78,6 +78,8 @@ class Context:
 
     Attributes:
         seed: this run's seed; rng: a numpy Generator seeded with it.
+        seeded: whether the check read its seed or rng (a check that draws nothing, as a quiz
+            question's, has no seed to show).
         workdir: the directory of the student's notebook and module files.
         domain_id: a ROS domain reserved for this check (student nodes and probes use it).
         second_domain_id: another one, for nodes that must not hear those of domain_id while both
@@ -93,11 +95,10 @@ class Context:
     def __init__(self, spec: Check, seed: int, workdir: Path, out: Path, students: StudentProcesses | None = None,
                  servers: StudentServers | None = None, deadline: float | None = None, domain_id: int | None = None,
                  second_domain_id: int | None = None):
-        import numpy as np
-
         self.spec = spec
-        self.seed = seed
-        self.rng = np.random.default_rng(seed)
+        self._seed = seed
+        self._rng = None
+        self.seeded = False
         self.workdir = workdir
         self.out = out
         self._started_processes: list = []
@@ -114,6 +115,21 @@ class Context:
         self._second_reservation = None if second_domain_id is None else _Fixed(second_domain_id)
         self._started = time.monotonic()
         self._answers = answers.AnswerKey(spec.assignment)
+
+    @property
+    def seed(self) -> int:
+        self.seeded = True
+        return self._seed
+
+    @property
+    def rng(self):
+        """A numpy Generator seeded with the seed (made when first asked for)."""
+        self.seeded = True
+        if self._rng is None:
+            import numpy as np
+
+            self._rng = np.random.default_rng(self._seed)
+        return self._rng
 
     # -- recording -----------------------------------------------------------------------------
 

@@ -23,6 +23,7 @@ class Result:
     images: list[dict] = dataclasses.field(default_factory=list)
     error: str | None = None
     seconds: float = 0.0
+    seeded: bool = True  # False: the check drew nothing from its seed (the verdict does not show it)
 
     def verdict_lines(self) -> list[str]:
         """The points, then what failed (each cause followed by its consequences), then what passed."""
@@ -63,11 +64,12 @@ def points_text(value: float) -> str:
 
 
 def verdict_text(result: Result, graded: bool) -> str:
-    """What a check cell shows: the seed, the check's description, and what passed and failed."""
-    header = (f"[{'graded' if graded else 'self-check'} · seed {result.seed}] "
-              f"{get_check(result.assignment, result.name).description}")
-    lines = [header, *result.verdict_lines()]
-    if graded:
+    """What a check cell shows: the seed (when the check drew from it), the check's description, and
+    what passed and failed."""
+    kind = "graded" if graded else "self-check"
+    tag = f"{kind} · seed {result.seed}" if result.seeded else kind
+    lines = [f"[{tag}] {get_check(result.assignment, result.name).description}", *result.verdict_lines()]
+    if graded and result.seeded:
         lines.append(f"  (reproduce with AUTOGRADER_SEED={result.seed})")
     return "\n".join(lines)
 

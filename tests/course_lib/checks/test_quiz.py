@@ -18,6 +18,7 @@ from course_lib import contract
 from course_lib.checks import answers, assignments, check_process, registry
 from course_lib.checks import quiz as checks
 from course_lib.checks.quiz_questions import QUIZ_QUESTIONS
+from course_lib.checks.result import verdict_text
 
 RIGHT = {name: entry.answer for name, entry in key.KEY.items()}
 
@@ -68,6 +69,13 @@ def test_the_answer_key_gets_full_marks(tmp_path, monkeypatch):
     result = graded(tmp_path, monkeypatch, RIGHT)
     assert result.points == result.max_points == len(QUIZ_QUESTIONS), result.verdict_lines()
     assert result.error is None
+
+
+def test_the_verdict_shows_no_seed_the_quiz_never_drew_from(tmp_path, monkeypatch):
+    """A quiz draws nothing at random: its feedback has no seed line and no AUTOGRADER_SEED to
+    reproduce it with (a check that draws scenes keeps both: tests/course_lib/checks/test_result.py)."""
+    text = verdict_text(graded(tmp_path, monkeypatch, RIGHT), graded=True)
+    assert text.startswith("[graded] ") and "seed" not in text.lower(), text
 
 
 @pytest.mark.parametrize("given", [{}, None], ids=["blank", "no-answers-file"])

@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
-from course_lib.checks.result import Result, earned_points, points_text, round_points
+from course_lib.checks.result import Result, earned_points, points_text, round_points, verdict_text
 
 
 def test_verdict_names_causes_first_then_their_consequences_then_what_passed():
@@ -39,3 +41,19 @@ def test_a_check_earns_its_share_of_points_as_the_grader_rounds_them():
     assert Result("brightness", "node", points, 7.0, 5, items=items).verdict_lines()[0] == "node: 6.13 of 7 points"
     assert earned_points(7, items[-1:], failed=True) == 0.0 and earned_points(7, [], failed=False) == 0.0
     assert earned_points(7, items, failed=True) == 6.13  # an error after items passed keeps their points
+
+
+def test_a_check_that_drew_from_its_seed_shows_it_and_how_to_reproduce_the_grade():
+    """A check that read its rng (its scenes, frames, values) is reproduced with its seed; the header
+    and the AUTOGRADER_SEED line say which. A check that drew nothing shows neither (the quiz's)."""
+    from course_lib.checks.context import Context
+    from course_lib.checks.registry import get_check
+
+    ctx = Context(get_check("brightness", "values"), 41, Path("."), Path("."))
+    assert not ctx.seeded
+    ctx.rng.integers(0, 10)
+    assert ctx.seeded
+    drawn = verdict_text(Result("brightness", "values", 4.0, 4.0, 41, seeded=ctx.seeded), graded=True)
+    assert drawn.startswith("[graded · seed 41] ") and drawn.endswith("(reproduce with AUTOGRADER_SEED=41)")
+    not_drawn = verdict_text(Result("brightness", "values", 4.0, 4.0, 41, seeded=False), graded=False)
+    assert not_drawn.startswith("[self-check] ") and "41" not in not_drawn
