@@ -79,16 +79,6 @@ def _controlling_terminal() -> None:
     fcntl.ioctl(0, termios.TIOCSCTTY, 0)
 
 
-def _start_in_a_pty(domain_id: int) -> tuple[subprocess.Popen, int]:
-    """The terminal tool in a pty of its own; the pty's side of the test."""
-    main, child = pty.openpty()
-    process = subprocess.Popen([str(ROS2), "run", "teleop_twist_keyboard", "teleop_twist_keyboard"],
-                               env=rosenv.ros_environment(domain_id), stdin=child, stdout=child, stderr=child,
-                               start_new_session=True, preexec_fn=_controlling_terminal)
-    os.close(child)
-    return process, main
-
-
 def test_a_key_typed_between_two_reads_is_read_not_flushed():
     """The tool reads in raw mode only while it waits for a key; a key typed before that (a Ctrl-C
     right after a key that moved the robot) must be the next key read. With tty.setraw's default
@@ -108,78 +98,82 @@ def test_a_key_typed_between_two_reads_is_read_not_flushed():
     assert keys == ["u"]
 
 
-def _press_until(main: int, executor, heard: list, key: str, condition) -> bool:
-    """Press `key` again until the twist it publishes arrives (the first may go out before the
-    publisher has matched this subscriber: a key press is not stored)."""
-    def done():
-        os.write(main, key.encode())
-        executor.spin_once(timeout_sec=0.2)
-        return bool(heard) and condition(heard[-1])
-    return wait_until(done)
+class TerminalTool:
+    """The terminal tool in a pty of its own (`terminal`: the pty's other side), and a node of the
+    test's that hears /cmd_vel (`heard`); `seen`: what the tool printed so far."""
 
+    def __init__(self, domain_id: int):
+        self.terminal, child = pty.openpty()
+        self.process = subprocess.Popen(
+            [str(ROS2), "run", "teleop_twist_keyboard", "teleop_twist_keyboard"],
+            env=rosenv.ros_environment(domain_id), stdin=child, stdout=child, stderr=child,
+            start_new_session=True, preexec_fn=_controlling_terminal)
+        os.close(child)
+        self.context = rclpy.Context()
+        rclpy.init(context=self.context, domain_id=domain_id)
+        self.heard, self.seen = [], []
+        self.node = Node("cmd_vel_reader", context=self.context)
+        self.executor = SingleThreadedExecutor(context=self.context)
+        self.node.create_subscription(Twist, "/cmd_vel", self.heard.append, 10)
+        self.executor.add_node(self.node)
 
-def test_the_terminal_tool_in_a_pty_publishes_the_keys_twists_and_stops_on_ctrl_c(domain_id):
-    """About 1.5 CPU-s: one ROS process and a subscriber."""
-    process, main = _start_in_a_pty(domain_id)
-    context = rclpy.Context()
-    rclpy.init(context=context, domain_id=domain_id)
-    heard, seen = [], []
-    node = Node("cmd_vel_reader", context=context)
-    executor = SingleThreadedExecutor(context=context)
-    try:
-        node.create_subscription(Twist, "/cmd_vel", heard.append, 10)
-        executor.add_node(node)
-        assert read_until(main, "currently:\tspeed 0.5\tturn 1.0 ", seen), "".join(seen)
-        assert "Moving around:\n   u    i    o\n   j    k    l\n   m    ,    .\n" in "".join(seen).replace("\r\n", "\n")
+    def read_until(self, words: str) -> bool:
+        return read_until(self.terminal, words, self.seen)
 
-        def press_until(key: str, condition) -> bool:
-            return _press_until(main, executor, heard, key, condition)
+    def press_until(self, key: str, condition) -> bool:
+        """Press `key` again until the twist it publishes arrives (the first may go out before the
+        publisher has matched this subscriber: a key press is not stored)."""
+        def done():
+            os.write(self.terminal, key.encode())
+            self.executor.spin_once(timeout_sec=0.2)
+            return bool(self.heard) and condition(self.heard[-1])
+        return wait_until(done)
 
-        assert press_until("i", lambda t: (t.linear.x, t.angular.z) == (0.5, 0.0))
-        os.write(main, b"q")
-        assert read_until(main, "currently:\tspeed 0.55\tturn 1.1 ", seen)
-        assert press_until("j", lambda t: (t.linear.x, t.angular.z) == (0.0, pytest.approx(1.1)))
-        assert press_until("k", lambda t: (t.linear.x, t.angular.z) == (0.0, 0.0))
-        assert press_until("u", lambda t: t.linear.x == pytest.approx(0.55))
-        os.write(main, b"\x03")  # raw mode: Ctrl-C is a key, and the tool stops the robot as it quits
-        assert wait_until(lambda: process.poll() is not None)
-        assert wait_until(lambda: executor.spin_once(timeout_sec=0.1) or heard[-1].linear.x == 0.0)
-        assert process.returncode == 0
-    finally:
+    def ended_with_a_stop(self) -> bool:
+        """The tool ended with exit code 0, and the last twist heard is a stop."""
+        return (wait_until(lambda: self.process.poll() is not None) and self.process.returncode == 0
+                and wait_until(lambda: self.executor.spin_once(timeout_sec=0.1)
+                               or (self.heard[-1].linear.x, self.heard[-1].angular.z) == (0.0, 0.0)))
+
+    def close(self) -> None:
         # The node leaves the graph now, whatever failed: a later test in this domain must not see it.
-        executor.shutdown()
-        node.destroy_node()
-        rclpy.try_shutdown(context=context)
-        process_tree.stop_group(process, STOP_STEPS)
-        os.close(main)
+        self.executor.shutdown()
+        self.node.destroy_node()
+        rclpy.try_shutdown(context=self.context)
+        process_tree.stop_group(self.process, STOP_STEPS)
+        os.close(self.terminal)
 
 
-def test_ctrl_c_between_two_keys_is_a_sigint_that_ends_the_tool_with_a_stop(domain_id):
+@pytest.fixture
+def tool(domain_id):
+    started = TerminalTool(domain_id)
+    yield started
+    started.close()
+
+
+def test_the_terminal_tool_in_a_pty_publishes_the_keys_twists_and_stops_on_ctrl_c(tool):
+    """About 1.5 CPU-s: one ROS process and a subscriber."""
+    assert tool.read_until("currently:\tspeed 0.5\tturn 1.0 "), "".join(tool.seen)
+    shown = "".join(tool.seen).replace("\r\n", "\n")
+    assert "Moving around:\n   u    i    o\n   j    k    l\n   m    ,    .\n" in shown
+    assert tool.press_until("i", lambda t: (t.linear.x, t.angular.z) == (0.5, 0.0))
+    os.write(tool.terminal, b"q")
+    assert tool.read_until("currently:\tspeed 0.55\tturn 1.1 ")
+    assert tool.press_until("j", lambda t: (t.linear.x, t.angular.z) == (0.0, pytest.approx(1.1)))
+    assert tool.press_until("k", lambda t: (t.linear.x, t.angular.z) == (0.0, 0.0))
+    assert tool.press_until("u", lambda t: t.linear.x == pytest.approx(0.55))
+    os.write(tool.terminal, b"\x03")  # raw mode: Ctrl-C is a key, and the tool stops the robot as it quits
+    assert tool.ended_with_a_stop(), "".join(tool.seen)
+
+
+def test_ctrl_c_between_two_keys_is_a_sigint_that_ends_the_tool_with_a_stop(tool):
     """The terminal is out of raw mode between two keys, so a Ctrl-C typed then is a SIGINT to the
     tool's process group, not a key (a test that types Ctrl-C right after a key meets this now and
     then). About 1.5 CPU-s."""
-    process, main = _start_in_a_pty(domain_id)
-    context = rclpy.Context()
-    rclpy.init(context=context, domain_id=domain_id)
-    heard, seen = [], []
-    node = Node("cmd_vel_reader", context=context)
-    executor = SingleThreadedExecutor(context=context)
-    try:
-        node.create_subscription(Twist, "/cmd_vel", heard.append, 10)
-        executor.add_node(node)
-        assert read_until(main, "currently:\tspeed 0.5\tturn 1.0 ", seen), "".join(seen)
-        assert _press_until(main, executor, heard, "i", lambda t: t.linear.x == 0.5)  # matched both ways
-        os.killpg(process.pid, signal.SIGINT)
-        assert wait_until(lambda: process.poll() is not None), "Ctrl-C between two keys was swallowed"
-        assert process.returncode == 0
-        assert wait_until(lambda: executor.spin_once(timeout_sec=0.1) or bool(heard))
-        assert heard[-1].linear.x == 0.0 and heard[-1].angular.z == 0.0
-    finally:
-        executor.shutdown()
-        node.destroy_node()
-        rclpy.try_shutdown(context=context)
-        process_tree.stop_group(process, STOP_STEPS)
-        os.close(main)
+    assert tool.read_until("currently:\tspeed 0.5\tturn 1.0 "), "".join(tool.seen)
+    assert tool.press_until("i", lambda t: t.linear.x == 0.5)  # matched both ways
+    os.killpg(tool.process.pid, signal.SIGINT)
+    assert tool.ended_with_a_stop(), "".join(tool.seen)
 
 
 @pytest.fixture
