@@ -25,6 +25,7 @@ from __future__ import annotations
 import argparse
 import itertools
 import os
+import signal
 import sys
 import threading
 import time
@@ -234,6 +235,23 @@ class Service:
                                   "details.")
 
 
+def _stop_on_signals(loop) -> None:
+    """SIGINT and SIGTERM stop `loop` (a tornado IOLoop) through its own wake-up pipe (asyncio's
+    add_signal_handler), whenever they come. A KeyboardInterrupt could not: the loop waits in
+    select() with nothing scheduled, and a signal that came just before that call (or to another
+    thread) raised nothing until select returned, which was never (a stopped service hung)."""
+    for number in (signal.SIGINT, signal.SIGTERM):
+        loop.asyncio_loop.add_signal_handler(number, loop.stop)
+
+
+def _keyboard_interrupt_on_signals(loop) -> None:
+    """After `loop`: SIGINT and SIGTERM raise KeyboardInterrupt again (a second signal cuts the
+    wait for the runs still going short)."""
+    for number in (signal.SIGINT, signal.SIGTERM):
+        loop.asyncio_loop.remove_signal_handler(number)
+        signal.signal(number, signal.default_int_handler)
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="python -m coursehub.grading_service", description=__doc__.split("\n")[0])
     parser.add_argument("--hub-dir", type=Path, default=Path(os.environ.get(course_settings.HUB_DIR_ENV,
@@ -241,8 +259,6 @@ def main(argv=None) -> int:
     parser.add_argument("--workers", type=int, help="submissions graded at the same time (default: "
                         f"c.GradeOnSubmit.workers in the course's nbgrader_config.py, else {config.SUBMIT_WORKERS})")
     args = parser.parse_args(argv)
-    import signal
-
     from tornado import ioloop
 
     from autograder.grading import fork_server, work_folders
@@ -258,19 +274,27 @@ def main(argv=None) -> int:
                  "restarted.")
             workers = config.SUBMIT_WORKERS
     service = Service(course, workers=max(1, workers), rules_file=course.submit_rules)
-    # The hub stops its services with SIGINT, then SIGTERM: either ends the loop below.
+    # The hub stops its services with SIGINT, then SIGTERM: either ends the service, also one
+    # started with SIGINT ignored. Until the loop below has them, they raise KeyboardInterrupt.
+    signal.signal(signal.SIGINT, signal.default_int_handler)
     signal.signal(signal.SIGTERM, signal.default_int_handler)
     # Before the service's threads: the gradings' sandboxed programs are forked from it.
     with fork_server.serving(wait=STOP_SECONDS):
+        loop = None
         try:
+            loop = ioloop.IOLoop.current()
+            _stop_on_signals(loop)
             service.start()
             prefix = os.environ.get("JUPYTERHUB_SERVICE_PREFIX", f"/{course_settings.GRADING_PAGE}")
             grading_status.application(service.queue, prefix).listen(course.grading_port, "127.0.0.1")
             _log(f"grading {', '.join(service.rules()) or 'nothing yet (c.GradeOnSubmit.assignments)'} on "
                  f"submission with {service.workers} worker(s); status at {prefix} (127.0.0.1:{course.grading_port})")
-            ioloop.IOLoop.current().start()
+            loop.start()
         except KeyboardInterrupt:
             pass
+        finally:
+            if loop is not None:
+                _keyboard_interrupt_on_signals(loop)
         service.stopping.set()
     # The gradings cut short (queued again at the next start) leave no work folder: the process
     # becomes their remover when its worker threads hold any (autograder.grading.work_folders),

@@ -34,13 +34,13 @@ sys.stdin.read()
 #: interpreter's exit runs atexit functions while daemon threads still run; one that lasts until
 #: the grading has seen its folder go makes that window as wide as it may be.
 SERVICE = """
-import atexit, sys, threading, time
+import atexit, signal, sys, threading, time
 from pathlib import Path
 from types import SimpleNamespace
 from autograder.grading import work_folders
 from coursehub import grading_service, grading_status
 
-saw_it_go, grading = Path(sys.argv[1]), sys.argv[2] == "grading"
+saw_it_go, grading, to_a_thread = Path(sys.argv[1]), sys.argv[2] != "idle", sys.argv[2] == "thread"
 seen = threading.Event()
 
 class Service:
@@ -61,6 +61,9 @@ class Service:
         (work / "submission.ipynb").write_text("{}")
         atexit.register(self.exiting, work)
         print(work, flush=True)
+        if to_a_thread:  # as the kernel may deliver the hub's SIGINT: to this thread, the main one in select()
+            time.sleep(0.5)
+            signal.pthread_kill(threading.get_ident(), signal.SIGINT)
         while (work / "submission.ipynb").exists():  # the grading goes on
             time.sleep(0.01)
         saw_it_go.write_text("a grading saw its folder go, and would record a failure")
@@ -191,17 +194,21 @@ def test_autograder_grade_sweeps_when_it_starts(tmp_path, monkeypatch):
     assert not work.exists()
 
 
-@pytest.mark.parametrize(("stop", "grading"), [(signal.SIGINT, True), (signal.SIGTERM, True), (signal.SIGTERM, False)],
-                         ids=["SIGINT-grading", "SIGTERM-grading", "SIGTERM-idle"])
-def test_the_grading_service_stopped_as_the_hub_stops_it_leaves_no_work_folder(tmp_path, stop, grading):
+@pytest.mark.parametrize(("stop", "mode"), [(signal.SIGINT, "grading"), (signal.SIGTERM, "grading"),
+                                           (signal.SIGTERM, "idle"), (None, "thread")],
+                         ids=["SIGINT-grading", "SIGTERM-grading", "SIGTERM-idle", "SIGINT-to-a-worker-thread"])
+def test_the_grading_service_stopped_as_the_hub_stops_it_leaves_no_work_folder(tmp_path, stop, mode):
     """The hub stops its services with SIGINT, then SIGTERM; a grading in a worker thread then is cut
-    short (the queue grades it again at the next start) and neither sees its folder go nor leaves it."""
+    short (the queue grades it again at the next start) and neither sees its folder go nor leaves it.
+    A signal the kernel hands to a worker thread while the main thread waits in the loop's select()
+    stops the service too (a KeyboardInterrupt waited for select to return, which it never did)."""
     saw_it_go = tmp_path / "saw-it-go"
-    service = _python(SERVICE, tmp_path, str(saw_it_go), "grading" if grading else "idle")
+    service = _python(SERVICE, tmp_path, str(saw_it_go), mode)
     try:
         said = service.stdout.readline().strip()
-        assert Path(said).is_dir() if grading else said == "idle", said
-        service.send_signal(stop)
+        assert Path(said).is_dir() if mode != "idle" else said == "idle", said
+        if stop is not None:
+            service.send_signal(stop)
         assert service.wait(timeout=60) == 0
     finally:
         service.kill()
