@@ -11,6 +11,7 @@ from collections.abc import Callable, Sequence
 import cv2
 import numpy as np
 
+from course_lib.imaging import drawn_cache
 from course_lib.imaging.marker_board import PICTURES, dictionary
 from course_lib.imaging.pictures import draw_cat, draw_dog
 
@@ -32,12 +33,24 @@ class TextureLevels(Sequence):
         self.scales, self.shapes = tuple(scales), tuple(shapes)
         self._make = make
         self._images = dict(enumerate(images))
-        self._lock = threading.Lock()  # the checks of one submission render in threads
+        self._lock = threading.RLock()  # the checks of one submission render in threads
 
     @classmethod
     def of(cls, levels: Sequence[tuple[float, np.ndarray]]) -> TextureLevels:
         """Levels whose images are made already."""
         return cls([s for s, _ in levels], [image.shape for _, image in levels], images=[image for _, image in levels])
+
+    @classmethod
+    def pyramid(cls, scale: float, image: np.ndarray, smallest: int = 64) -> TextureLevels:
+        """`image` at `scale`, then halved (cv2.pyrDown) until at most `smallest` pixels wide; a
+        halving is made when first asked for."""
+        shapes = [image.shape]
+        while shapes[-1][1] > smallest:
+            height, width = shapes[-1][:2]
+            shapes.append(((height + 1) // 2, (width + 1) // 2, *shapes[-1][2:]))
+        levels = cls([scale / 2 ** index for index in range(len(shapes))], shapes,
+                     make=lambda index: cv2.pyrDown(levels[index - 1][1]), images=[image])
+        return levels
 
     def __len__(self) -> int:
         return len(self.scales)
@@ -243,5 +256,24 @@ def default_board() -> Board:
     if _DEFAULT_BOARD is None:
         with _DEFAULT_BOARD_LOCK:
             if _DEFAULT_BOARD is None:
-                _DEFAULT_BOARD = Board()
+                _DEFAULT_BOARD = _kept_default_board()
     return _DEFAULT_BOARD
+
+
+def _kept_default_board() -> Board:
+    """Board() with its pictures and its whole texture mapped from the copy kept on disk
+    (drawn_cache), else drawn, and then kept when this process may."""
+    key = drawn_cache.key("boards.py", "pictures.py", "marker_board.py")
+    kept = drawn_cache.load("default_board", key)
+    if kept is not None and len(kept) > 2:
+        board = Board(cat=kept[0], dog=kept[1])
+        width, height = board.size
+        if kept[2].shape == (height * board.SCALE, width * board.SCALE, 4):
+            board._textures[frozenset()] = TextureLevels.of([(board.SCALE / 2 ** index, image)
+                                                             for index, image in enumerate(kept[2:])])
+            return board
+    board = Board()
+    levels = board.texture()
+    drawn_cache.store("default_board", key, [board.pictures["cat"], board.pictures["dog"],
+                                             *(image for _, image in levels)])
+    return board

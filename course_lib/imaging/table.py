@@ -59,10 +59,7 @@ def _table(board: Board, entropy: list[int]):
         board_box = np.array([-origin[0], -origin[1], -origin[0] + bw, -origin[1] + bh]) * _TABLE_SCALE
         for _ in range(int(rng.integers(40, 60))):
             _clutter_item(texture, rng, board_box)
-        levels = [(_TABLE_SCALE, texture)]
-        while levels[-1][1].shape[1] > 64:
-            levels.append((levels[-1][0] / 2, cv2.pyrDown(levels[-1][1])))
-        _TABLE_CACHE[key] = (TextureLevels.of(levels), origin)
+        _TABLE_CACHE[key] = (TextureLevels.pyramid(_TABLE_SCALE, texture), origin)
     return _TABLE_CACHE[key]
 
 
