@@ -18,7 +18,7 @@ import cv2
 import numpy as np
 
 from course_lib.imaging import scenes
-from course_lib.imaging.boards import Board
+from course_lib.imaging.boards import Board, TextureLevels
 from course_lib.imaging.camera_views import sample_look, sample_pose
 from course_lib.imaging.marker_board import PICTURES
 from course_lib.imaging.photos import _detail, draw_photo
@@ -138,4 +138,4 @@ def _cloth(board: Board, seed: int, kind: str):
     levels = [(0.5, np.clip(texture, 0, 255).astype(np.uint8))]
     while levels[-1][1].shape[1] > 64:
         levels.append((levels[-1][0] / 2, cv2.pyrDown(levels[-1][1])))
-    return levels, origin
+    return TextureLevels.of(levels), origin

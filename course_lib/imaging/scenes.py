@@ -20,7 +20,7 @@ from collections.abc import Sequence
 import cv2
 import numpy as np
 
-from course_lib.imaging.boards import Board, _paste_marker, _square, default_board
+from course_lib.imaging.boards import Board, TextureLevels, _paste_marker, _square, default_board
 from course_lib.imaging.camera_views import (
     Look,
     Pose,
@@ -284,7 +284,7 @@ def _render(board: Board, pose: Pose, look: Look, size, *, missing, occluded, du
     duplicate_truth = []
     for marker_id, origin in zip(duplicates, _sticker_places(board, H, size, len(duplicates)), strict=True):
         sticker = _sticker(marker_id)
-        image = _composite(image, [(4.0, sticker)], to_super @ _translation(*origin), super_size)
+        image = _composite(image, TextureLevels.of([(4.0, sticker)]), to_super @ _translation(*origin), super_size)
         corners = _square(origin[0] + Board.QUIET, origin[1] + Board.QUIET, Board.MARKER)
         duplicate_truth.append((marker_id, _project(_EDGE_TO_CENTRE @ H, corners).astype(np.float32)))
 
@@ -328,28 +328,28 @@ def _warp_levels(levels, to_super, super_size, border=cv2.BORDER_CONSTANT, flags
                                borderValue=outside)
 
 
-def _pick_level(levels, to_super):
+def _pick_level(levels: TextureLevels, to_super):
     """The coarsest level that still has at least one texture pixel per screen pixel everywhere."""
-    texture_h, texture_w = levels[0][1].shape[:2]
-    w, h = texture_w / levels[0][0], texture_h / levels[0][0]
+    texture_h, texture_w = levels.shapes[0][:2]
+    w, h = texture_w / levels.scales[0], texture_h / levels.scales[0]
     probes = np.array([[0, 0], [w, 0], [w, h], [0, h], [w / 2, h / 2]], np.float64)
     base = _project(to_super, probes)
     dx = np.linalg.norm(_project(to_super, probes + [1, 0]) - base, axis=1)
     dy = np.linalg.norm(_project(to_super, probes + [0, 1]) - base, axis=1)
     needed = float(max(dx.max(), dy.max()))
-    chosen = levels[0]
-    for level in levels:
-        if level[0] >= needed:
-            chosen = level
-    return chosen
+    chosen = 0
+    for index, scale in enumerate(levels.scales):
+        if scale >= needed:
+            chosen = index
+    return levels[chosen]
 
 
 def _composite(image: np.ndarray, levels, to_super, super_size) -> np.ndarray:
     """Paste a BGRA texture (a list of levels) through a homography onto image, in place; returns
     image. Only the texture's bounding box (2 pixels more for the interpolated edge) is warped and
     blended: outside it the layer is fully transparent."""
-    scale, texture = levels[0]
-    outline = _project(to_super, _square(0, 0, 1) * [texture.shape[1] / scale, texture.shape[0] / scale])
+    scale, shape = levels.scales[0], levels.shapes[0]
+    outline = _project(to_super, _square(0, 0, 1) * [shape[1] / scale, shape[0] / scale])
     x0, y0 = np.maximum(np.floor(outline.min(axis=0)).astype(int) - 2, 0)
     x1, y1 = np.minimum(np.ceil(outline.max(axis=0)).astype(int) + 3, super_size)
     if x1 <= x0 or y1 <= y0:

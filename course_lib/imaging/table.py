@@ -3,11 +3,12 @@
 from __future__ import annotations
 
 import math
+import threading
 
 import cv2
 import numpy as np
 
-from course_lib.imaging.boards import Board
+from course_lib.imaging.boards import Board, TextureLevels
 
 # --------------------------------------------------------------------------------------------
 # The table
@@ -18,25 +19,28 @@ _TABLE_CACHE: dict = {}
 
 
 _GRAIN: dict = {}
+_GRAIN_LOCK = threading.Lock()  # the checks of a submission render in threads: one grain is drawn once
 
 
 def _wood_grain(size) -> np.ndarray:
     """Brightness pattern of a wooden table top around 1.0 (one channel, float32), the same for
     every table of that size."""
-    if size not in _GRAIN:
-        rng = np.random.default_rng(12345)
-        width, height = size
-        blotches = cv2.resize(rng.normal(0, 1, (6, 8)).astype(np.float32), size, interpolation=cv2.INTER_CUBIC)
-        y = np.arange(height, dtype=np.float32)[:, None]
-        grain = np.sin(y * np.float32(0.2) + 3 * blotches) * 0.5 + rng.normal(0, 0.15, (height, 1)).astype(np.float32)
-        _GRAIN[size] = np.ascontiguousarray(1 + 0.08 * blotches + 0.06 * grain, dtype=np.float32)
-    return _GRAIN[size]
+    with _GRAIN_LOCK:
+        if size not in _GRAIN:
+            rng = np.random.default_rng(12345)
+            width, height = size
+            blotches = cv2.resize(rng.normal(0, 1, (6, 8)).astype(np.float32), size, interpolation=cv2.INTER_CUBIC)
+            y = np.arange(height, dtype=np.float32)[:, None]
+            grain = (np.sin(y * np.float32(0.2) + 3 * blotches) * 0.5
+                     + rng.normal(0, 0.15, (height, 1)).astype(np.float32))
+            _GRAIN[size] = np.ascontiguousarray(1 + 0.08 * blotches + 0.06 * grain, dtype=np.float32)
+        return _GRAIN[size]
 
 
 def _plain_table():
     texture = np.empty((64, 64, 3), np.uint8)
     texture[:] = (96, 118, 140)
-    return [(_TABLE_SCALE, texture)]
+    return TextureLevels.of([(_TABLE_SCALE, texture)])
 
 
 def _table(board: Board, entropy: list[int]):
@@ -55,10 +59,7 @@ def _table(board: Board, entropy: list[int]):
         board_box = np.array([-origin[0], -origin[1], -origin[0] + bw, -origin[1] + bh]) * _TABLE_SCALE
         for _ in range(int(rng.integers(40, 60))):
             _clutter_item(texture, rng, board_box)
-        levels = [(_TABLE_SCALE, texture)]
-        while levels[-1][1].shape[1] > 64:
-            levels.append((levels[-1][0] / 2, cv2.pyrDown(levels[-1][1])))
-        _TABLE_CACHE[key] = (levels, origin)
+        _TABLE_CACHE[key] = (TextureLevels.pyramid(_TABLE_SCALE, texture), origin)
     return _TABLE_CACHE[key]
 
 

@@ -1,0 +1,62 @@
+"""Tests for course_lib.imaging.drawn_cache: the default board is drawn once and then mapped from disk,
+from a copy no one but root or the code's owner can have written."""
+
+import os
+
+import numpy as np
+import pytest
+
+from course_lib.imaging import boards, drawn_cache, scenes
+
+
+@pytest.fixture
+def folder(tmp_path, monkeypatch):
+    """The cache in a folder of its own (the package's stand-in: the tests' tmp_path)."""
+    tmp_path.chmod(0o755)
+    monkeypatch.setattr(drawn_cache, "PACKAGE", tmp_path)
+    monkeypatch.setattr(drawn_cache, "FOLDER", tmp_path / "__pycache__")
+    return tmp_path / "__pycache__"
+
+
+def test_kept_images_come_back_the_same_and_read_only(folder):
+    images = [np.arange(24, dtype=np.uint8).reshape(2, 3, 4), np.full((5, 7, 3), 9, np.uint8)]
+    drawn_cache.store("thing", "k1", images)
+    kept = drawn_cache.load("thing", "k1")
+    assert [k.shape for k in kept] == [i.shape for i in images]
+    assert all(np.array_equal(k, i) for k, i in zip(kept, images, strict=True))
+    assert not kept[0].flags.writeable
+    assert drawn_cache.load("thing", "k2") is None  # drawn by other code: not the same images
+    drawn_cache.store("thing", "k2", images[:1])
+    assert sorted(p.name for p in folder.glob("thing-*")) == ["thing-k2.bin"]  # the old key's copy went
+
+
+@pytest.mark.parametrize("loosen", ["file", "folder"])
+def test_a_copy_that_others_may_write_is_not_read(folder, loosen):
+    """A copy, or its folder, writable by group or others could be a student's: it is not trusted."""
+    drawn_cache.store("thing", "k", [np.zeros((2, 2), np.uint8)])
+    (folder / "thing-k.bin" if loosen == "file" else folder).chmod(0o666 if loosen == "file" else 0o777)
+    assert drawn_cache.load("thing", "k") is None
+
+
+def test_a_copy_of_another_owner_is_neither_read_nor_written(folder, monkeypatch):
+    drawn_cache.store("thing", "k", [np.zeros((2, 2), np.uint8)])
+    monkeypatch.setattr(drawn_cache, "_owners", lambda: {os.geteuid() + 12345})
+    assert drawn_cache.load("thing", "k") is None
+    drawn_cache.store("thing", "other", [np.zeros((2, 2), np.uint8)])
+    assert not (folder / "thing-other.bin").exists()
+
+
+def test_the_default_board_from_a_kept_copy_draws_the_same_frames(folder, monkeypatch):
+    """The first default board is drawn and kept; the next is mapped from the copy, and scenes
+    (with and without markers missing) are the same bytes."""
+    monkeypatch.setattr(drawn_cache, "key", lambda *modules: "test")
+    drawn = boards._kept_default_board()
+    assert (folder / "default_board-test.bin").exists()
+    mapped = boards._kept_default_board()
+    assert not mapped.texture()[0][1].flags.writeable  # mapped, not drawn
+    for name in ("cat", "dog"):
+        assert np.array_equal(drawn.pictures[name], mapped.pictures[name])
+    for seed, missing in ((3, ()), (4, (2, 7))):
+        a = scenes.render_scene(seed, board=drawn, missing_markers=missing)
+        b = scenes.render_scene(seed, board=mapped, missing_markers=missing)
+        assert np.array_equal(a.frame, b.frame)
