@@ -301,7 +301,7 @@ def _drive(ctx: Context, seed: int, parameters: dict | None = None) -> _Record |
     with ctx.probe() as probe:
         sim = _simulator(probe.context, proc, seed, scan_topic, record)
         probe.executor.add_node(sim)
-        probe.node.create_subscription(Marker, MARKER_TOPIC, lambda m: record.markers.append(
+        markers = probe.node.create_subscription(Marker, MARKER_TOPIC, lambda m: record.markers.append(
             (m.header.frame_id, m.pose.position.x, m.pose.position.y)), 100)
         try:
             if not packages.wait_node(ctx, probe, proc, NODE):
@@ -321,8 +321,9 @@ def _drive(ctx: Context, seed: int, parameters: dict | None = None) -> _Record |
             if scan_topic not in record.scan_topics or not record.publishes_cmd_vel:
                 return record
             ctx.waiting_on(f"the robot to stop (simulated time {TIME_LIMIT:g} s at most)")
-            probe.spin_until(lambda: not proc.running() or record.failure or record.stopped() or (
-                record.ticks and record.ticks[-1][0] >= TIME_LIMIT), min(scaled(60.0), ctx.remaining() - 5.0))
+            sim.drive_until(lambda: not proc.running() or record.failure or record.stopped() or (
+                record.ticks and record.ticks[-1][0] >= TIME_LIMIT), min(scaled(60.0), ctx.remaining() - 5.0),
+                listeners=[markers])
             if packages.node_ended(ctx, proc, NODE, "drove to the pillar"):
                 return None
         finally:

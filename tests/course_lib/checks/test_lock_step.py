@@ -17,6 +17,7 @@ from contextlib import contextmanager
 
 import pytest
 import rclpy
+from geometry_msgs.msg import Twist
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.parameter import Parameter
 
@@ -148,3 +149,26 @@ def test_a_controller_that_computes_endlessly_fails_on_processor_time_not_the_wa
         drive(sim, executor)
     assert sim.failure == ("the controller did not answer the scan at 0.20 simulated s (scan 5) within 1 s of "
                            "processor time (an endless loop, or far too much work per scan?)")
+
+
+def test_drive_until_drives_exactly_as_an_executors_spin_and_feeds_its_listeners(domain_id, undisturbed):
+    """drive_until waits on the /cmd_vel subscription, the timers and the check's listeners only
+    (no executor): the same pose after SECONDS, and a listener's callback gets its messages."""
+    with lock_step(domain_id) as (sim, _, _):
+        listener = rclpy.create_node("lock_step_listener", context=sim.context)
+        twists = []
+        subscription = listener.create_subscription(Twist, "cmd_vel", twists.append, 100)
+        try:
+            assert sim.drive_until(lambda: sim.sim.time >= SECONDS - 1e-9 or sim.halted is not None, RUN_BOUND,
+                                   listeners=[subscription])
+            assert sim.failure is None and sim.sim.pose() == undisturbed
+            assert sim.scans - 3 <= len(twists) <= sim.scans  # the last answers may still be on their way
+        finally:
+            listener.destroy_node()
+
+
+def test_drive_until_serves_the_lock_step_timer_that_judges_a_missing_answer(domain_id):
+    with lock_step(domain_id, "--silent-from", "20", backstop=3.0) as (sim, _, _):
+        assert sim.drive_until(lambda: sim.halted is not None, RUN_BOUND)
+    assert sim.failure.startswith("the controller did not answer the scan at 0.95 simulated s (scan 20) within 3 s")
+    assert sim.scans == 20 and sim.sim.time == pytest.approx(0.95)
