@@ -143,8 +143,8 @@ class JudgedSimulator(RobotSimulator):
             for timer in timers:
                 wait_set.add_timer(timer.handle)
             wait_set.wait(round(min(POLL, left) * 1e9))
-            for index, timer in enumerate(timers):
-                if wait_set.is_ready("timer", index) and not timer.is_canceled():
+            for index, timer in enumerate(timers):  # a callback before may have destroyed a pace timer
+                if wait_set.is_ready("timer", index) and timer in self.timers and not timer.is_canceled():
                     timer.handle.call_timer()
                     timer.callback()
                     if condition():
