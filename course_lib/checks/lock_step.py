@@ -20,6 +20,8 @@ its first callback then answers it twice, the same way under any load.
 
 from __future__ import annotations
 
+import time
+
 from course_lib.checks.context import scaled
 from course_lib.checks.student_server import ProcessorTime
 from course_lib.robot.simulator_node import RobotSimulator
@@ -34,6 +36,8 @@ REPLY_BACKSTOP = 30.0
 #: answering the first scan, that scan is sent again (once): it may have gone out while DDS was
 #: still matching the controller's endpoints, and been lost. Later scans go over matched endpoints.
 FIRST_SCAN_RESEND = 2.0
+#: Wall seconds between two looks at the caller's condition while nothing arrives (drive_until).
+POLL = 0.05
 #: A controller that used less than this share of its processor time per scan by the backstop
 #: was waiting; one that used more was computing on a machine too busy to let it finish.
 WAITING_SHARE = 0.25
@@ -109,3 +113,47 @@ class JudgedSimulator(RobotSimulator):
     def fail(self, reason: str) -> None:
         self.failure = reason
         self.halt(reason)
+
+    def drive_until(self, condition, timeout: float, listeners=()) -> bool:
+        """Run the lock-step drive until condition() holds or `timeout` wall seconds pass; returns
+        condition(). It waits on exactly what a tick needs: the /cmd_vel subscription, the node's
+        timers (the lock-step timer: the start, the waiting scan's judge) and `listeners` (the
+        check's own subscriptions, e.g. of the markers), and takes each message straight from its
+        subscription, calling its callback and then looking at condition() again: the same
+        callbacks in the same order as an executor's spin, without its per-spin work (a wait set
+        built anew from every node's entities, a timer for its timeout, a task per callback),
+        which cost more than a tick's 25 MuJoCo steps and four messages."""
+        from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
+
+        subscriptions = [self.cmd_sub, *listeners]
+        end = time.monotonic() + timeout
+        wait_sets = {}  # by the number of timers (a tick the pace holds back has one more)
+        while not condition():
+            left = end - time.monotonic()
+            if left <= 0:
+                return bool(condition())
+            timers = [timer for timer in self.timers if not timer.is_canceled()]
+            if len(timers) not in wait_sets:
+                wait_sets[len(timers)] = _rclpy.WaitSet(len(subscriptions), 0, len(timers), 0, 0, 0,
+                                                        self.context.handle)
+            wait_set = wait_sets[len(timers)]
+            wait_set.clear_entities()
+            for subscription in subscriptions:
+                wait_set.add_subscription(subscription.handle)
+            for timer in timers:
+                wait_set.add_timer(timer.handle)
+            wait_set.wait(round(min(POLL, left) * 1e9))
+            for index, timer in enumerate(timers):  # a callback before may have destroyed a pace timer
+                if wait_set.is_ready("timer", index) and timer in self.timers and not timer.is_canceled():
+                    timer.handle.call_timer()
+                    timer.callback()
+                    if condition():
+                        return True
+            for index, subscription in enumerate(subscriptions):
+                if not wait_set.is_ready("subscription", index):
+                    continue
+                while (taken := subscription.handle.take_message(subscription.msg_type, subscription.raw)) is not None:
+                    subscription.callback(taken[0])
+                    if condition():
+                        return True
+        return True

@@ -194,8 +194,7 @@ class Simulation:
 
     def step(self, seconds: float) -> None:
         """Advance the simulation by `seconds` (rounded to whole MuJoCo steps, at least one)."""
-        for _ in range(max(1, round(seconds / self.timestep))):
-            mujoco.mj_step(self.model, self.data)
+        mujoco.mj_step(self.model, self.data, nstep=max(1, round(seconds / self.timestep)))  # the steps in one call
 
     def pose(self) -> tuple[float, float, float]:
         """base_link's (x, y, yaw) in the world, which is the odom frame: m, m, rad in (-π, π]."""

@@ -39,7 +39,6 @@ import math
 import time
 
 import rclpy
-from builtin_interfaces.msg import Time
 from geometry_msgs.msg import TransformStamped, Twist
 from nav_msgs.msg import Odometry
 from rcl_interfaces.msg import ParameterDescriptor
@@ -54,12 +53,6 @@ from tf2_msgs.msg import TFMessage
 
 from course_lib.robot import husky
 from course_lib.robot.simulation import Laser, Simulation
-
-
-def stamp(seconds: float) -> Time:
-    nanoseconds = round(seconds * 1e9)
-    return Time(sec=nanoseconds // 10**9, nanosec=nanoseconds % 10**9)
-
 
 #: The node's parameters: default and what it sets (``ros2 param describe /robot_simulator NAME``).
 PARAMETERS = {
@@ -110,6 +103,7 @@ class RobotSimulator(Node):
         self._pace_start: tuple[float, float] | None = None  # lock-step: (wall, simulated) when it (re)started
         self._pace_timer = None  # lock-step: the timer of a tick the cap holds back
         self.last_scan: LaserScan | None = None
+        self._state = self._state_messages()
 
         self.clock_pub = self.create_publisher(ClockMessage, "/clock", 10)
         self.tf_pub = self.create_publisher(TFMessage, "/tf", 100)
@@ -235,40 +229,44 @@ class RobotSimulator(Node):
     # --- what the robot publishes ----------------------------------------------------------------
 
     def publish_state(self) -> None:
-        now = stamp(self.now)
-        self.clock_pub.publish(ClockMessage(clock=now))
+        clock, moved, tf, odom, scan = self._state
+        nanoseconds = round(self.now * 1e9)
+        now = clock.clock  # the one stamp of all four messages
+        now.sec, now.nanosec = nanoseconds // 10**9, nanoseconds % 10**9
+        self.clock_pub.publish(clock)
         x, y, yaw = self.sim.pose()
         linear, angular = self.sim.velocity()
-        moved = TransformStamped()
-        moved.header.stamp, moved.header.frame_id, moved.child_frame_id = now, husky.ODOM_FRAME, husky.BASE_FRAME
-        moved.transform.translation.x, moved.transform.translation.y = x, y
-        q = moved.transform.rotation
-        q.x, q.y, q.z, q.w = yaw_quaternion(yaw)
-        self.tf_pub.publish(TFMessage(transforms=[moved]))
-        self.odom_pub.publish(self.odometry(moved, linear, angular))
-        self.last_scan = self.laser_scan(now)
+        translation, rotation = moved.transform.translation, moved.transform.rotation
+        translation.x, translation.y = x, y
+        rotation.x, rotation.y, rotation.z, rotation.w = yaw_quaternion(yaw)
+        self.tf_pub.publish(tf)
+        position, twist = odom.pose.pose.position, odom.twist.twist
+        position.x, position.y = x, y
+        twist.linear.x, twist.angular.z = linear, angular
+        self.odom_pub.publish(odom)
+        scan.ranges = array.array("f", self.sim.scan().tobytes())
+        self.last_scan = scan
         self.scans += 1
-        self.scan_pub.publish(self.last_scan)
+        self.scan_pub.publish(scan)
 
-    def odometry(self, moved: TransformStamped, linear: float, angular: float) -> Odometry:
-        odom = Odometry()
-        odom.header = moved.header
-        odom.child_frame_id = moved.child_frame_id
-        odom.pose.pose.position.x = moved.transform.translation.x
-        odom.pose.pose.position.y = moved.transform.translation.y
+    def _state_messages(self) -> tuple[ClockMessage, TransformStamped, TFMessage, Odometry, LaserScan]:
+        """What publish_state sends, built once and updated in place each tick (building four
+        messages anew cost more than publishing them): /clock's message, whose stamp the others
+        share, the moved transform, /tf's message holding it, the odometry (sharing its rotation)
+        and the scan, all stamped with the simulated time."""
+        clock = ClockMessage()
+        moved, odom = TransformStamped(), Odometry()
+        for message in (moved, odom):
+            message.header.stamp, message.header.frame_id = clock.clock, husky.ODOM_FRAME
+            message.child_frame_id = husky.BASE_FRAME
         odom.pose.pose.orientation = moved.transform.rotation
-        odom.twist.twist.linear.x, odom.twist.twist.angular.z = linear, angular
-        return odom
-
-    def laser_scan(self, now: Time) -> LaserScan:
         laser = self.sim.laser
         scan = LaserScan()
-        scan.header.stamp, scan.header.frame_id = now, husky.LASER_FRAME
+        scan.header.stamp, scan.header.frame_id = clock.clock, husky.LASER_FRAME
         scan.angle_min, scan.angle_max, scan.angle_increment = laser.angle_min, laser.angle_max, laser.angle_increment
         scan.scan_time = 1.0 / self.scan_rate
         scan.range_min, scan.range_max = laser.range_min, laser.range_max
-        scan.ranges = array.array("f", self.sim.scan().tobytes())
-        return scan
+        return clock, moved, TFMessage(transforms=[moved]), odom, scan
 
     def laser_transform(self) -> TransformStamped:
         mount = TransformStamped()

@@ -218,11 +218,11 @@ def _find_hint(got, expected) -> str:
 
 class _Record:
     """What one lock-step drive showed: per tick the truth, per /cmd_vel the command and the
-    nearest return of the scan it answers, the markers, the node's endpoints."""
+    scan it answers, the markers, the node's endpoints."""
 
     def __init__(self):
         self.ticks: list[tuple[float, float, float, bool]] = []  # time, laser to surface, speed, touching
-        self.commands: list[tuple[float, float, tuple | None]] = []  # linear, angular, nearest return
+        self.commands: list[tuple[float, float, tuple]] = []  # linear, angular, the scan it answers
         self.markers: list[tuple[str, float, float]] = []  # frame, x, y
         self.scan = None  # the last scan published: (ranges, angle_min, angle_increment)
         self.pillar = (0.0, 0.0)
@@ -260,18 +260,15 @@ def _simulator(context, proc, seed: int, scan_topic: str, record: _Record):
     from course_lib.checks.lock_step import JudgedSimulator
 
     class GradedSimulator(JudgedSimulator):
-        def laser_scan(self, now):
-            scan = super().laser_scan(now)
-            record.scan = (np.frombuffer(scan.ranges, dtype=np.float32), scan.angle_min, scan.angle_increment)
-            return scan
-
         def publish_state(self):
             super().publish_state()
+            scan = self.last_scan  # its ranges are a new array every tick
+            record.scan = (np.frombuffer(scan.ranges, dtype=np.float32), scan.angle_min, scan.angle_increment)
             record.tick(self.sim)
 
         def on_cmd_vel(self, msg):
             if self.awaiting_reply_since is not None and record.scan is not None:
-                record.commands.append((msg.linear.x, msg.angular.z, _nearest(*record.scan)))
+                record.commands.append((msg.linear.x, msg.angular.z, record.scan))
             super().on_cmd_vel(msg)
 
         def fail(self, reason):
@@ -301,7 +298,7 @@ def _drive(ctx: Context, seed: int, parameters: dict | None = None) -> _Record |
     with ctx.probe() as probe:
         sim = _simulator(probe.context, proc, seed, scan_topic, record)
         probe.executor.add_node(sim)
-        probe.node.create_subscription(Marker, MARKER_TOPIC, lambda m: record.markers.append(
+        markers = probe.node.create_subscription(Marker, MARKER_TOPIC, lambda m: record.markers.append(
             (m.header.frame_id, m.pose.position.x, m.pose.position.y)), 100)
         try:
             if not packages.wait_node(ctx, probe, proc, NODE):
@@ -321,8 +318,9 @@ def _drive(ctx: Context, seed: int, parameters: dict | None = None) -> _Record |
             if scan_topic not in record.scan_topics or not record.publishes_cmd_vel:
                 return record
             ctx.waiting_on(f"the robot to stop (simulated time {TIME_LIMIT:g} s at most)")
-            probe.spin_until(lambda: not proc.running() or record.failure or record.stopped() or (
-                record.ticks and record.ticks[-1][0] >= TIME_LIMIT), min(scaled(60.0), ctx.remaining() - 5.0))
+            sim.drive_until(lambda: not proc.running() or record.failure or record.stopped() or (
+                record.ticks and record.ticks[-1][0] >= TIME_LIMIT), min(scaled(60.0), ctx.remaining() - 5.0),
+                listeners=[markers])
             if packages.node_ended(ctx, proc, NODE, "drove to the pillar"):
                 return None
         finally:
@@ -480,7 +478,8 @@ def parameters(ctx: Context) -> None:
     ctx.note(f"the node ran with --params-file <yours> -p {given}")
     if not _endpoint_items(ctx, record, values["scan_topic"], weight=1.0) or not record.ticks:
         return _consequences(ctx, "the simulator waits for a node on the scan topic and /cmd_vel", later)
-    answered = [(lin, ang, _law(values, nearest)) for lin, ang, nearest in record.commands if nearest is not None]
+    nearest = [(lin, ang, _nearest(*scan)) for lin, ang, scan in record.commands]  # only this check reads it
+    answered = [(lin, ang, _law(values, near)) for lin, ang, near in nearest if near is not None]
     wrong = [(lin, ang, want) for lin, ang, want in answered
              if abs(lin - want[0]) > 0.01 + 0.02 * abs(want[0]) or abs(ang - want[1]) > 0.01 + 0.02 * abs(want[1])]
     share = 1 - len(wrong) / len(answered) if answered else 0.0

@@ -19,6 +19,7 @@ import pytest
 import rclpy
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.parameter import Parameter
+from sensor_msgs.msg import LaserScan
 
 from course_lib import contract
 from course_lib.checks.lock_step import JudgedSimulator
@@ -32,14 +33,16 @@ SEED, SECONDS = 4, 3.0
 
 
 @contextmanager
-def lock_step(domain_id: int, *controller_args: str, judged: bool = True, **options):
-    """(simulator node, controller process, executor): the pillar world of SEED in lock-step."""
+def lock_step(domain_id: int, *controller_args: str, judged: bool = True, parameters: dict | None = None, **options):
+    """(simulator node, controller process, executor): the pillar world of SEED in lock-step, with
+    the node's `parameters` (a judged simulator's)."""
     path = os.pathsep.join(filter(None, [str(TESTS), os.environ.get("PYTHONPATH")]))
     proc = NodeProcess([sys.executable, "-m", "support.controller", *controller_args], domain_id=domain_id,
                        env={"PYTHONPATH": path}, cwd=TESTS).start()
     context = rclpy.Context()
     rclpy.init(context=context, domain_id=domain_id)
-    overrides = [Parameter("world", value="pillar"), Parameter("seed", value=SEED)]
+    overrides = [Parameter(name, value=value) for name, value in
+                 {"world": "pillar", "seed": SEED, **(parameters or {})}.items()]
     if judged:
         sim = JudgedSimulator(proc, context=context, parameter_overrides=overrides, **options)
     else:
@@ -148,3 +151,41 @@ def test_a_controller_that_computes_endlessly_fails_on_processor_time_not_the_wa
         drive(sim, executor)
     assert sim.failure == ("the controller did not answer the scan at 0.20 simulated s (scan 5) within 1 s of "
                            "processor time (an endless loop, or far too much work per scan?)")
+
+
+def test_drive_until_drives_exactly_as_an_executors_spin_and_feeds_its_listeners(domain_id, undisturbed):
+    """drive_until waits on the /cmd_vel subscription, the timers and the check's listeners only
+    (no executor): the same pose after SECONDS, and a listener's callback gets every message."""
+    with lock_step(domain_id) as (sim, _, _):
+        listener = rclpy.create_node("lock_step_listener", context=sim.context)
+        scans = []
+        subscription = listener.create_subscription(LaserScan, "scan", scans.append, 1000)
+        try:
+            assert sim.drive_until(lambda: sim.sim.time >= SECONDS - 1e-9 or sim.halted is not None, RUN_BOUND,
+                                   listeners=[subscription])
+            assert sim.failure is None and sim.sim.pose() == undisturbed
+            # The scans reach the listener through DDS's transport, on a busy machine some way
+            # behind: the rest arrive while the drive goes on.
+            published = sim.scans
+            assert sim.drive_until(lambda: len(scans) >= published, RUN_BOUND, listeners=[subscription])
+            stamps = [round(m.header.stamp.sec + m.header.stamp.nanosec * 1e-9, 2) for m in scans[:published]]
+            assert stamps == [round(i * 0.05, 2) for i in range(published)]
+        finally:
+            listener.destroy_node()
+
+
+def test_drive_until_serves_the_lock_step_timer_that_judges_a_missing_answer(domain_id):
+    with lock_step(domain_id, "--silent-from", "20", backstop=3.0) as (sim, _, _):
+        assert sim.drive_until(lambda: sim.halted is not None, RUN_BOUND)
+    assert sim.failure.startswith("the controller did not answer the scan at 0.95 simulated s (scan 20) within 3 s")
+    assert sim.scans == 20 and sim.sim.time == pytest.approx(0.95)
+
+
+def test_drive_until_keeps_the_pace_of_max_real_time_factor_and_drives_the_same(domain_id, undisturbed):
+    """A capped pace holds a tick back with a timer of its own, which drive_until serves too: never
+    faster than the cap (a one-sided bound, which a busy machine cannot break)."""
+    with lock_step(domain_id, parameters={"max_real_time_factor": 2.0}) as (sim, _, _):
+        started = time.monotonic()
+        assert sim.drive_until(lambda: sim.sim.time >= SECONDS - 1e-9 or sim.halted is not None, RUN_BOUND)
+        assert time.monotonic() - started >= SECONDS / 2.0 - 0.05
+        assert sim.failure is None and sim.sim.pose() == undisturbed
