@@ -63,7 +63,7 @@ class JudgedSimulator(RobotSimulator):
         self.backstop = scaled(REPLY_BACKSTOP) if backstop is None else backstop
         self.failure: str | None = None
         self._spent: ProcessorTime | None = None  # the controller's processor time on the waiting scan
-        self._resent = False
+        self.resent = False  # the first scan was sent again (see FIRST_SCAN_RESEND)
         # Nobody sets its parameters or asks for its types while a check runs: seven services fewer
         # for every spin to look at.
         overrides = [*options.pop("parameter_overrides", []), Parameter("lock_step", value=True),
@@ -98,8 +98,8 @@ class JudgedSimulator(RobotSimulator):
         if spent.used_up():
             self.fail(f"the controller did not answer {scan} within {self.reply_cpu_seconds:g} s of processor "
                       "time (an endless loop, or far too much work per scan?)")
-        elif self.scans == 1 and not self._resent and spent.waits_after(FIRST_SCAN_RESEND):
-            self._resent = True
+        elif self.scans == 1 and not self.resent and spent.waits_after(FIRST_SCAN_RESEND):
+            self.resent = True
             self.scan_pub.publish(self.last_scan)
         elif waited > self.backstop:
             used = self.controller.cpu_seconds() - spent.start
