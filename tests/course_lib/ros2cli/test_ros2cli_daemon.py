@@ -148,9 +148,13 @@ def test_parallel_domains_get_daemons_of_their_own(domain):
 
 
 #: A notebook's session with its tool node, until Ctrl-C: prints the tool node's name once it runs.
-SESSION = ("import signal\nfrom course_lib.ros import session\nsession.start()\n"
-           "print(session.tool_node().get_name(), flush=True)\ntry:\n    signal.pause()\nexcept KeyboardInterrupt:\n"
-           "    session.stop()\n")
+#: SIGINT gets a handler of its own (a test run started with `&` by a script passes it on ignored,
+#: and signal.pause() then slept through it until the test's 60 s ran out) and is blocked in every
+#: thread and awaited by the main one (pause() sleeps on when a session thread takes the signal).
+SESSION = ("import signal\nfrom course_lib.ros import session\n"
+           "signal.signal(signal.SIGINT, signal.default_int_handler)\n"
+           "signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})\nsession.start()\n"
+           "print(session.tool_node().get_name(), flush=True)\nsignal.sigwait({signal.SIGINT})\nsession.stop()\n")
 
 
 def node_list_showing(names, args, env):
