@@ -278,7 +278,9 @@ def main(argv=None) -> int:
                  "restarted.")
             workers = config.SUBMIT_WORKERS
     service = Service(course, workers=max(1, workers), rules_file=course.submit_rules)
-    # The hub stops its services with SIGINT, then SIGTERM: either ends the loop below.
+    # The hub stops its services with SIGINT, then SIGTERM: either ends the loop below, also where
+    # SIGINT came ignored (a service started with & by a script), as ros2 launch does.
+    signal.signal(signal.SIGINT, signal.default_int_handler)
     signal.signal(signal.SIGTERM, signal.default_int_handler)
     # Before the service's threads: the gradings' sandboxed programs are forked from it.
     with fork_server.serving(wait=STOP_SECONDS):
