@@ -154,7 +154,7 @@ test: setup browser-deps hub-deps
 CHECK_MARKERS ?= not slow and not browser and not hub
 check: setup
 	$(PY) -m ruff check .
-	env -u PYTHONDONTWRITEBYTECODE $(PY) -m pytest -n $(TEST_WORKERS) --dist loadfile -p no:nbmake -m "$(CHECK_MARKERS)" $(PYTEST_ARGS); status=$$?; \
+	env -u PYTHONDONTWRITEBYTECODE $(PY) -m pytest -n $(TEST_WORKERS) --dist loadfile --no-loadscope-reorder -p no:nbmake -m "$(CHECK_MARKERS)" $(PYTEST_ARGS); status=$$?; \
 	PATH="$(VENV)/bin:$$PATH" fastdds shm clean >/dev/null 2>&1; exit $$status
 
 clean:

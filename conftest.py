@@ -81,7 +81,7 @@ def domain_id():
 #: The test files that take longest (whole grading runs, JupyterLab in Chromium), longest first
 #: (a folder ending in "/" stands for its files):
 #: a long file started last ends the suite last. With `--dist loadfile` xdist hands out files in
-#: collection order only under `--no-loadscope-reorder` (the Makefile passes it); by default it
+#: collection order only under `--no-loadscope-reorder` (make test and make check pass it); by default it
 #: hands out the files with the most tests first (tests/course_lib/launch/test_launch_parser.py), and
 #: the hub and the lessons in Chromium started 7-8 minutes into an 11-minute run.
 LONGEST_FIRST = (
@@ -95,6 +95,13 @@ LONGEST_FIRST = (
     "tests/assignments/test_autograder.py",
     "tests/lessons/test_lesson_commands.py",
     "tests/assignments/test_autograder_pipeline.py",
+    # make check's longest (the files above are left out of it)
+    "tests/course_lib/imaging/test_photos.py",
+    "tests/course_lib/ros2cli/test_ros2cli.py",
+    "tests/course_lib/ros2cli/test_ros2cli_daemon.py",
+    "tests/course_lib/checks/test_lock_step.py",
+    "tests/course_lib/imaging/test_scenes.py",
+    "tests/course_lib/ros2cli/test_ros2cli_service.py",
 )
 
 

@@ -4,12 +4,10 @@ and not called again, answers kept across a crash."""
 
 from __future__ import annotations
 
-import time
-
 import numpy as np
 import pytest
 
-from course_lib.checks import context
+from course_lib.checks import context, student_server
 from course_lib.checks.context import Context, StudentError
 from course_lib.checks.registry import get_check
 from course_lib.checks.student_server import ProcessorTime, StudentServers
@@ -119,23 +117,42 @@ def test_an_import_that_never_ends_is_marked_for_later_checks(tmp_path, monkeypa
         ctx.close()
 
 
-class _Using:
-    """A stand-in for a NodeProcess whose tree uses `share` of a core from now on."""
+class _Clock:
+    """student_server's monotonic clock, moved on by the test: ProcessorTime's window passes at once."""
 
-    def __init__(self, share: float):
-        self.share, self.start = share, time.monotonic()
+    def __init__(self):
+        self.now = 1000.0
+
+    def monotonic(self) -> float:
+        return self.now
+
+
+@pytest.fixture
+def clock(monkeypatch):
+    fake = _Clock()
+    monkeypatch.setattr(student_server, "time", fake)
+    return fake
+
+
+class _Using:
+    """A stand-in for a NodeProcess whose tree uses `share` of a core from now on (by `clock`)."""
+
+    def __init__(self, share: float, clock: _Clock):
+        self.share, self.clock, self.start = share, clock, clock.monotonic()
 
     def cpu_seconds(self) -> float:
-        return self.share * (time.monotonic() - self.start)
+        return self.share * (self.clock.monotonic() - self.start)
 
 
 @pytest.mark.parametrize("share, waits", [(0.0, True), (0.01, True), (0.1, False), (1.0, False)])
-def test_a_process_waits_when_it_uses_next_to_no_processor_time(share, waits):
+def test_a_process_waits_when_it_uses_next_to_no_processor_time(share, waits, clock):
     """A process that gets a tenth of a core (ten busy processes per core) still computes; an idle
     rclpy node's hundredth of one is waiting. Nothing is said before a whole window was seen."""
-    spent = ProcessorTime(_Using(share), budget=None)
+    spent = ProcessorTime(_Using(share, clock), budget=None)
     assert not spent.waiting()
-    time.sleep(ProcessorTime.WAITING_WINDOW + 0.2)
+    clock.now += ProcessorTime.WAITING_WINDOW - 0.1
+    assert not spent.waiting(), "less than a whole window seen"
+    clock.now += 0.3
     assert spent.waiting() == waits and not spent.used_up()
 
 
@@ -143,12 +160,14 @@ class _Ended(_Using):
     """A stand-in for a NodeProcess that computed and has just ended: its tree's time reads 0."""
 
     def cpu_seconds(self) -> float:
-        return 0.0 if time.monotonic() - self.start > ProcessorTime.WAITING_WINDOW else super().cpu_seconds()
+        return 0.0 if self.clock.monotonic() - self.start > ProcessorTime.WAITING_WINDOW else super().cpu_seconds()
 
 
-def test_a_process_that_has_just_ended_is_not_waiting():
+def test_a_process_that_has_just_ended_is_not_waiting(clock):
     """Its processor time reads 0 once it is gone, while its supervisor may not have said so yet: a
     self-check took a node that computed and then crashed for one waiting without an answer."""
-    spent = ProcessorTime(_Ended(1.0), budget=None)
-    time.sleep(ProcessorTime.WAITING_WINDOW + 0.2)
+    computed = _Ended(1.0, clock)
+    clock.now += 0.5  # it has computed for a while when the wait on it starts
+    spent = ProcessorTime(computed, budget=None)
+    clock.now += ProcessorTime.WAITING_WINDOW
     assert not spent.waiting()
