@@ -48,7 +48,10 @@ _PR_SET_PDEATHSIG = 1
 _PR_SET_CHILD_SUBREAPER = 36
 
 #: Seconds between two counts of the child's processes and threads against config["max_tasks"].
-TASKS_EVERY = 0.2
+TASKS_EVERY = 0.1
+#: A user's processes and threads are counted one process after the other while they fork and end:
+#: a count within this share of the limit is taken for the limit.
+TASKS_SLACK = 1 / 32
 
 
 
@@ -223,7 +226,7 @@ class _Supervisor:
             uid = os.stat(f"/proc/{self.child.pid}").st_uid
         except OSError:
             return
-        if uid != 0 and process_tree.uid_tasks(uid) >= max_tasks:  # root has no such limit
+        if uid != 0 and process_tree.uid_tasks(uid) >= max_tasks * (1 - TASKS_SLACK):  # root has no such limit
             self.reason, self.count_at = "max_processes", None
             process_tree.signal_tree(self.child.pid, signal.SIGKILL)
 
