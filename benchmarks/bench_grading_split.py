@@ -20,13 +20,15 @@ it: the same kernel launcher running no cell, then the submission's cells alone 
 grading's flags), and a process that imports rclpy (and one that also makes a node).
 
     .venv/bin/python benchmarks/bench_grading_split.py [--assignment A ...] [--period 0.05] [--before DIR]
-                                                       [--rounds N]
+                                                       [--rounds N] [--zoo ENTRY ...]
 
 With ``--before DIR`` (a checkout of another commit, e.g. ``git worktree add DIR HEAD~3``) every
 command also runs with DIR's grader and course_lib (PYTHONPATH=DIR) on the same submissions, the
 two alternating per assignment, and each assignment gets a column "A (before)" beside "A": a change
 measured side by side in one run. With ``--rounds N`` each column is graded N times (the columns
-alternating in every round) and each row shows the median.
+alternating in every round) and each row shows the median. ``--zoo ENTRY`` also hands in the brightness
+zoo's submission ENTRY (tests/support/zoo/brightness.py, e.g. fork_bomb) and grades it as a column
+"brightness: ENTRY" of its own (no floor: its cells are the student's, run nowhere but in the sandbox).
 
 Per assignment (and tree) it prints CPU-seconds per row (rows that are 0 everywhere are left out), what the
 samples saw, the command's wait4 total, the machine's busy time meanwhile, the wall time and the
@@ -60,6 +62,7 @@ from course_lib import contract  # noqa: E402
 from course_lib.checks import assignments  # noqa: E402
 from course_lib.supervision import process_tree  # noqa: E402
 from tests.support import zoo  # noqa: E402 (it builds submissions from the reference solutions)
+from tests.support.zoo import brightness as brightness_zoo  # noqa: E402
 
 ASSIGNMENTS = list(assignments.ASSIGNMENTS)
 GRADER = "grader main thread"
@@ -280,11 +283,11 @@ def load() -> str:
     return open("/proc/loadavg").read().split()[0]
 
 
-def _score(course: Path, assignment: str) -> str:
-    """student0's score of `assignment` in the course's grades.csv (written by every grade command)."""
+def _score(course: Path, assignment: str, student: str = "student0") -> str:
+    """The student's score of `assignment` in the course's grades.csv (written by every grade command)."""
     with open(course / "grades.csv", newline="") as handle:
         for row in csv.DictReader(handle):
-            if row["assignment"] == assignment and row["student_id"] == "student0":
+            if row["assignment"] == assignment and row["student_id"] == student:
                 return f"{float(row['raw_score']):g}/{float(row['max_score']):g}"
     return "?"
 
@@ -295,8 +298,11 @@ def main(argv=None) -> int:
     parser.add_argument("--period", type=float, default=0.05, help="seconds between samples of /proc")
     parser.add_argument("--before", type=Path, help="a checkout of another commit, measured beside this one")
     parser.add_argument("--rounds", type=int, default=1, help="gradings per column; each row shows their median")
+    parser.add_argument("--zoo", action="append", default=[], help="a brightness zoo entry graded beside them")
     args = parser.parse_args(argv)
     chosen = args.assignment or ASSIGNMENTS
+    # (column, assignment, student): the references, then the zoo's entries
+    subjects = [(a, a, "student0") for a in chosen] + [(f"brightness: {e}", "brightness", e) for e in args.zoo]
     trees = {"": ROOT, **({" (before)": args.before.resolve()} if args.before else {})}
     envs = {}
     for suffix, tree in trees.items():
@@ -307,34 +313,35 @@ def main(argv=None) -> int:
     cli = [sys.executable, "-m", "autograder"]
     with tempfile.TemporaryDirectory(prefix="bench-grading-split-") as scratch:
         course = Path(scratch) / "course"
-        release.release(course, chosen)
-        for assignment in chosen:
-            zoo.submit(course, "student0", assignment)
+        release.release(course, sorted({assignment for _, assignment, _ in subjects}))
+        zoo_entries = brightness_zoo.entries(str(course))
+        for _, assignment, student in subjects:
+            zoo.submit(course, student, assignment, zoo_entries[student]["edits"] if student in args.zoo else ())
         grade.grade(course, progress=False, force=True)  # the caches every grading below reuses
         for suffix in trees:  # the other tree's caches, if its builds key them otherwise
             if suffix:
                 subprocess.run([*cli, "grade", str(course), "--force"], env=envs[suffix], check=True,
                                stdout=subprocess.DEVNULL, cwd=trees[suffix])
         for _ in range(args.rounds):
-            for assignment in chosen:
+            for label, assignment, student in subjects:
                 for suffix in sorted(trees, reverse=True):  # the other tree first, then this one
                     # In the tree's own folder: `python -m` puts the working folder before PYTHONPATH.
-                    column, env, tree = assignment + suffix, envs[suffix], trees[suffix]
+                    column, env, tree = label + suffix, envs[suffix], trees[suffix]
                     before = load()
                     split, total, wall = run_sampled([*cli, "grade", str(course), "--assignment", assignment,
-                                                      "--student", "student0", "--force"], env, args.period, tree)
-                    scores[column] = scores.get(column, set()) | {_score(course, assignment)}
+                                                      "--student", student, "--force"], env, args.period, tree)
+                    scores[column] = scores.get(column, set()) | {_score(course, assignment, student)}
                     feedback, feedback_total, _ = run_sampled([*cli, "feedback", str(course), "--assignment",
-                                                               assignment, "--student", "student0"], env, args.period,
+                                                               assignment, "--student", student], env, args.period,
                                                               tree)
                     split[FEEDBACK] = feedback_total
                     runs[column].append((split, total, wall, feedback_total))
-                    if column not in floors:
+                    if column not in floors and student == "student0":
                         floors[column] = floor(course, assignment, Path(scratch), env, args.period, column)
                     loads[column] = loads.get(column, f"{before} → ").split("→")[0] + f"→ {load()}"
         nodes = {name: run_sampled([sys.executable, "-c", code], env, args.period)[1]
                  for name, code in (("import rclpy", "import rclpy"), ("rclpy: init, a node, shutdown", NODE_FLOOR))}
-    columns = [assignment + suffix for assignment in chosen for suffix in sorted(trees, reverse=True)]
+    columns = [label + suffix for label, _, _ in subjects for suffix in sorted(trees, reverse=True)]
     measured = {column: _median(runs[column]) for column in columns}
     scores = {column: ", ".join(sorted(found)) for column, found in scores.items()}
     report(columns, measured, floors, nodes, scores, loads)
@@ -375,9 +382,12 @@ def report(chosen, measured, floors, nodes, scores, loads) -> None:
              "1-min load average, before → after": [loads[a] for a in chosen],
              "score": [scores.get(a, "?") for a in chosen]}
     for title, run in (("no cell", "empty"), ("the submission's cells", "cells")):
-        lines[f"floor, {title}: kernel (the grader's launcher)"] = [f"{floors[a][run][0][KERNEL]:.2f}" for a in chosen]
-        lines[f"floor, {title}: the cells' child processes"] = [f"{floors[a][run][0][CHILDREN]:.2f}" for a in chosen]
-        lines[f"floor, {title}: nbclient driver process"] = [f"{_driver(floors[a][run][0]):.2f}" for a in chosen]
+        lines[f"floor, {title}: kernel (the grader's launcher)"] = [
+            f"{floors[a][run][0][KERNEL]:.2f}" if a in floors else "" for a in chosen]
+        lines[f"floor, {title}: the cells' child processes"] = [
+            f"{floors[a][run][0][CHILDREN]:.2f}" if a in floors else "" for a in chosen]
+        lines[f"floor, {title}: nbclient driver process"] = [
+            f"{_driver(floors[a][run][0]):.2f}" if a in floors else "" for a in chosen]
     for row, cells in lines.items():
         print(f"| {row} | " + " | ".join(cells) + " |")
     print("\nfloor, one process each: " + ", ".join(f"{name} {seconds:.2f} CPU-s" for name, seconds in nodes.items()))

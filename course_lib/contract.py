@@ -105,6 +105,14 @@ MEMORY_MB = 4096
 #: Address space (MB) of each process the checks start for the student. rclpy with Fast DDS maps a
 #: few hundred MB.
 STUDENT_MEMORY_MB = 2048
-#: Processes and threads of the student's uid (RLIMIT_NPROC, root only) in the notebook run, the
-#: build and the checks. A kernel, a check and a node need about 100.
+#: Processes and threads of the student's uid (RLIMIT_NPROC, root only) in the notebook run and the
+#: build. A kernel needs about 16.
 MAX_PROCESSES = 384
+#: The same bound while the checks run the student's code (its functions' server, its nodes):
+#: CHECKS_PROCESSES_BASE + CHECKS_PROCESSES_PER_CORE per core, at most MAX_PROCESSES
+#: (autograder.grading.pipeline.checks_max_processes). The references' checks peak at 68 tasks of the
+#: uid (services_actions; catdog_warp 51, brightness and pillar 31) on 2 cores, and a process that uses
+#: OpenCV's pool adds a thread per core. A fork bomb forks copies of a ROS process up to this bound,
+#: and its cost grows with it (the zoo's fork_bomb, docs/developers.md).
+CHECKS_PROCESSES_BASE = 64
+CHECKS_PROCESSES_PER_CORE = 32

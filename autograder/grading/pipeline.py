@@ -18,7 +18,8 @@ are listed in :data:`STEPS`):
    every test cell "passes").
 4. The hidden checks run in a fresh sandbox of the same kind, as processes
    of the grader (``python -m autograder.grading.hidden_checks_process``, root), against the module the
-   notebook wrote; the student's code they start runs as the worker's uid, with the same limits.
+   notebook wrote; the student's code they start runs as the worker's uid, with the same limits
+   but fewer processes and threads (checks_max_processes).
    Their points replace nbgrader's scores of those cells, and their verdicts (seed, what passed
    and failed, pictures) replace the cells' outputs in the autograded notebook. The workspace is
    built and checked while nbgrader runs the notebook, from the files the notebook is predicted
@@ -186,13 +187,21 @@ def choose_environment(g: Grading) -> None:
              contract.LOAD_FACTOR_ENV: f"{g.budget / GRADING_SECONDS:.2f}"}
     if g.result.isolation == "root":
         g.result.kernel_uid = KERNEL_UID_BASE + g.domain_id
-        uid, nproc = str(g.result.kernel_uid), str(contract.MAX_PROCESSES)
-        g.env.update({contract.KERNEL_UID_ENV: uid, contract.KERNEL_NPROC_ENV: nproc})
-        g.env.update({contract.STUDENT_UID_ENV: uid, contract.STUDENT_NPROC_ENV: nproc})
+        uid = str(g.result.kernel_uid)
+        g.env.update({contract.KERNEL_UID_ENV: uid, contract.KERNEL_NPROC_ENV: str(contract.MAX_PROCESSES)})
+        g.env.update({contract.STUDENT_UID_ENV: uid, contract.STUDENT_NPROC_ENV: str(checks_max_processes())})
         exposure = interpreter_exposure()
         if exposure:
             (work / "stage").mkdir()
             g.env.update(exposure, **{contract.STAGE_ENV: str(work / "stage")})
+
+
+def checks_max_processes(cores: int | None = None) -> int:
+    """Processes and threads the student's uid may have while the checks run its code (RLIMIT_NPROC):
+    contract.CHECKS_PROCESSES_BASE plus CHECKS_PROCESSES_PER_CORE per core of this machine (default:
+    the cores this process may run on), at most contract.MAX_PROCESSES."""
+    cores = len(os.sched_getaffinity(0)) if cores is None else cores
+    return min(contract.MAX_PROCESSES, contract.CHECKS_PROCESSES_BASE + contract.CHECKS_PROCESSES_PER_CORE * cores)
 
 
 def start_early_checks(g: Grading) -> None:

@@ -9,6 +9,7 @@ then neither read nor signal nor trace the check, nor write its results.
 
 from __future__ import annotations
 
+import dataclasses
 import os
 from pathlib import Path
 
@@ -32,6 +33,11 @@ class StudentUid(StudentProcesses):
         if not uid or os.geteuid() != 0:
             return StudentProcesses()
         return cls(int(uid), int(os.environ.get(contract.STUDENT_NPROC_ENV, str(contract.MAX_PROCESSES))))
+
+    def limits(self, wall_seconds: float):
+        """A self-check's bounds; and the tree is killed at once when the uid reaches max_processes
+        (which run_as sets after its switch) and the tree holds at least a quarter of them."""
+        return dataclasses.replace(super().limits(wall_seconds), stop_at_tasks=self.max_processes)
 
     def confine(self, command: list[str], env: dict) -> tuple[list[str], dict, list[Path]]:
         home = run_as.home_for(self.uid)

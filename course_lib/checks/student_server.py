@@ -82,8 +82,15 @@ class StudentServer:
 
         Raises:
             ServerError: no answer: the process ended (timed_out False) or its processor time,
-                its wait or the backstop ran out (timed_out True; the process is then stopped).
+                its wait or the backstop ran out, or its processes reached their limit, now or after
+                the call before (timed_out True; the process is then stopped).
         """
+        if self.proc is not None and not self.proc.running() and self.proc.exit_reason == "max_processes":
+            # Its earlier call answered, then its processes filled the user's limit (a fork bomb):
+            # that, not this call, was the last thing it did; another process would do it again.
+            why = self.proc.describe_exit()
+            self.stop()
+            raise ServerError(f"was not run: the process that served the call before it was {why}", True)
         if self.proc is None or not self.proc.running():
             self.stop()
             self._start(domain_id)
@@ -108,7 +115,8 @@ class StudentServer:
             how = ", waiting rather than computing (a sleep(), spin() or input()?)" if waited else ""
             limit = waiting_after if waited else timeout
             raise ServerError(f"did not return within {limit:.3g} s{how}. Last output:\n{output}", True)
-        raise ServerError(f"ended the process ({proc.describe_exit()}) before returning. Last output:\n{output}", False)
+        raise ServerError(f"ended the process ({proc.describe_exit()}) before returning. Last output:\n{output}",
+                          proc.exit_reason == "max_processes")  # a fork bomb is not called again
 
     def stop(self, grace: float = 1.0) -> None:
         """Stop the process (SIGINT, SIGKILL after `grace` seconds) and remove its job folder."""

@@ -20,6 +20,11 @@ class Limits:
         max_processes: processes *and threads* of the child's user (RLIMIT_NPROC). Fast DDS
             starts about a dozen threads per node. The kernel does not enforce it for root (the
             grader, as root, runs the student's code as another uid: autograder.sandbox.run_as).
+        stop_at_tasks: the processes and threads of the child's user at which its supervisor kills
+            the child's tree at once, when the tree holds at least a quarter of them (exit_reason
+            "max_processes"): the user's RLIMIT_NPROC where another step sets it (the grader's
+            autograder.sandbox.run_as, after its switch of user). At that limit nothing of the user
+            can fork or start a thread any more, and a fork bomb's copies would run on.
         file_size_mb: largest file the child may write (RLIMIT_FSIZE); SIGXFSZ beyond it.
         open_files: open file descriptors (RLIMIT_NOFILE).
         grace_seconds: time between SIGINT and SIGKILL when the wall time runs out.
@@ -29,12 +34,13 @@ class Limits:
     memory_mb: int | None = None
     cpu_seconds: int | None = None
     max_processes: int | None = None
+    stop_at_tasks: int | None = None
     file_size_mb: int | None = None
     open_files: int | None = None
     grace_seconds: float = 2.0
 
     def __post_init__(self):
-        for field in ("wall_seconds", "memory_mb", "cpu_seconds", "max_processes", "file_size_mb",
+        for field in ("wall_seconds", "memory_mb", "cpu_seconds", "max_processes", "stop_at_tasks", "file_size_mb",
                       "open_files"):
             value = getattr(self, field)
             if value is not None and not value > 0:

@@ -87,6 +87,33 @@ def processes_of_uid(uid: int) -> list[int]:
     return found
 
 
+def _task_count(pid: int) -> int:
+    try:
+        return len(os.listdir(f"/proc/{pid}/task"))
+    except OSError:
+        return 0  # gone meanwhile
+
+
+def tree_tasks(pid: int) -> int:
+    """Processes and threads of the descendants of process `pid` (zombies count one), not of `pid`."""
+    return sum(_task_count(child) for child in descendants_of(pid))
+
+
+def uid_tasks(uid: int) -> int:
+    """Processes and threads whose owner is `uid` (zombies count one): what RLIMIT_NPROC counts for
+    that user; read from /proc (a stat per process, a listing per process of the user)."""
+    total = 0
+    for entry in os.listdir("/proc"):
+        if entry.isdigit():
+            try:
+                if os.stat(f"/proc/{entry}").st_uid != uid:
+                    continue
+            except OSError:
+                continue
+            total += _task_count(int(entry))
+    return total
+
+
 def kill_all(find, timeout: float = 5.0) -> int:
     """SIGKILL every process that ``find()`` lists (running ones, zombies left out), again and
     again until it lists none (a process may fork while it is being killed) or `timeout` seconds

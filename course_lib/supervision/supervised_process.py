@@ -62,7 +62,8 @@ class SupervisedProcess:
     Attributes:
         pid: the child's process id (it also leads the child's process group) once started.
         exit_reason: None while running, then "exited" (on its own), "stopped" (stop()),
-            "wall_seconds" (Limits), "parent_exited" or "supervisor_died".
+            "wall_seconds" (Limits), "max_processes" (Limits: its user reached the limit and this
+            tree held at least a quarter of it), "parent_exited" or "supervisor_died".
         usage: after the end, {"max_rss_kb", "cpu_seconds"} of the child (the peak memory
             includes the ~20 MB of the supervisor it was forked from) and the supervisor's own
             "supervisor_max_rss_kb".
@@ -122,7 +123,8 @@ class SupervisedProcess:
             config = {"command": self.command, "cwd": self.cwd, "log_dir": str(self._log_dir),
                       "head_bytes": LOG_HEAD_BYTES, "tail_bytes": LOG_TAIL_BYTES,
                       "rlimits": self.limits.rlimit_pairs(), "wall_seconds": self.limits.wall_seconds,
-                      "grace_seconds": self.limits.grace_seconds, "cleanup": cleanup, "echo_fd": echo_write}
+                      "grace_seconds": self.limits.grace_seconds, "cleanup": cleanup, "echo_fd": echo_write,
+                      "max_tasks": self.limits.stop_at_tasks}
             try:
                 with open(self._log_dir / "supervisor.err", "wb") as errors:
                     self._supervisor = subprocess.Popen(
@@ -228,7 +230,9 @@ class SupervisedProcess:
                 text = f"killed by signal {-code}"
         hints = {"wall_seconds": f" after the wall-time limit of {self.limits.wall_seconds} s",
                  "stopped": " after stop()", "parent_exited": " because its caller exited",
-                 "supervisor_died": " because its supervisor died"}
+                 "supervisor_died": " because its supervisor died",
+                 "max_processes": f" when its user had the most processes and threads it may have "
+                                  f"({self.limits.stop_at_tasks}: a fork() or a thread started in a loop?)"}
         text += hints.get(self.exit_reason, "")
         if code == -signal.SIGXCPU:
             text += f" (CPU time limit of {self.limits.cpu_seconds} s)"

@@ -47,6 +47,12 @@ _ECHO_PIECE = 4000
 _PR_SET_PDEATHSIG = 1
 _PR_SET_CHILD_SUBREAPER = 36
 
+#: Seconds between two counts of the child's processes and threads against config["max_tasks"].
+TASKS_EVERY = 0.1
+#: A user's processes and threads are counted one process after the other while they fork and end:
+#: a count within this share of the limit is taken for the limit.
+TASKS_SLACK = 1 / 32
+
 
 
 def _peak_rss_kb() -> int:
@@ -83,6 +89,7 @@ class _Supervisor:
         self.reason: str | None = None
         self.kill_at: float | None = None
         self.parent_gone = False
+        self.count_at = None if not config.get("max_tasks") else time.monotonic()
 
     def report(self, **event) -> None:
         """Write one event as a JSON line to the status pipe; the caller may have gone."""
@@ -153,7 +160,8 @@ class _Supervisor:
         wall = self.config["wall_seconds"]
         self.wall_deadline = None if wall is None else time.monotonic() + wall
         while os.waitid(os.P_PID, self.child.pid, os.WEXITED | os.WNOHANG | os.WNOWAIT) is None:
-            timeouts = [0.5] + [t - time.monotonic() for t in (self.kill_at, self.wall_deadline) if t is not None]
+            timeouts = [0.5] + [t - time.monotonic() for t in (self.kill_at, self.wall_deadline, self.count_at)
+                                if t is not None]
             for fd, _events in self.poller.poll(max(0, int(min(timeouts) * 1000) + 1)):
                 if fd in self.streams and not self.relay_output(fd):
                     self.poller.unregister(fd)
@@ -199,6 +207,28 @@ class _Supervisor:
         if self.kill_at is not None and time.monotonic() >= self.kill_at:
             process_tree.signal_tree(self.child.pid, signal.SIGKILL)
             self.kill_at = None  # once is enough; SIGCHLD wakes us when it has died
+        if self.count_at is not None and time.monotonic() >= self.count_at:
+            self.count_at = time.monotonic() + TASKS_EVERY
+            self._stop_at_process_limit()
+
+    def _stop_at_process_limit(self) -> None:
+        """SIGKILL the child's tree at once when its user has as many processes and threads as
+        config["max_tasks"] (its RLIMIT_NPROC: no process of that user can fork or start a thread
+        any more) and this tree holds at least a quarter of them: a fork bomb, whose copies would
+        otherwise go on running (a forked ROS node spins in its shared memory) until a check stops
+        them. A quarter, not half: two bombs of one user (the student's function and node) may
+        share the limit. A node needs about 15 (Fast DDS), plus a thread per core for OpenCV's
+        pool. Its exit_reason becomes "max_processes"."""
+        max_tasks = self.config["max_tasks"]
+        if self.reason is not None or process_tree.tree_tasks(self.me) * 4 < max_tasks:
+            return
+        try:
+            uid = os.stat(f"/proc/{self.child.pid}").st_uid
+        except OSError:
+            return
+        if uid != 0 and process_tree.uid_tasks(uid) >= max_tasks * (1 - TASKS_SLACK):  # root has no such limit
+            self.reason, self.count_at = "max_processes", None
+            process_tree.signal_tree(self.child.pid, signal.SIGKILL)
 
     def begin_stop(self, why: str, grace: float) -> None:
         """SIGINT the child's tree on the first stop only, and SIGKILL it after the earliest grace asked for."""

@@ -87,6 +87,23 @@ def test_the_grader_tells_the_checks_its_load_factor(tmp_path):
     assert g.env[contract.LOAD_FACTOR_ENV] == "2.50"
 
 
+def test_the_checks_student_processes_may_start_fewer_tasks_than_the_kernel(tmp_path):
+    """As root, the kernel's uid may have MAX_PROCESSES processes and threads, the checks' student
+    processes checks_max_processes(): what the references' checks need with room to spare, a third
+    of the kernel's on 2 cores, so that a fork bomb in the student's function or node forks a third
+    as many copies of a ROS process (the zoo's fork_bomb)."""
+    from autograder.results.submissions import Submission
+
+    sub = Submission("s", "brightness", tmp_path)
+    g = pipeline.Grading(sub, tmp_path, 0, GradeResult("s", "brightness", "", isolation="root"), tmp_path)
+    pipeline.choose_environment(g)
+    assert g.env[contract.KERNEL_NPROC_ENV] == str(contract.MAX_PROCESSES)
+    assert g.env[contract.STUDENT_NPROC_ENV] == str(pipeline.checks_max_processes())
+    assert pipeline.checks_max_processes(cores=2) == 128
+    assert pipeline.checks_max_processes(cores=2) >= 68 * 1.8  # the references' checks peak at 68 tasks there
+    assert pipeline.checks_max_processes(cores=64) == contract.MAX_PROCESSES
+
+
 def test_an_early_run_still_going_at_the_deadline_is_waited_for_not_dropped(tmp_path, monkeypatch):
     """On a machine busier than the budget allows for, the notebook can end while the early build
     and checks are past the grading's deadline: their verdicts are waited for (their steps bound

@@ -2,6 +2,7 @@
 worker's uid, with a HOME of their own, and can reach the check's ROS shared memory."""
 
 import os
+import time
 
 import pytest
 
@@ -9,6 +10,7 @@ from autograder.sandbox import student_uid
 from autograder.sandbox.student_uid import StudentUid
 from course_lib import contract
 from course_lib.checks.student_processes import StudentProcesses
+from course_lib.supervision import process_tree
 
 needs_root = pytest.mark.skipif(os.geteuid() != 0, reason="running as the student's uid needs root")
 
@@ -30,6 +32,44 @@ def test_the_students_process_runs_as_the_uid_with_a_home_it_owns(tmp_path, monk
     process.wait(timeout=30)
     assert process.log.split() == [str(UID), str(UID), "True", str(UID), "64", str(contract.STUDENT_MEMORY_MB),
                                    "None"], process.log
+
+
+#: Forks children that sleep, and tries again each fork that fails (the system's Python: the uid
+#: cannot enter a virtual environment under root's folders).
+SYSTEM_PYTHON = "/usr/bin/python3"
+BOMB = """
+import os, time
+while True:
+    try:
+        if os.fork() == 0:
+            time.sleep(1000)
+    except BlockingIOError:
+        time.sleep(0.01)
+"""
+
+
+@needs_root
+@pytest.mark.skipif(not os.access(SYSTEM_PYTHON, os.X_OK), reason=f"no {SYSTEM_PYTHON}")
+def test_a_fork_bomb_is_killed_once_the_uid_reaches_its_process_limit():
+    """A tree that fills its uid's process limit is killed at once, its exit says why; without the
+    supervisor's stop it would fork for its whole wall time (60 s)."""
+    process = StudentUid(UID, max_processes=24).start([SYSTEM_PYTHON, "-I", "-S", "-c", BOMB], cwd="/",
+                                                      name="student-test-bomb", domain_id=0, wall_seconds=60)
+    started = time.monotonic()
+    process.wait(timeout=60)
+    assert time.monotonic() - started < 20
+    assert process.exit_reason == "max_processes"
+    assert "most processes and threads it may have (24" in process.describe_exit()
+    assert process_tree.uid_tasks(UID) == 0
+
+
+@needs_root
+def test_a_tree_below_its_uids_process_limit_runs_to_its_end():
+    """Processes and threads well within the limit are left alone (the watch counts, and stops nothing)."""
+    process = StudentUid(UID, max_processes=24).start(["sh", "-c", "sleep 0.3 & sleep 0.3 & sleep 1; wait"],
+                                                      name="student-test-few", cwd="/", domain_id=0, wall_seconds=60)
+    process.wait(timeout=60)
+    assert (process.returncode, process.exit_reason) == (0, "exited")
 
 
 @needs_root

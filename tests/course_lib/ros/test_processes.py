@@ -271,7 +271,7 @@ def test_starting_a_named_process_again_replaces_the_old_one():
         second.stop()
 
 
-@pytest.mark.parametrize("field", ["wall_seconds", "memory_mb", "max_processes"])
+@pytest.mark.parametrize("field", ["wall_seconds", "memory_mb", "max_processes", "stop_at_tasks"])
 def test_limits_refuse_non_positive_values(field):
     with pytest.raises(ValueError, match=f"Limits.{field}.*positive"):
         Limits(**{field: 0})

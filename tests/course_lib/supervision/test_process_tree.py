@@ -124,3 +124,19 @@ def test_cpu_seconds_of_a_process_that_has_gone_is_zero():
     proc = subprocess.Popen([sys.executable, "-S", "-c", "pass"])
     proc.wait(timeout=10)
     assert process_tree.cpu_seconds(proc.pid) == 0.0
+
+
+def test_tree_and_uid_tasks_count_processes_and_threads(token):
+    """tree_tasks: the descendants' processes and threads (what a fork bomb adds); uid_tasks: every
+    process and thread of a user, what RLIMIT_NPROC counts."""
+    code = "import threading, time; [threading.Thread(target=time.sleep, args=(60,)).start() for _ in range(2)]"
+    leader = _group(token, code + "; print('ready', flush=True); time.sleep(60)")
+    try:
+        assert leader.stdout.readline() == "ready\n"
+        assert wait_until(lambda: len(processes_with(token)) == 2)
+        assert process_tree.tree_tasks(leader.pid) == 1  # its sleeping child
+        assert process_tree.tree_tasks(os.getpid()) >= 4  # the leader's three threads and its child
+        assert process_tree.uid_tasks(os.geteuid()) >= 4 + len(os.listdir("/proc/self/task"))
+    finally:
+        process_tree.signal_tree(leader.pid, signal.SIGKILL)
+        leader.wait(timeout=10)
