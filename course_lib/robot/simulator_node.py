@@ -247,7 +247,8 @@ class RobotSimulator(Node):
         nanoseconds = round(self.now * 1e9)
         now = clock.clock  # the one stamp of all four messages
         now.sec, now.nanosec = nanoseconds // 10**9, nanoseconds % 10**9
-        self.clock_pub.publish(clock)
+        if self.heard(self.clock_pub):
+            self.clock_pub.publish(clock)
         x, y, yaw = self.sim.pose()
         linear, angular = self.sim.velocity()
         translation, rotation = moved.transform.translation, moved.transform.rotation
@@ -257,11 +258,16 @@ class RobotSimulator(Node):
         position, twist = odom.pose.pose.position, odom.twist.twist
         position.x, position.y = x, y
         twist.linear.x, twist.angular.z = linear, angular
-        self.odom_pub.publish(odom)
+        if self.heard(self.odom_pub):
+            self.odom_pub.publish(odom)
         scan.ranges = array.array("f", self.sim.scan().tobytes())
         self.last_scan = scan
         self.scans += 1
         self.scan_pub.publish(scan)
+
+    def heard(self, publisher) -> bool:
+        """Whether publish_state publishes on `publisher` (/clock, /odom) this tick: always here."""
+        return True
 
     def _state_messages(self) -> tuple[ClockMessage, TransformStamped, TFMessage, Odometry, LaserScan]:
         """What publish_state sends, built once and updated in place each tick (building four
