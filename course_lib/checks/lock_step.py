@@ -85,6 +85,12 @@ class JudgedSimulator(RobotSimulator):
         kwargs.setdefault("event_callbacks", SubscriptionEventCallbacks(use_default_callbacks=False))
         return super().create_subscription(*args, **kwargs)
 
+    def heard(self, publisher) -> bool:
+        """/clock and /odom only while someone subscribes (a student's node may read /odom): a
+        message published with no subscription matched reaches nobody, even one that subscribes
+        later (the QoS is volatile), and nothing in lock-step waits for either."""
+        return publisher.get_subscription_count() > 0
+
     def publish_state(self) -> None:
         super().publish_state()
         self._spent = None  # measured from the first look at the waiting scan (on_unanswered)

@@ -19,6 +19,7 @@ needs it fails with the build's own error lines.
 
 from __future__ import annotations
 
+import functools
 import json
 import os
 import xml.etree.ElementTree as ElementTree
@@ -132,12 +133,29 @@ def endpoints(ctx, module: str, class_name: str) -> dict:
 
 def ros_packages(ctx) -> set[str]:
     """The ROS packages the code could import: installed ones (the ament index) and the workspace's."""
-    from course_lib.ros import ament
-
-    names = set(ament.packages())
+    prefixes = tuple(p for p in os.environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep) if p)
+    names = set(_installed(prefixes, tuple(_index_mtime(p) for p in prefixes)))
     src = ctx.workspace_dir() / "src"
     names.update(p.parent.name for p in src.glob("*/package.xml"))
     return names
+
+
+def _index_mtime(prefix: str) -> int | None:
+    """When the ament index of `prefix` last gained or lost a package (None: it has none)."""
+    try:
+        return os.stat(os.path.join(prefix, "share", "ament_index", "resource_index", "packages")).st_mtime_ns
+    except OSError:
+        return None
+
+
+@functools.lru_cache(maxsize=4)
+def _installed(prefixes: tuple[str, ...], mtimes: tuple) -> frozenset[str]:
+    """The installed ROS packages of these AMENT_PREFIX_PATH entries (as their indexes were at
+    `mtimes`): read once per process while neither changes (a pillar grading's checks look
+    twice, 0.02 CPU-s each)."""
+    from course_lib.ros import ament
+
+    return frozenset(ament.packages())
 
 
 def dependency_items(ctx, package: str, weight: float = 1.0) -> None:

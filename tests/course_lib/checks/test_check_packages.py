@@ -109,3 +109,22 @@ def test_a_failed_grader_build_is_the_reason_of_every_check_that_needs_it(tmp_pa
     monkeypatch.setenv(contract.BUILD_REPORT_ENV, str(report))
     with pytest.raises(StudentError, match="(?s)did not build.*SyntaxError: x"):
         packages.require_build(Recorder(tmp_path))
+
+
+def test_the_ament_index_is_read_once_until_a_package_is_installed_or_the_path_changes(tmp_path, monkeypatch):
+    from course_lib.ros import ament
+
+    index = tmp_path / "prefix" / "share" / "ament_index" / "resource_index" / "packages"
+    index.mkdir(parents=True)
+    (index / "first_pkg").write_text("")
+    monkeypatch.setenv("AMENT_PREFIX_PATH", str(tmp_path / "prefix"))
+    reads = []
+    monkeypatch.setattr(ament, "packages", lambda real=ament.packages: reads.append(1) or real())
+    ctx = Recorder(tmp_path)
+    assert "first_pkg" in packages.ros_packages(ctx) and "first_pkg" in packages.ros_packages(ctx)
+    assert len(reads) == 1
+    (index / "second_pkg").write_text("")
+    assert "second_pkg" in packages.ros_packages(ctx) and len(reads) == 2
+    monkeypatch.setenv("AMENT_PREFIX_PATH", f"{tmp_path / 'prefix'}:{tmp_path / 'other'}")
+    packages.ros_packages(ctx)
+    assert len(reads) == 3

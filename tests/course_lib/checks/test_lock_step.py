@@ -70,6 +70,16 @@ def drive(sim, executor, seconds: float = SECONDS, at_each_spin=None) -> None:
             at_each_spin()
 
 
+def wait_matched(sim, scan_subscribers: int) -> None:
+    """Wait (without spinning: DDS matches in threads of its own) until the simulator sees the
+    controller's /cmd_vel and `scan_subscribers` /scan subscriptions: a test's own listener alone
+    would start the drive before the controller hears the first scan, which is then sent again."""
+    deadline = time.monotonic() + RUN_BOUND
+    while sim.scan_pub.get_subscription_count() < scan_subscribers or sim.cmd_sub.get_publisher_count() < 1:
+        assert time.monotonic() < deadline, "the controller's endpoints never matched"
+        time.sleep(0.01)
+
+
 def stop_for(proc, sim, executor, at: float, seconds: float):
     """What drive() calls to stop the controller's process for `seconds` wall seconds once the
     simulation reaches `at` simulated seconds (once), spinning the simulator meanwhile; and a list
@@ -161,6 +171,7 @@ def test_drive_until_drives_exactly_as_an_executors_spin_and_feeds_its_listeners
         scans = []
         subscription = listener.create_subscription(LaserScan, "scan", scans.append, 1000)
         try:
+            wait_matched(sim, scan_subscribers=2)
             assert sim.drive_until(lambda: sim.sim.time >= SECONDS - 1e-9 or sim.halted is not None, RUN_BOUND,
                                    listeners=[subscription])
             assert sim.failure is None and sim.sim.pose() == undisturbed
@@ -190,3 +201,32 @@ def test_drive_until_keeps_the_pace_of_max_real_time_factor_and_drives_the_same(
         assert sim.drive_until(lambda: sim.sim.time >= SECONDS - 1e-9 or sim.halted is not None, RUN_BOUND)
         assert time.monotonic() - started >= SECONDS / 2.0 - 0.05
         assert sim.failure is None and sim.sim.pose() == undisturbed
+
+
+def test_odom_goes_out_only_to_a_subscriber_which_then_gets_every_tick_and_the_drive_is_the_same(domain_id,
+                                                                                                  undisturbed):
+    """/clock and /odom, which nothing in lock-step waits for, are published only while someone
+    subscribes: a student's node that reads /odom gets each tick's, stamped in order."""
+    from nav_msgs.msg import Odometry
+
+    with lock_step(domain_id) as (sim, _, _):
+        assert not sim.heard(sim.odom_pub) and not sim.heard(sim.clock_pub)
+        listener = rclpy.create_node("odom_listener", context=sim.context)
+        odom = []
+        subscription = listener.create_subscription(Odometry, "odom", odom.append, 1000)
+        try:
+            wait_matched(sim, scan_subscribers=1)
+            deadline = time.monotonic() + RUN_BOUND
+            while not sim.heard(sim.odom_pub):
+                assert time.monotonic() < deadline, "the simulator never saw the /odom subscription"
+                time.sleep(0.01)
+            assert not sim.heard(sim.clock_pub)
+            assert sim.drive_until(lambda: sim.sim.time >= SECONDS - 1e-9 or sim.halted is not None, RUN_BOUND,
+                                   listeners=[subscription])
+            assert sim.failure is None and sim.sim.pose() == undisturbed
+            published = sim.scans
+            assert sim.drive_until(lambda: len(odom) >= published, RUN_BOUND, listeners=[subscription])
+            stamps = [round(m.header.stamp.sec + m.header.stamp.nanosec * 1e-9, 2) for m in odom[:published]]
+            assert stamps == [round(i * 0.05, 2) for i in range(published)]
+        finally:
+            listener.destroy_node()
