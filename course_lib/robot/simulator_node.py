@@ -36,7 +36,6 @@ from __future__ import annotations
 
 import array
 import math
-import sys
 import time
 
 import rclpy
@@ -77,19 +76,6 @@ def pace_delay(simulated: float, wall: float, factor: float) -> float:
     if factor <= 0:
         return 0.0
     return max(0.0, simulated / factor - wall)
-
-
-def log_info(logger, message: str) -> None:
-    """``logger.info(message)`` with the same line on the console, in the log file and on /rosout,
-    without rclpy's look-up of the caller (``inspect.getframeinfo``: its first call in a process
-    maps every loaded module to its file, some 12 ms) and without its filters (none is asked for)."""
-    from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
-    from rclpy.logging import LoggingSeverity
-
-    if logger.is_enabled_for(LoggingSeverity.INFO):
-        caller = sys._getframe(1)
-        _rclpy.rclpy_logging_rcutils_log(LoggingSeverity.INFO, logger.name, message, caller.f_code.co_name,
-                                         caller.f_code.co_filename, caller.f_lineno)
 
 
 def yaw_quaternion(yaw: float) -> tuple[float, float, float, float]:
@@ -141,7 +127,7 @@ class RobotSimulator(Node):
         cap = f", at most x{self.max_real_time_factor:g} real time" if self.max_real_time_factor > 0 else ""
         pace = (f"lock-step{cap}: waiting for a /scan subscriber and a /cmd_vel publisher" if self.lock_step
                 else f"real time x{self.real_time_factor:g}")
-        log_info(self.get_logger(), f"Robot in world '{world}' (seed {seed}){self.pillar_words()}, {pace}")
+        self.get_logger().info(f"Robot in world '{world}' (seed {seed}){self.pillar_words()}, {pace}")
 
     @property
     def now(self) -> float:

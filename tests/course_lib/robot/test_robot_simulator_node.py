@@ -24,7 +24,7 @@ from std_srvs.srv import Trigger
 from tf2_msgs.msg import TFMessage
 
 from course_lib.robot import husky
-from course_lib.robot.simulator_node import RobotSimulator, log_info, pace_delay
+from course_lib.robot.simulator_node import RobotSimulator, pace_delay
 
 BACKSTOP = 60.0
 
@@ -194,17 +194,6 @@ def test_a_nan_command_is_refused_with_an_error_and_the_robot_stops(run):
     assert abs(sim.velocity()[0]) < 0.01
     errors = [log.msg for log in heard.logs if log.level == Log.ERROR]
     assert errors and "Refused /cmd_vel" in errors[0] and "not finite" in errors[0]
-
-
-def test_log_info_writes_the_line_get_logger_info_writes(capfd):
-    """The simulator's start line, logged without rclpy's caller look-up, reads the same."""
-    logger = rclpy.logging.get_logger("log_info_test")
-    log_info(logger, "Robot in world 'pillar' (seed 3)")
-    logger.info("Robot in world 'pillar' (seed 3)")
-    lines = [line for line in capfd.readouterr().err.splitlines() if "log_info_test" in line]
-    assert len(lines) == 2
-    expected = ["[INFO", " [log_info_test]: Robot in world 'pillar' (seed 3)"]  # the time stamp left out
-    assert [line.split("]", 2)[::2] for line in lines] == [expected] * 2
 
 
 def test_reset_puts_the_robot_back_and_the_clock_goes_on(run):
