@@ -13,6 +13,7 @@ import math
 import cv2
 import numpy as np
 
+from course_lib.imaging import drawn_cache
 from course_lib.imaging.boards import Board, _square, default_board
 
 DIFFICULTIES = ("easy", "hard")
@@ -183,9 +184,15 @@ _NOISE_PAD = 64
 
 
 def _noise_tile(size) -> np.ndarray:
+    """The webcam's fixed field of sensor noise for frames of `size` (a window of it per frame): mapped
+    from the copy kept on disk (drawn_cache), else drawn."""
     width, height = size
-    rng = np.random.default_rng(4321)
-    return rng.standard_normal((height + _NOISE_PAD, width + _NOISE_PAD, 3), dtype=np.float32)
+
+    def draw():
+        rng = np.random.default_rng(4321)
+        return rng.standard_normal((height + _NOISE_PAD, width + _NOISE_PAD, 3), dtype=np.float32)
+
+    return drawn_cache.kept(f"noise_tile-{width}x{height}", drawn_cache.key("camera_views.py"), draw, np.float32)
 
 
 def _gamma_table(gamma: float) -> np.ndarray:
