@@ -184,15 +184,17 @@ _NOISE_PAD = 64
 
 
 def _noise_tile(size) -> np.ndarray:
-    """The webcam's fixed field of sensor noise for frames of `size` (a window of it per frame): mapped
-    from the copy kept on disk (drawn_cache), else drawn."""
+    """A fixed field of sensor noise for frames of `size` (a random window of it per frame): the
+    default frame size's is mapped from the copy kept on disk (drawn_cache), others are drawn."""
     width, height = size
 
     def draw():
         rng = np.random.default_rng(4321)
         return rng.standard_normal((height + _NOISE_PAD, width + _NOISE_PAD, 3), dtype=np.float32)
 
-    return drawn_cache.kept(f"noise_tile-{width}x{height}", drawn_cache.key("camera_views.py"), draw, np.float32)
+    if (width, height) != (640, 480):
+        return draw()
+    return drawn_cache.kept("noise_tile", drawn_cache.key("camera_views.py"), draw, np.float32)
 
 
 def _gamma_table(gamma: float) -> np.ndarray:

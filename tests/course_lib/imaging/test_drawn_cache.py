@@ -86,6 +86,9 @@ def test_the_wood_grain_and_the_noise_field_from_kept_copies_are_the_numbers_dra
     mapped = table._wood_grain((40, 30))
     assert not mapped.flags.writeable and np.array_equal(grain, table._draw_wood_grain((40, 30)))
     assert np.array_equal(mapped, grain)
-    noise = camera_views._noise_tile((32, 24))
-    assert (folder / "noise_tile-32x24-test.bin").exists() and noise.shape == (24 + 64, 32 + 64, 3)
-    assert np.array_equal(camera_views._noise_tile((32, 24)), noise)
+    noise = camera_views._noise_tile((640, 480))
+    assert (folder / "noise_tile-test.bin").exists() and noise.shape == (480 + 64, 640 + 64, 3)
+    assert np.array_equal(camera_views._noise_tile((640, 480)), noise)
+    assert not camera_views._noise_tile((640, 480)).flags.writeable  # mapped
+    assert camera_views._noise_tile((32, 24)).shape == (88, 96, 3)  # drawn: only the default size is kept
+    assert sorted(p.name for p in folder.glob("noise_tile*")) == ["noise_tile-test.bin"]
