@@ -203,11 +203,12 @@ def render_scene(seed: int | Sequence[int] = 0, *, size: tuple[int, int] = (640,
     occluded = set(_check_ids(occluded_markers, "occluded_markers", board_only=True))
     if difficulty == "hard" and finger_rng.random() < 0.25:
         occluded.add(int(finger_rng.choice([i for ids in PICTURES.values() for i in ids])))
-    return _render(board, pose or sampled_pose, look or sampled_look, size,
+    look = look or sampled_look
+    return _render(board, pose or sampled_pose, look, size,
                    missing=_check_ids(missing_markers, "missing_markers", board_only=True),
                    occluded=tuple(sorted(occluded)), duplicates=_check_ids(duplicate_markers, "duplicate_markers"),
                    table=lambda: _table(board, _seed_entropy(seed)), finger_rng=finger_rng, noise_rng=noise_rng,
-                   seed=seed, difficulty=difficulty)
+                   seed=seed, difficulty=difficulty, noise_tile=_noise_tile(size) if look.noise > 0 else None)
 
 
 def scene_pose(seed: int | Sequence[int] = 0, *, size: tuple[int, int] = (640, 480), difficulty: str = "easy",

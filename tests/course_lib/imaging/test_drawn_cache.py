@@ -86,7 +86,9 @@ def test_the_wood_grain_and_the_noise_field_from_kept_copies_are_the_numbers_dra
     mapped = table._wood_grain((40, 30))
     assert not mapped.flags.writeable and np.array_equal(grain, table._draw_wood_grain((40, 30)))
     assert np.array_equal(mapped, grain)
+    camera_views._noise_tile.cache_clear()
     noise = camera_views._noise_tile((640, 480))
+    camera_views._noise_tile.cache_clear()
     assert (folder / "noise_tile-test.bin").exists() and noise.shape == (480 + 64, 640 + 64, 3)
     assert np.array_equal(camera_views._noise_tile((640, 480)), noise)
     assert not camera_views._noise_tile((640, 480)).flags.writeable  # mapped
