@@ -13,16 +13,21 @@ from __future__ import annotations
 
 import ctypes
 
-#: Blocks up to this size come from (and go back to) the heap, and up to twice it of free memory
-#: at the heap's top is kept: a 1280x960 float32 frame is 14.7 MB. glibc allows at most 32 MB here.
-LIMIT = 32 * 1024 * 1024
+#: Blocks below this size come from the heap and go back to it (a 1280x960 float32 frame is
+#: 14.7 MB; glibc allows at most 32 MB here) ...
+MMAP_THRESHOLD = 32 * 1024 * 1024
+#: ... and the heap keeps this much free memory at its top before it gives any back.
+TRIM_THRESHOLD = 128 * 1024 * 1024
+#: The same settings for a process about to start (glibc reads them there): the checks give them
+#: to every student process (course_lib.checks.student_processes).
+ENVIRONMENT = {"MALLOC_MMAP_THRESHOLD_": str(MMAP_THRESHOLD), "MALLOC_TRIM_THRESHOLD_": str(TRIM_THRESHOLD)}
 _M_TRIM_THRESHOLD, _M_MMAP_THRESHOLD = -1, -3
 
 
-def keep_freed_frames(limit: int = LIMIT) -> bool:
-    """Let this process reuse freed blocks up to `limit` bytes; True when the C library took it
+def keep_freed_frames() -> bool:
+    """Give this running process the settings of ENVIRONMENT; True when the C library took them
     (glibc's mallopt; elsewhere nothing changes)."""
     mallopt = getattr(ctypes.CDLL(None), "mallopt", None)
     if mallopt is None:
         return False
-    return bool(mallopt(_M_MMAP_THRESHOLD, limit)) and bool(mallopt(_M_TRIM_THRESHOLD, 2 * limit))
+    return bool(mallopt(_M_MMAP_THRESHOLD, MMAP_THRESHOLD)) and bool(mallopt(_M_TRIM_THRESHOLD, TRIM_THRESHOLD))
