@@ -168,9 +168,13 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     import cv2
 
+    from course_lib.imaging import frame_memory
+
     # The checks run side by side in threads and draw their scenes there: OpenCV's own worker
-    # threads would only add to the processor time on the cores they already share.
+    # threads would only add to the processor time on the cores they already share; and each
+    # scene's arrays reuse the memory of the last one's.
     cv2.setNumThreads(1)
+    frame_memory.keep_freed_frames()
     run_outside(args.assignment, args.checks, args.workdir, Path(args.out))
     return 0
 

@@ -13,6 +13,7 @@ from pathlib import Path
 
 from course_lib import contract
 from course_lib.checks.runner import child_pythonpath
+from course_lib.imaging import frame_memory
 
 #: Largest file a student's process may write, MB.
 STUDENT_FILE_MB = 128
@@ -33,7 +34,7 @@ def student_env() -> dict:
 #: then costs 10 or 25 ms of processor time in the same node: the brightness check's throughput
 #: item compares processor time per frame (course_lib.checks.brightness), and with this setting a
 #: good node costs what the grader's yardstick does, 0.9-1.1 times, idle or loaded.
-MALLOC_ENV = {"MALLOC_MMAP_THRESHOLD_": str(32 * 1024 * 1024), "MALLOC_TRIM_THRESHOLD_": str(128 * 1024 * 1024)}
+MALLOC_ENV = frame_memory.ENVIRONMENT
 
 
 class StudentProcesses:

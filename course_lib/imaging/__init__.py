@@ -7,5 +7,7 @@
 - the world the camera sees: ``camera_views`` (poses), ``table`` (the cluttered table),
   ``scenes`` (seeded scenes with ground truth, the camera's path), ``camera`` (the webcam node);
 - ``drawing``: markers, image grids and plots drawn for the lessons (``from course_lib import
-  vision`` in a notebook).
+  vision`` in a notebook);
+- ``frame_memory``: processes that draw many frames (the webcam node, the grader's checks) reuse
+  the memory of freed frames.
 """

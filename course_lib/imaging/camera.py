@@ -26,7 +26,7 @@ from rclpy.node import Node
 from sensor_msgs.msg import Image
 from std_srvs.srv import Trigger
 
-from course_lib.imaging import images, scenes
+from course_lib.imaging import frame_memory, images, scenes
 
 FRAME_ID = "camera"
 
@@ -148,6 +148,7 @@ def main(args=None):
     # A camera process does one thing: OpenCV's worker threads would make each frame sooner but
     # cost about a fifth more processor (14 instead of 17 ms per 640x480 frame on one thread).
     cv2.setNumThreads(1)
+    frame_memory.keep_freed_frames()  # each frame's arrays reuse the last one's memory
     rclpy.init(args=args)
     node = None
     try:

@@ -2,8 +2,9 @@
 
 The default board (its pictures and its texture levels, about 46 MB) takes about 0.1 s of
 processor time to draw, in every process that shows it: a notebook's kernel, the webcam node and
-the grader's checks. :func:`load` maps a kept copy instead (read-only; only the pages a process
-reads are read), :func:`store` keeps one.
+the grader's checks; the table's wood grain 16 ms and the webcam's noise field 10 ms. :func:`load`
+maps a kept copy instead (read-only; only the pages a process reads are read), :func:`store`
+keeps one, and :func:`kept` does both for one array of any number type.
 
 A copy lives in this package's ``__pycache__`` folder, named by a key of what drew it (the
 drawing modules' source and OpenCV's and numpy's versions: :func:`key`). It is trusted only when
@@ -21,6 +22,7 @@ import mmap
 import os
 import stat
 import tempfile
+from collections.abc import Callable
 from pathlib import Path
 
 import cv2
@@ -86,6 +88,18 @@ def store(name: str, key: str, images: list[np.ndarray]) -> None:
         finally:
             with contextlib.suppress(FileNotFoundError):
                 os.unlink(staging)
+
+
+def kept(name: str, key: str, draw: Callable[[], np.ndarray], dtype=np.uint8) -> np.ndarray:
+    """The array kept as `name` with this `key` (read-only, of `dtype`), else draw()'s as `dtype`,
+    then kept when this process may."""
+    loaded = load(name, key)
+    if loaded is not None and len(loaded) == 1:
+        with contextlib.suppress(ValueError):  # bytes that make no array of `dtype`: drawn again
+            return loaded[0].view(dtype)
+    array = np.ascontiguousarray(draw(), dtype)
+    store(name, key, [array.view(np.uint8)])
+    return array
 
 
 def _arrays(mapped: mmap.mmap) -> list[np.ndarray] | None:

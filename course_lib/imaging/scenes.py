@@ -203,11 +203,12 @@ def render_scene(seed: int | Sequence[int] = 0, *, size: tuple[int, int] = (640,
     occluded = set(_check_ids(occluded_markers, "occluded_markers", board_only=True))
     if difficulty == "hard" and finger_rng.random() < 0.25:
         occluded.add(int(finger_rng.choice([i for ids in PICTURES.values() for i in ids])))
-    return _render(board, pose or sampled_pose, look or sampled_look, size,
+    look = look or sampled_look
+    return _render(board, pose or sampled_pose, look, size,
                    missing=_check_ids(missing_markers, "missing_markers", board_only=True),
                    occluded=tuple(sorted(occluded)), duplicates=_check_ids(duplicate_markers, "duplicate_markers"),
                    table=lambda: _table(board, _seed_entropy(seed)), finger_rng=finger_rng, noise_rng=noise_rng,
-                   seed=seed, difficulty=difficulty)
+                   seed=seed, difficulty=difficulty, noise_tile=_noise_tile(size) if look.noise > 0 else None)
 
 
 def scene_pose(seed: int | Sequence[int] = 0, *, size: tuple[int, int] = (640, 480), difficulty: str = "easy",
@@ -346,8 +347,8 @@ def _pick_level(levels: TextureLevels, to_super):
 
 def _composite(image: np.ndarray, levels, to_super, super_size) -> np.ndarray:
     """Paste a BGRA texture (a list of levels) through a homography onto image, in place; returns
-    image. Only the texture's bounding box (2 pixels more for the interpolated edge) is warped and
-    blended: outside it the layer is fully transparent."""
+    image. Only the texture's bounding box (2 pixels more for the interpolated edge) is warped:
+    outside it the layer is fully transparent."""
     scale, shape = levels.scales[0], levels.shapes[0]
     outline = _project(to_super, _square(0, 0, 1) * [shape[1] / scale, shape[0] / scale])
     x0, y0 = np.maximum(np.floor(outline.min(axis=0)).astype(int) - 2, 0)
@@ -355,10 +356,24 @@ def _composite(image: np.ndarray, levels, to_super, super_size) -> np.ndarray:
     if x1 <= x0 or y1 <= y0:
         return image
     layer = _warp_levels(levels, _translation(-x0, -y0) @ to_super, (int(x1 - x0), int(y1 - y0)))
-    alpha = layer[:, :, 3].astype(np.float32) * np.float32(1 / 255)
-    box = image[y0:y1, x0:x1]
-    box[:] = cv2.blendLinear(layer[:, :, :3], box, alpha, 1 - alpha)
+    _blend(image[y0:y1, x0:x1], layer)
     return image
+
+
+def _blend(box: np.ndarray, layer: np.ndarray) -> None:
+    """box = layer over box by the layer's alpha, in place: cv2.blendLinear's pixels (weights alpha / 255
+    and 1 - alpha / 255). Where alpha is 255 that is the layer's pixel and where it is 0 the box's, so
+    only the pixels in between (a textured layer's anti-aliased edge, about 0.2 % of a board's box)
+    are blended: a fifth of the processor time of blending the whole box."""
+    alpha = cv2.extractChannel(layer, 3)
+    edge = cv2.findNonZero(cv2.inRange(alpha, 1, 254))
+    if edge is not None:
+        xs, ys = edge.reshape(-1, 2).T
+        weight = alpha[ys, xs].astype(np.float32)[:, None] * np.float32(1 / 255)
+        blended = cv2.blendLinear(layer[ys, xs, :3][:, None], box[ys, xs][:, None], weight, 1 - weight)
+    cv2.copyTo(cv2.cvtColor(layer, cv2.COLOR_BGRA2BGR), alpha, box)
+    if edge is not None:
+        box[ys, xs] = blended[:, 0]
 
 
 def _sticker(marker_id: int) -> np.ndarray:

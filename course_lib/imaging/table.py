@@ -8,6 +8,7 @@ import threading
 import cv2
 import numpy as np
 
+from course_lib.imaging import drawn_cache
 from course_lib.imaging.boards import Board, TextureLevels
 
 # --------------------------------------------------------------------------------------------
@@ -24,17 +25,22 @@ _GRAIN_LOCK = threading.Lock()  # the checks of a submission render in threads: 
 
 def _wood_grain(size) -> np.ndarray:
     """Brightness pattern of a wooden table top around 1.0 (one channel, float32), the same for
-    every table of that size."""
+    every table of that size: mapped from the copy kept on disk (drawn_cache), else drawn."""
     with _GRAIN_LOCK:
         if size not in _GRAIN:
-            rng = np.random.default_rng(12345)
             width, height = size
-            blotches = cv2.resize(rng.normal(0, 1, (6, 8)).astype(np.float32), size, interpolation=cv2.INTER_CUBIC)
-            y = np.arange(height, dtype=np.float32)[:, None]
-            grain = (np.sin(y * np.float32(0.2) + 3 * blotches) * 0.5
-                     + rng.normal(0, 0.15, (height, 1)).astype(np.float32))
-            _GRAIN[size] = np.ascontiguousarray(1 + 0.08 * blotches + 0.06 * grain, dtype=np.float32)
+            _GRAIN[size] = drawn_cache.kept(f"wood_grain-{width}x{height}", drawn_cache.key("table.py"),
+                                            lambda: _draw_wood_grain(size), np.float32)
         return _GRAIN[size]
+
+
+def _draw_wood_grain(size) -> np.ndarray:
+    rng = np.random.default_rng(12345)
+    width, height = size
+    blotches = cv2.resize(rng.normal(0, 1, (6, 8)).astype(np.float32), size, interpolation=cv2.INTER_CUBIC)
+    y = np.arange(height, dtype=np.float32)[:, None]
+    grain = (np.sin(y * np.float32(0.2) + 3 * blotches) * 0.5 + rng.normal(0, 0.15, (height, 1)).astype(np.float32))
+    return np.ascontiguousarray(1 + 0.08 * blotches + 0.06 * grain, dtype=np.float32)
 
 
 def _plain_table():

@@ -60,3 +60,37 @@ def test_the_default_board_from_a_kept_copy_draws_the_same_frames(folder, monkey
         a = scenes.render_scene(seed, board=drawn, missing_markers=missing)
         b = scenes.render_scene(seed, board=mapped, missing_markers=missing)
         assert np.array_equal(a.frame, b.frame)
+
+
+def test_kept_arrays_of_any_number_type_are_drawn_once_then_mapped(folder):
+    """kept(): the first call draws and keeps, the next maps the copy (read-only), the same numbers."""
+    drawn = []
+
+    def draw():
+        drawn.append(1)
+        return np.random.default_rng(1).standard_normal((4, 5, 3), dtype=np.float32)
+
+    first = drawn_cache.kept("field", "k", draw, np.float32)
+    second = drawn_cache.kept("field", "k", draw, np.float32)
+    assert len(drawn) == 1 and second.dtype == np.float32 and not second.flags.writeable
+    assert np.array_equal(first, second)
+
+
+def test_the_wood_grain_and_the_noise_field_from_kept_copies_are_the_numbers_drawn(folder, monkeypatch):
+    from course_lib.imaging import camera_views, table
+
+    monkeypatch.setattr(drawn_cache, "key", lambda *modules: "test")
+    monkeypatch.setattr(table, "_GRAIN", {})
+    grain = table._wood_grain((40, 30))
+    monkeypatch.setattr(table, "_GRAIN", {})
+    mapped = table._wood_grain((40, 30))
+    assert not mapped.flags.writeable and np.array_equal(grain, table._draw_wood_grain((40, 30)))
+    assert np.array_equal(mapped, grain)
+    camera_views._noise_tile.cache_clear()
+    noise = camera_views._noise_tile((640, 480))
+    camera_views._noise_tile.cache_clear()
+    assert (folder / "noise_tile-test.bin").exists() and noise.shape == (480 + 64, 640 + 64, 3)
+    assert np.array_equal(camera_views._noise_tile((640, 480)), noise)
+    assert not camera_views._noise_tile((640, 480)).flags.writeable  # mapped
+    assert camera_views._noise_tile((32, 24)).shape == (88, 96, 3)  # drawn: only the default size is kept
+    assert sorted(p.name for p in folder.glob("noise_tile*")) == ["noise_tile-test.bin"]

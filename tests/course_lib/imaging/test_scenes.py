@@ -76,6 +76,23 @@ def test_frame_sizes_from_tiny_to_full_hd_render(size):
         assert scene.fully_framed == (), "markers of a few pixels cannot count as detectable"
 
 
+@pytest.mark.parametrize("alphas", ["every", "opaque", "transparent"])
+def test_a_layer_is_pasted_with_blend_linears_pixels_though_only_its_edge_is_blended(alphas):
+    """scenes._blend (only where the layer is partly transparent) gives the pixels of cv2.blendLinear
+    over the whole box, for every alpha (random pixels on both sides), in a box that is a view into
+    a larger frame."""
+    rng = np.random.default_rng(7)
+    layer = rng.integers(0, 256, (256, 300, 4), dtype=np.uint8)
+    layer[:, :, 3] = {"every": np.arange(256)[:, None], "opaque": 255, "transparent": 0}[alphas]
+    frame = rng.integers(0, 256, (300, 340, 3), dtype=np.uint8)
+    box = frame[20:276, 30:330]
+    alpha = layer[:, :, 3].astype(np.float32) * np.float32(1 / 255)
+    expected = frame.copy()
+    expected[20:276, 30:330] = cv2.blendLinear(layer[:, :, :3], box, alpha, 1 - alpha)
+    scenes._blend(box, layer)
+    np.testing.assert_array_equal(frame, expected)
+
+
 def test_unknown_options_are_refused_with_the_valid_choices():
     with pytest.raises(ValueError, match="easy"):
         scenes.render_scene(0, difficulty="medium")
