@@ -226,6 +226,7 @@ def test_partial_regrade_keeps_every_other_grade(term, feedback):
     export_before = _rows(course / "grades.csv")
     bob_page = (feedback / "bob" / "index.html").read_text()
     alice_pubsub = (course / "autograded" / "alice" / "pubsub" / "pubsub.ipynb").stat().st_mtime_ns
+    alice_quiz = (course / "autograded" / "alice" / "quiz" / "quiz.ipynb").stat().st_mtime_ns
     _run("grade", str(course), "--student", "alice", "--assignment", "quiz", "--force",
          env={"AUTOGRADER_SEED": "4242"})
     _run("feedback", str(course), "--student", "alice", "--assignment", "quiz")
@@ -239,7 +240,9 @@ def test_partial_regrade_keeps_every_other_grade(term, feedback):
     assert report[regraded]["from_cache"] == "0"
     assert {k: v for k, v in export.items() if k != regraded} == \
         {k: v for k, v in export_before.items() if k != regraded}
-    assert "seed 4242" in zoo.graded_outputs(course, *regraded)
+    # Graded again (the quiz draws nothing from its seed, so its verdict shows none).
+    assert (course / "autograded" / "alice" / "quiz" / "quiz.ipynb").stat().st_mtime_ns != alice_quiz
+    assert "[graded] " in zoo.graded_outputs(course, *regraded)
     assert (course / "autograded" / "alice" / "pubsub" / "pubsub.ipynb").stat().st_mtime_ns == alice_pubsub
     assert (feedback / "bob" / "index.html").read_text() == bob_page
     # One assignment's feedback for everyone keeps the other assignments in each index.

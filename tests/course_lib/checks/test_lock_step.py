@@ -178,10 +178,11 @@ def test_drive_until_drives_exactly_as_an_executors_spin_and_feeds_its_listeners
             # The scans reach the listener through DDS's transport, on a busy machine some way
             # behind: the rest arrive while the drive goes on. A first scan the controller had not
             # answered within FIRST_SCAN_RESEND s (a busy machine's start) went out twice.
-            published = sim.scans + sim.resent
+            ticks, resent = sim.scans, int(sim.resent)
+            published = ticks + resent
             assert sim.drive_until(lambda: len(scans) >= published, RUN_BOUND, listeners=[subscription])
             stamps = [round(m.header.stamp.sec + m.header.stamp.nanosec * 1e-9, 2) for m in scans[:published]]
-            assert stamps == [0.0] * sim.resent + [round(i * 0.05, 2) for i in range(sim.scans)]
+            assert stamps == [0.0] * resent + [round(i * 0.05, 2) for i in range(ticks)]
         finally:
             listener.destroy_node()
 
