@@ -176,7 +176,10 @@ def entries(course_dir: str) -> dict[str, dict]:
         # Gated to the grader's student processes (not the notebook kernel), to keep the zoo short.
         "fork_bomb": dict(edits=[(SUM, "import os, sys\n    while 'ipykernel' not in sys.argv[0]:\n"
                                        "        os.fork()\n    " + SUM)], values=0, node=None,
-                          reason="average_brightness failed"),
+                          # fork() refused at the process limit, or the function's server killed
+                          # there (whichever comes first: the call then ended with its server)
+                          reason=("average_brightness failed", "the call average_brightness on",
+                                  "the most processes and threads it may have")),
         # 256 MB of output from each of the grader's student processes, 800 times what the grader
         # keeps of a log (course_lib.supervision.bounded_log): neither memory nor disk fills, the answers count.
         "prints_flood": dict(edits=[(SUM, "import sys\n"
