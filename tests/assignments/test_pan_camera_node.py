@@ -8,7 +8,6 @@ says why. Here: SIGTERM to ROUNDS spinning main() calls in one process (support.
 
 from __future__ import annotations
 
-import signal
 import sys
 
 import pytest
@@ -39,13 +38,6 @@ def test_sigterm_ends_the_nodes_main_every_time_as_ctrl_c_does(node_env):
 @pytest.mark.slow
 def test_a_node_process_ends_on_sigterm_with_exit_code_0(node_env):
     """`kill` of a pan_camera_node process that spins ends it at once, as Ctrl-C does (exit code 0)."""
-    from course_lib.ros.processes import NodeProcess
-
-    node = NodeProcess([sys.executable, "-m", "pan_camera.pan_camera_node"], env=node_env)
-    node.start()
-    try:
-        node.wait_for_node("pan_camera", timeout=30)
-        node.send_signal(signal.SIGTERM)
-        assert node.wait(timeout=sigterm_rounds.ENDS_WITHIN) == 0, node.log
-    finally:
-        node.stop()
+    code, log = sigterm_rounds.exit_code_after_sigterm([sys.executable, "-m", "pan_camera.pan_camera_node"],
+                                                       "pan_camera", node_env)
+    assert code == 0, log

@@ -10,7 +10,6 @@ runs, at rounds 1 to 49), and `kill` of a real server process, which exits 0.
 from __future__ import annotations
 
 import json
-import signal
 import sys
 
 import pytest
@@ -57,17 +56,10 @@ def test_sigterm_ends_main_every_time_as_ctrl_c_does(server_env):
 def test_a_server_process_ends_on_sigterm_with_exit_code_0(server_env):
     """`kill` of a server process that spins ends it at once, as Ctrl-C does (exit code 0)."""
     folder, env = server_env
-    from course_lib.ros.processes import NodeProcess
-
     source = "import find_pictures_server; find_pictures_server.main()"  # python -c: its folder is importable
-    server = NodeProcess([sys.executable, "-c", source], env=env, cwd=folder)
-    server.start()
-    try:
-        server.wait_for_node("find_pictures_server", timeout=30)
-        server.send_signal(signal.SIGTERM)
-        assert server.wait(timeout=sigterm_rounds.ENDS_WITHIN) == 0, server.log
-    finally:
-        server.stop()
+    code, log = sigterm_rounds.exit_code_after_sigterm([sys.executable, "-c", source], "find_pictures_server",
+                                                       env, cwd=folder)
+    assert code == 0, log
 
 
 def test_the_server_hands_sigterm_on_before_rclpy_init_and_the_lesson_says_why():

@@ -15,6 +15,7 @@ outlive a round's context.
 
 from __future__ import annotations
 
+import signal
 import subprocess
 import sys
 from pathlib import Path
@@ -32,6 +33,22 @@ def run_rounds(module: str, env: dict, cwd: Path | None = None, rounds: int = RO
     """Run `module`'s main() `rounds` times in one process, each ended by SIGTERM while it spins."""
     return subprocess.run([sys.executable, __file__, module, str(rounds)], env=env, cwd=cwd, capture_output=True,
                           text=True, timeout=rounds * ENDS_WITHIN + 60)
+
+
+def exit_code_after_sigterm(command: list[str], node: str, env: dict, cwd: Path | None = None) -> tuple[int, str]:
+    """Start `command` (a node process), wait until its node `node` is in the graph, send it SIGTERM
+    and return its exit code within ENDS_WITHIN seconds, and its log (the process is stopped
+    whatever happens)."""
+    from course_lib.ros.processes import NodeProcess
+
+    process = NodeProcess(command, env=env, cwd=cwd)
+    process.start()
+    try:
+        process.wait_for_node(node, timeout=30)
+        process.send_signal(signal.SIGTERM)
+        return process.wait(timeout=ENDS_WITHIN), process.log
+    finally:
+        process.stop()
 
 
 def _main(module: str, rounds: int) -> None:
